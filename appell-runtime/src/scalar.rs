@@ -1,0 +1,254 @@
+//! The scalar trait the generated code is generic over.
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+
+/// A real number type the generated equations of motion can run on: `f64`,
+/// `f32`, and (with the `dual` feature) the dual numbers of `num-dual`, so
+/// derivatives of the generated code come out exactly by forward-mode
+/// automatic differentiation.
+///
+/// Emitted code calls these as methods (`x.sin()`), so the trait must be in
+/// scope there; the derive takes care of that.
+///
+/// ```
+/// use appell_runtime::Scalar;
+///
+/// fn pendulum_accel<T: Scalar>(theta: T, g_over_l: T) -> T {
+///     -(g_over_l * theta.sin())
+/// }
+/// assert_eq!(pendulum_accel(0.0_f64, 9.81), 0.0);
+/// assert!((pendulum_accel(0.5_f32, 9.81) + 9.81 * 0.5_f32.sin()).abs() < 1e-6);
+/// ```
+pub trait Scalar:
+    Copy
+    + Debug
+    + Add<Output = Self>
+    + Sub<Output = Self>
+    + Mul<Output = Self>
+    + Div<Output = Self>
+    + Neg<Output = Self>
+    + AddAssign
+    + SubAssign
+    + MulAssign
+    + DivAssign
+    + 'static
+{
+    /// The value `x` (rounded for `f32`; a constant for dual numbers).
+    fn from_f64(x: f64) -> Self;
+    /// The real part as `f64` (the value itself for plain floats).
+    fn re(self) -> f64;
+    /// Sine.
+    fn sin(self) -> Self;
+    /// Cosine.
+    fn cos(self) -> Self;
+    /// Tangent.
+    fn tan(self) -> Self;
+    /// Exponential.
+    fn exp(self) -> Self;
+    /// Natural logarithm.
+    fn ln(self) -> Self;
+    /// Absolute value.
+    fn abs(self) -> Self;
+    /// Square root.
+    fn sqrt(self) -> Self;
+    /// Integer power.
+    fn powi(self, n: i32) -> Self;
+    /// Four-quadrant arctangent of `self / x`.
+    fn atan2(self, x: Self) -> Self;
+    /// Zero.
+    fn zero() -> Self {
+        Self::from_f64(0.0)
+    }
+    /// One.
+    fn one() -> Self {
+        Self::from_f64(1.0)
+    }
+}
+
+macro_rules! float_scalar {
+    ($t:ty, $libm_suffix:ident) => {
+        impl Scalar for $t {
+            #[inline(always)]
+            fn from_f64(x: f64) -> Self {
+                x as $t
+            }
+            #[inline(always)]
+            fn re(self) -> f64 {
+                self as f64
+            }
+            #[inline(always)]
+            fn sin(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, sin, self)
+            }
+            #[inline(always)]
+            fn cos(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, cos, self)
+            }
+            #[inline(always)]
+            fn tan(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, tan, self)
+            }
+            #[inline(always)]
+            fn exp(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, exp, self)
+            }
+            #[inline(always)]
+            fn ln(self) -> Self {
+                #[cfg(feature = "std")]
+                {
+                    <$t>::ln(self)
+                }
+                #[cfg(not(feature = "std"))]
+                {
+                    libm::Libm::<$t>::log(self)
+                }
+            }
+            #[inline(always)]
+            fn abs(self) -> Self {
+                if self < 0.0 {
+                    -self
+                } else {
+                    self
+                }
+            }
+            #[inline(always)]
+            fn sqrt(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, sqrt, self)
+            }
+            #[inline(always)]
+            fn powi(self, n: i32) -> Self {
+                #[cfg(feature = "std")]
+                {
+                    <$t>::powi(self, n)
+                }
+                #[cfg(not(feature = "std"))]
+                {
+                    libm::Libm::<$t>::pow(self, n as $t)
+                }
+            }
+            #[inline(always)]
+            fn atan2(self, x: Self) -> Self {
+                #[cfg(feature = "std")]
+                {
+                    <$t>::atan2(self, x)
+                }
+                #[cfg(not(feature = "std"))]
+                {
+                    libm::Libm::<$t>::atan2(self, x)
+                }
+            }
+        }
+    };
+    (@call $t:ty, $s:ident, $f:ident, $x:expr) => {{
+        #[cfg(feature = "std")]
+        {
+            <$t>::$f($x)
+        }
+        #[cfg(not(feature = "std"))]
+        {
+            libm::Libm::<$t>::$f($x)
+        }
+    }};
+}
+
+float_scalar!(f64, f64);
+float_scalar!(f32, f32);
+
+#[cfg(feature = "dual")]
+mod dual {
+    use super::Scalar;
+    use num_dual::{Dual, Dual2, DualNum, HyperDual};
+
+    macro_rules! dual_scalar {
+        ($ty:ty, [$($gen:tt)*]) => {
+            impl<$($gen)*> Scalar for $ty {
+                #[inline(always)]
+                fn from_f64(x: f64) -> Self {
+                    <$ty>::from(x)
+                }
+                #[inline(always)]
+                fn re(self) -> f64 {
+                    num_dual::DualStruct::re(&self)
+                }
+                #[inline(always)]
+                fn sin(self) -> Self {
+                    DualNum::sin(&self)
+                }
+                #[inline(always)]
+                fn cos(self) -> Self {
+                    DualNum::cos(&self)
+                }
+                #[inline(always)]
+                fn tan(self) -> Self {
+                    DualNum::tan(&self)
+                }
+                #[inline(always)]
+                fn exp(self) -> Self {
+                    DualNum::exp(&self)
+                }
+                #[inline(always)]
+                fn ln(self) -> Self {
+                    DualNum::ln(&self)
+                }
+                #[inline(always)]
+                fn abs(self) -> Self {
+                    if Scalar::re(self) < 0.0 {
+                        -self
+                    } else {
+                        self
+                    }
+                }
+                #[inline(always)]
+                fn sqrt(self) -> Self {
+                    DualNum::sqrt(&self)
+                }
+                #[inline(always)]
+                fn powi(self, n: i32) -> Self {
+                    DualNum::powi(&self, n)
+                }
+                #[inline(always)]
+                fn atan2(self, x: Self) -> Self {
+                    DualNum::atan2(&self, x)
+                }
+            }
+        };
+    }
+
+    dual_scalar!(Dual<f64>, []);
+    dual_scalar!(Dual2<f64>, []);
+    dual_scalar!(HyperDual<f64>, []);
+    dual_scalar!(Dual<Dual<f64>>, []);
+    dual_scalar!(num_dual::DualSVec64<N>, [const N: usize]);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::Scalar;
+
+    fn poly<T: Scalar>(x: T) -> T {
+        x * x.sin() + T::from_f64(2.0) * x.powi(3) - x.exp().ln()
+            + x.abs().sqrt()
+            + x.atan2(T::one())
+    }
+
+    #[test]
+    fn f32_and_f64_agree() {
+        let a = poly(0.7_f64);
+        let b = poly(0.7_f32) as f64;
+        assert!((a - b).abs() < 1e-5, "{a} vs {b}");
+    }
+
+    #[cfg(feature = "dual")]
+    #[test]
+    fn dual_gives_the_derivative() {
+        use num_dual::Dual64;
+        let x = 0.7;
+        let d = poly(Dual64::new(x, 1.0));
+        // d/dx [x sin x + 2x³ − x + √x + atan(x)]
+        let exact =
+            x.sin() + x * x.cos() + 6.0 * x * x - 1.0 + 0.5 / x.sqrt() + 1.0 / (1.0 + x * x);
+        assert!((d.eps - exact).abs() < 1e-12);
+        assert!((d.re - poly(x)).abs() < 1e-15);
+    }
+}

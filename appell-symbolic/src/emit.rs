@@ -1,0 +1,868 @@
+//! Emission: from expression roots to straight-line Rust over a generic scalar.
+//!
+//! Two steps. [`Program::lower`] turns the canonical n-ary graph into binary
+//! instructions (`+ − × ÷`, negation, integer powers by repeated squaring,
+//! function calls), hash-consed again so that e.g. `x²` is computed once for
+//! `x³` and `x⁴`. [`Program::to_rust`] then writes one `let` per instruction
+//! used more than once (common-subexpression elimination is "a node used twice
+//! becomes a `let`"), inlines the rest, and separates the instructions that
+//! depend on parameters only, so they can be computed once per parameter set.
+//!
+//! The output is deterministic: names, order and text depend only on the
+//! graph, never on hash-map iteration.
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::{self, Write};
+
+use crate::error::Result;
+use crate::graph::{Func, FxHashMap, Graph, Id, Node, Symbol, SymbolKind};
+use crate::number::Number;
+
+/// One binary instruction of a lowered program. Operands index earlier
+/// instructions.
+#[derive(Clone, Debug, PartialEq, Eq, Hash)]
+pub enum Inst {
+    /// A constant.
+    Const(Number),
+    /// A symbol's value.
+    Symbol(Symbol),
+    /// `a + b`.
+    Add(u32, u32),
+    /// `a − b`.
+    Sub(u32, u32),
+    /// `a · b`.
+    Mul(u32, u32),
+    /// `a / b`.
+    Div(u32, u32),
+    /// `−a`.
+    Neg(u32),
+    /// `aⁿ` (only for exponents too large for a multiplication chain).
+    Powi(u32, i32),
+    /// `f(a)`.
+    Call(Func, u32),
+    /// `atan2(y, x)`.
+    Atan2(u32, u32),
+}
+
+impl Inst {
+    fn operands(&self) -> Vec<u32> {
+        match *self {
+            Inst::Const(_) | Inst::Symbol(_) => vec![],
+            Inst::Add(a, b) | Inst::Sub(a, b) | Inst::Mul(a, b) | Inst::Div(a, b) => vec![a, b],
+            Inst::Atan2(y, x) => vec![y, x],
+            Inst::Neg(a) | Inst::Powi(a, _) | Inst::Call(_, a) => vec![a],
+        }
+    }
+}
+
+/// Operation counts of emitted code, by kind.
+///
+/// ```
+/// use appell_symbolic::Graph;
+/// let mut g = Graph::new();
+/// let e = g.parse("sin(x)^2*y + sin(x)*z - 1/y").unwrap();
+/// let ops = g.op_count(&[e]).unwrap();
+/// assert_eq!(ops.calls, 1); // sin(x) once
+/// assert_eq!(ops.div, 1);
+/// assert_eq!(ops.total(), ops.add + ops.mul + ops.div + ops.neg + ops.calls + ops.powi);
+/// ```
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCount {
+    /// Additions and subtractions.
+    pub add: usize,
+    /// Multiplications.
+    pub mul: usize,
+    /// Divisions.
+    pub div: usize,
+    /// Negations.
+    pub neg: usize,
+    /// Calls of `sin cos tan exp ln abs sqrt atan2`.
+    pub calls: usize,
+    /// `powi` calls (exponents above 16).
+    pub powi: usize,
+}
+
+impl OpCount {
+    /// All operations.
+    pub fn total(&self) -> usize {
+        self.add + self.mul + self.div + self.neg + self.calls + self.powi
+    }
+
+    fn count(&mut self, inst: &Inst, times: usize) {
+        match inst {
+            Inst::Const(_) | Inst::Symbol(_) => {}
+            Inst::Add(..) | Inst::Sub(..) => self.add += times,
+            Inst::Mul(..) => self.mul += times,
+            Inst::Div(..) => self.div += times,
+            Inst::Neg(_) => self.neg += times,
+            Inst::Powi(..) => self.powi += times,
+            Inst::Call(..) | Inst::Atan2(..) => self.calls += times,
+        }
+    }
+}
+
+impl std::ops::Add for OpCount {
+    type Output = OpCount;
+    fn add(self, o: OpCount) -> OpCount {
+        OpCount {
+            add: self.add + o.add,
+            mul: self.mul + o.mul,
+            div: self.div + o.div,
+            neg: self.neg + o.neg,
+            calls: self.calls + o.calls,
+            powi: self.powi + o.powi,
+        }
+    }
+}
+
+impl fmt::Display for OpCount {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(
+            f,
+            "{} ops ({} add, {} mul, {} div, {} neg, {} calls, {} powi)",
+            self.total(),
+            self.add,
+            self.mul,
+            self.div,
+            self.neg,
+            self.calls,
+            self.powi
+        )
+    }
+}
+
+/// Exponents up to this are computed by multiplication chains.
+const MAX_CHAIN_EXPONENT: i32 = 16;
+
+/// A lowered, hash-consed straight-line program computing some roots.
+#[derive(Clone, Debug)]
+pub struct Program {
+    insts: Vec<Inst>,
+    outputs: Vec<u32>,
+    parameter_only: Vec<bool>,
+    uses: Vec<u32>,
+}
+
+struct Lowering<'g> {
+    graph: &'g Graph,
+    insts: Vec<Inst>,
+    index: FxHashMap<Inst, u32>,
+    memo: FxHashMap<Id, u32>,
+}
+
+impl Lowering<'_> {
+    fn push(&mut self, inst: Inst) -> u32 {
+        let inst = match inst {
+            Inst::Add(a, b) if b < a => Inst::Add(b, a),
+            Inst::Mul(a, b) if b < a => Inst::Mul(b, a),
+            i => i,
+        };
+        if let Some(&i) = self.index.get(&inst) {
+            return i;
+        }
+        let i = self.insts.len() as u32;
+        self.insts.push(inst.clone());
+        self.index.insert(inst, i);
+        i
+    }
+
+    fn constant(&mut self, n: Number) -> u32 {
+        self.push(Inst::Const(n))
+    }
+
+    fn power(&mut self, b: u32, e: i32) -> u32 {
+        debug_assert!(e >= 1);
+        if e == 1 {
+            b
+        } else if e > MAX_CHAIN_EXPONENT {
+            self.push(Inst::Powi(b, e))
+        } else if e % 2 == 0 {
+            let h = self.power(b, e / 2);
+            self.push(Inst::Mul(h, h))
+        } else {
+            let h = self.power(b, e - 1);
+            self.push(Inst::Mul(h, b))
+        }
+    }
+
+    fn chain(&mut self, items: &[u32], op: fn(u32, u32) -> Inst) -> Option<u32> {
+        let mut it = items.iter().copied();
+        let first = it.next()?;
+        Some(it.fold(first, |acc, x| self.push(op(acc, x))))
+    }
+
+    fn lower_node(&mut self, id: Id) -> u32 {
+        let node = self.graph.node(id);
+        match node {
+            Node::Num(n) => self.constant(*n),
+            Node::Sym(s) => self.push(Inst::Symbol(*s)),
+            Node::Add { constant, terms } => {
+                let mut pos = Vec::new();
+                let mut neg = Vec::new();
+                let mut ordered: Vec<(bool, Id, Number)> = terms
+                    .iter()
+                    .map(|&(b, k)| (!self.graph.is_parameter_only(b), b, k))
+                    .collect();
+                ordered.sort_by_key(|t| (t.0, t.1));
+                for (_, b, k) in ordered {
+                    let base = self.memo[&b];
+                    let mag = k.abs();
+                    let v = if mag.is_one() && !mag.is_float() {
+                        base
+                    } else {
+                        let c = self.constant(mag);
+                        self.push(Inst::Mul(c, base))
+                    };
+                    if k.is_negative() {
+                        neg.push(v)
+                    } else {
+                        pos.push(v)
+                    }
+                }
+                if !constant.is_zero() {
+                    let c = self.constant(constant.abs());
+                    if constant.is_negative() {
+                        neg.push(c)
+                    } else {
+                        pos.push(c)
+                    }
+                }
+                let start = match self.chain(&pos, Inst::Add) {
+                    Some(v) => v,
+                    None => {
+                        let first = neg.remove(0);
+                        self.push(Inst::Neg(first))
+                    }
+                };
+                neg.iter()
+                    .fold(start, |acc, &x| self.push(Inst::Sub(acc, x)))
+            }
+            Node::Mul { coeff, factors } => {
+                // Parameter-only factors first, so their product is one
+                // hoistable value; the coefficient joins them.
+                let mut num = Vec::new();
+                let mut den = Vec::new();
+                let mag = coeff.abs();
+                if !mag.is_one() || mag.is_float() {
+                    num.push(self.constant(mag));
+                }
+                let mut ordered: Vec<(bool, Id, i32)> = factors
+                    .iter()
+                    .map(|&(b, e)| (!self.graph.is_parameter_only(b), b, e))
+                    .collect();
+                ordered.sort();
+                for (_, b, e) in ordered {
+                    let base = self.memo[&b];
+                    if e > 0 {
+                        num.push(self.power(base, e));
+                    } else {
+                        den.push(self.power(base, -e));
+                    }
+                }
+                let n = match self.chain(&num, Inst::Mul) {
+                    Some(n) => n,
+                    None => self.constant(Number::ONE),
+                };
+                let v = match self.chain(&den, Inst::Mul) {
+                    Some(d) => self.push(Inst::Div(n, d)),
+                    None => n,
+                };
+                if coeff.is_negative() {
+                    self.push(Inst::Neg(v))
+                } else {
+                    v
+                }
+            }
+            Node::Fun(f, a) => {
+                let a = self.memo[a];
+                self.push(Inst::Call(*f, a))
+            }
+            Node::Atan2(y, x) => {
+                let (y, x) = (self.memo[y], self.memo[x]);
+                self.push(Inst::Atan2(y, x))
+            }
+        }
+    }
+}
+
+impl Program {
+    /// Lowers the expressions `roots` of `graph`.
+    pub fn lower(graph: &Graph, roots: &[Id]) -> Program {
+        let mut l = Lowering {
+            graph,
+            insts: Vec::new(),
+            index: FxHashMap::default(),
+            memo: FxHashMap::default(),
+        };
+        for id in graph.reachable(roots) {
+            let i = l.lower_node(id);
+            l.memo.insert(id, i);
+        }
+        let outputs: Vec<u32> = roots.iter().map(|r| l.memo[r]).collect();
+        // Keep only instructions the outputs need (lowering may have built
+        // intermediate forms that ended up unused), renumbered in order.
+        let mut needed = vec![false; l.insts.len()];
+        for &o in &outputs {
+            needed[o as usize] = true;
+        }
+        for i in (0..l.insts.len()).rev() {
+            if needed[i] {
+                for op in l.insts[i].operands() {
+                    needed[op as usize] = true;
+                }
+            }
+        }
+        let mut renumber = vec![u32::MAX; l.insts.len()];
+        let mut insts = Vec::new();
+        for (i, inst) in l.insts.into_iter().enumerate() {
+            if !needed[i] {
+                continue;
+            }
+            renumber[i] = insts.len() as u32;
+            let r = |x: u32| renumber[x as usize];
+            insts.push(match inst {
+                Inst::Add(a, b) => Inst::Add(r(a), r(b)),
+                Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
+                Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
+                Inst::Div(a, b) => Inst::Div(r(a), r(b)),
+                Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+                Inst::Neg(a) => Inst::Neg(r(a)),
+                Inst::Powi(a, e) => Inst::Powi(r(a), e),
+                Inst::Call(f, a) => Inst::Call(f, r(a)),
+                leaf => leaf,
+            });
+        }
+        let outputs: Vec<u32> = outputs.iter().map(|&o| renumber[o as usize]).collect();
+        let mut parameter_only = Vec::with_capacity(insts.len());
+        let mut uses = vec![0u32; insts.len()];
+        for inst in &insts {
+            let p = match inst {
+                Inst::Const(_) => true,
+                Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
+                other => other.operands().iter().all(|&o| parameter_only[o as usize]),
+            };
+            parameter_only.push(p);
+            for o in inst.operands() {
+                uses[o as usize] += 1;
+            }
+        }
+        for &o in &outputs {
+            uses[o as usize] += 1;
+        }
+        Program {
+            insts,
+            outputs,
+            parameter_only,
+            uses,
+        }
+    }
+
+    /// The instructions, in evaluation order.
+    pub fn insts(&self) -> &[Inst] {
+        &self.insts
+    }
+
+    /// The instruction of each root.
+    pub fn outputs(&self) -> &[u32] {
+        &self.outputs
+    }
+
+    /// Operations executed once all shared subexpressions are computed once.
+    pub fn op_count(&self) -> OpCount {
+        let mut c = OpCount::default();
+        for inst in &self.insts {
+            c.count(inst, 1);
+        }
+        c
+    }
+
+    /// Operations of the same program written as trees, every shared
+    /// subexpression recomputed where used (the count before CSE).
+    pub fn tree_op_count(&self) -> OpCount {
+        let mult = self.tree_multiplicity();
+        let mut c = OpCount::default();
+        for (i, inst) in self.insts.iter().enumerate() {
+            c.count(inst, mult[i]);
+        }
+        c
+    }
+
+    fn tree_multiplicity(&self) -> Vec<usize> {
+        let mut mult = vec![0usize; self.insts.len()];
+        for &o in &self.outputs {
+            mult[o as usize] += 1;
+        }
+        for i in (0..self.insts.len()).rev() {
+            let m = mult[i];
+            for o in self.insts[i].operands() {
+                mult[o as usize] = mult[o as usize].saturating_add(m);
+            }
+        }
+        mult
+    }
+
+    /// Runs the program in `f64` (the emitted Rust computes exactly this).
+    pub fn eval(&self, env: &dyn Fn(Symbol) -> Option<f64>) -> Option<Vec<f64>> {
+        let mut v: Vec<f64> = Vec::with_capacity(self.insts.len());
+        for inst in &self.insts {
+            let x = match *inst {
+                Inst::Const(n) => n.to_f64(),
+                Inst::Symbol(s) => env(s)?,
+                Inst::Add(a, b) => v[a as usize] + v[b as usize],
+                Inst::Sub(a, b) => v[a as usize] - v[b as usize],
+                Inst::Mul(a, b) => v[a as usize] * v[b as usize],
+                Inst::Div(a, b) => v[a as usize] / v[b as usize],
+                Inst::Neg(a) => -v[a as usize],
+                Inst::Powi(a, e) => v[a as usize].powi(e),
+                Inst::Call(f, a) => f.apply(v[a as usize]),
+                Inst::Atan2(y, x) => v[y as usize].atan2(v[x as usize]),
+            };
+            v.push(x);
+        }
+        Some(self.outputs.iter().map(|&o| v[o as usize]).collect())
+    }
+
+    /// Writes the program as Rust statements.
+    pub fn to_rust(&self, graph: &Graph, options: &EmitOptions) -> RustCode {
+        Writer::new(self, graph, options).write()
+    }
+}
+
+/// Choices for [`Program::to_rust`].
+#[derive(Clone, Debug)]
+pub struct EmitOptions {
+    /// The scalar type in the emitted code (a generic parameter name or a
+    /// concrete type).
+    pub scalar: String,
+    /// The expression that turns an `f64` literal into the scalar;
+    /// `{ty}` is replaced by [`EmitOptions::scalar`] and `{lit}` by the literal.
+    pub constant: String,
+    /// Share subexpressions used more than once through `let` bindings. Off,
+    /// every use is written out (readable for very small problems only).
+    pub cse: bool,
+    /// Move parameter-only subexpressions into [`RustCode::prepare`].
+    pub hoist_parameters: bool,
+    /// How each symbol is read (default: its name, as a local binding).
+    pub symbol_text: BTreeMap<Symbol, String>,
+}
+
+impl Default for EmitOptions {
+    fn default() -> Self {
+        EmitOptions {
+            scalar: "T".to_string(),
+            constant: "<{ty} as ::appell_runtime::Scalar>::from_f64({lit})".to_string(),
+            cse: true,
+            hoist_parameters: true,
+            symbol_text: BTreeMap::new(),
+        }
+    }
+}
+
+/// Emitted Rust code: statements and the expression of each output.
+///
+/// The statements use method-call syntax (`x.sin()`, `x.powi(20)`) on the
+/// scalar, so the runtime's scalar trait must be in scope where they are
+/// placed.
+///
+/// ```
+/// use appell_symbolic::{EmitOptions, Graph, Program};
+/// let mut g = Graph::new();
+/// let m = g.parameter("m").unwrap();
+/// let l = g.parameter("l").unwrap();
+/// let e = g.parse("m*l^2*sin(q)*cos(q) + m*l^2*q").unwrap();
+/// let program = Program::lower(&g, &[e]);
+/// let code = program.to_rust(&g, &EmitOptions::default());
+/// assert_eq!(code.hoisted, vec!["p0".to_string()]);      // m*l^2, once per parameter set
+/// assert!(code.prepare.iter().any(|s| s.starts_with("let p0 = ")));
+/// assert_eq!(code.outputs[0], "q.sin() * p0 * q.cos() + q * p0");
+/// # let _ = (m, l);
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RustCode {
+    /// Statements that compute the hoisted parameter-only values (they read
+    /// parameters only).
+    pub prepare: Vec<String>,
+    /// Names bound by `prepare` that the body reads.
+    pub hoisted: Vec<String>,
+    /// Statements of the per-call body.
+    pub body: Vec<String>,
+    /// One expression per root, valid after `body`.
+    pub outputs: Vec<String>,
+    /// Operations per call (body and outputs).
+    pub ops: OpCount,
+    /// Operations once per parameter set (prepare).
+    pub prepare_ops: OpCount,
+}
+
+impl RustCode {
+    /// A complete generic function computing all outputs at once (prepare and
+    /// body together), for tests and small tools:
+    /// `fn name<T: Trait>(symbols…) -> [T; N]`.
+    pub fn function(&self, name: &str, scalar_trait: &str, args: &[String]) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "#[allow(clippy::all, unused_variables, unused_parens, non_snake_case)]\n\
+             pub fn {name}<T: {scalar_trait}>({}) -> [T; {}] {{",
+            args.iter()
+                .map(|a| format!("{a}: T"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            self.outputs.len()
+        );
+        for st in self.prepare.iter().chain(&self.body) {
+            let _ = writeln!(s, "    {st}");
+        }
+        let _ = writeln!(s, "    [{}]\n}}", self.outputs.join(", "));
+        s
+    }
+}
+
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Prec {
+    Sum = 0,
+    Product = 1,
+    Unary = 2,
+    Atom = 3,
+}
+
+struct Writer<'a> {
+    p: &'a Program,
+    g: &'a Graph,
+    o: &'a EmitOptions,
+    /// Name of each instruction that is bound (`let`), a symbol or a constant.
+    names: Vec<Option<String>>,
+    used_names: BTreeSet<String>,
+    hoisted: Vec<bool>,
+}
+
+impl<'a> Writer<'a> {
+    fn new(p: &'a Program, g: &'a Graph, o: &'a EmitOptions) -> Writer<'a> {
+        let n = p.insts.len();
+        let mut used_names = BTreeSet::new();
+        for (s, info) in g.symbols() {
+            used_names.insert(o.symbol_text.get(&s).cloned().unwrap_or(info.name.clone()));
+        }
+        Writer {
+            p,
+            g,
+            o,
+            names: vec![None; n],
+            used_names,
+            hoisted: vec![false; n],
+        }
+    }
+
+    fn symbol_text(&self, s: Symbol) -> String {
+        self.o
+            .symbol_text
+            .get(&s)
+            .cloned()
+            .unwrap_or_else(|| self.g.symbol_name(s).to_string())
+    }
+
+    fn fresh(&mut self, wanted: String) -> String {
+        let mut name = wanted.clone();
+        let mut k = 2;
+        while self.used_names.contains(&name) {
+            name = format!("{wanted}_{k}");
+            k += 1;
+        }
+        self.used_names.insert(name.clone());
+        name
+    }
+
+    /// A readable name for a bound instruction when one is obvious.
+    fn suggest(&self, i: usize) -> Option<String> {
+        let leaf = |j: u32| -> Option<String> {
+            match &self.p.insts[j as usize] {
+                Inst::Symbol(s) => Some(self.symbol_text(*s)),
+                _ => self.names[j as usize].clone(),
+            }
+        };
+        let ident = |s: String| {
+            (s.len() <= 24 && s.chars().all(|c| c.is_alphanumeric() || c == '_')).then_some(s)
+        };
+        match self.p.insts[i] {
+            Inst::Call(f, a) => ident(format!("{}_{}", f.name(), leaf(a)?)),
+            Inst::Mul(a, b) if a == b => ident(format!("{}_sq", leaf(a)?)),
+            Inst::Atan2(y, x) => ident(format!("atan2_{}_{}", leaf(y)?, leaf(x)?)),
+            _ => None,
+        }
+    }
+
+    fn constant_name(n: Number) -> String {
+        let body = match n {
+            Number::Rational { num, den: 1 } => format!("{num}"),
+            Number::Rational { num, den } => format!("{num}_{den}"),
+            Number::Float(x) => format!("{x:?}").replace(['.', '+'], "_"),
+        };
+        format!("k{}", body.replace('-', "m"))
+    }
+
+    fn literal(n: Number) -> String {
+        let x = n.to_f64();
+        format!("{x:?}")
+    }
+
+    fn write(mut self) -> RustCode {
+        let n = self.p.insts.len();
+        let p = self.p;
+        // Decide what is hoisted: parameter-only, non-leaf instructions read by
+        // a per-call instruction or an output.
+        let nontrivial = |i: usize| !matches!(p.insts[i], Inst::Const(_) | Inst::Symbol(_));
+        let mut boundary = vec![false; n];
+        if self.o.hoist_parameters {
+            for i in 0..n {
+                if !p.parameter_only[i] {
+                    for op in p.insts[i].operands() {
+                        boundary[op as usize] = true;
+                    }
+                }
+            }
+            for &o in &p.outputs {
+                boundary[o as usize] = true;
+            }
+            for (i, h) in self.hoisted.iter_mut().enumerate() {
+                *h = p.parameter_only[i] && nontrivial(i);
+            }
+        }
+        // Which instructions get a `let`.
+        let mut bind = vec![false; n];
+        for i in 0..n {
+            if !nontrivial(i) {
+                continue;
+            }
+            let shared = p.uses[i] >= 2;
+            bind[i] = (self.o.cse && shared) || (self.hoisted[i] && boundary[i]);
+        }
+        let mut prepare = Vec::new();
+        let mut body = Vec::new();
+        let mut hoisted_names = Vec::new();
+        // Constants: bound once at the top of the section that first needs them.
+        let mut const_names: BTreeMap<usize, String> = BTreeMap::new();
+        for i in 0..n {
+            if let Inst::Const(c) = p.insts[i] {
+                let name = self.fresh(Self::constant_name(c));
+                const_names.insert(i, name.clone());
+                self.names[i] = Some(name);
+            }
+        }
+        let mut const_in_prepare = BTreeSet::new();
+        let mut const_in_body = BTreeSet::new();
+        let mut counter_p = 0;
+        let mut counter_t = 0;
+        let mut body_ops = OpCount::default();
+        let mut prepare_ops = OpCount::default();
+        // Count operations: bound instructions once; inlined ones once per
+        // inline use when CSE is off (their text is repeated).
+        let mult = if self.o.cse {
+            vec![1usize; n]
+        } else {
+            p.tree_multiplicity()
+        };
+        for (i, inst) in p.insts.iter().enumerate() {
+            if self.hoisted[i] {
+                prepare_ops.count(inst, if bind[i] { 1 } else { mult[i] });
+            } else {
+                body_ops.count(inst, if bind[i] { 1 } else { mult[i] });
+            }
+        }
+        for i in 0..n {
+            if !bind[i] {
+                continue;
+            }
+            let wanted = self.suggest(i).unwrap_or_else(|| {
+                if self.hoisted[i] {
+                    counter_p += 1;
+                    format!("p{}", counter_p - 1)
+                } else {
+                    counter_t += 1;
+                    format!("t{}", counter_t - 1)
+                }
+            });
+            let (text, _) = self.expr_inline(i);
+            let name = self.fresh(wanted);
+            let consts = self.constants_of(i, &bind);
+            if self.hoisted[i] {
+                for c in consts {
+                    if const_in_prepare.insert(c) {
+                        prepare.push(self.const_stmt(c, &const_names));
+                    }
+                }
+                prepare.push(format!("let {name} = {text};"));
+                if boundary[i] {
+                    hoisted_names.push(name.clone());
+                }
+            } else {
+                for c in consts {
+                    if const_in_body.insert(c) {
+                        body.push(self.const_stmt(c, &const_names));
+                    }
+                }
+                body.push(format!("let {name} = {text};"));
+            }
+            self.names[i] = Some(name);
+        }
+        let mut outputs = Vec::new();
+        for k in 0..p.outputs.len() {
+            let o = p.outputs[k] as usize;
+            for c in self.constants_of(o, &bind) {
+                if const_in_body.insert(c) {
+                    body.push(self.const_stmt(c, &const_names));
+                }
+            }
+            outputs.push(self.expr(o).0);
+        }
+        // Constants first in each section (stable order by instruction).
+        let split = |v: Vec<String>| {
+            let (mut c, rest): (Vec<String>, Vec<String>) =
+                v.into_iter().partition(|s| s.starts_with("let k"));
+            c.extend(rest);
+            c
+        };
+        RustCode {
+            prepare: split(prepare),
+            hoisted: hoisted_names,
+            body: split(body),
+            outputs,
+            ops: body_ops,
+            prepare_ops,
+        }
+    }
+
+    fn const_stmt(&self, i: usize, names: &BTreeMap<usize, String>) -> String {
+        let Inst::Const(c) = self.p.insts[i] else {
+            unreachable!("constant")
+        };
+        let text = self
+            .o
+            .constant
+            .replace("{ty}", &self.o.scalar)
+            .replace("{lit}", &Self::literal(c));
+        format!("let {}: {} = {text};", names[&i], self.o.scalar)
+    }
+
+    /// Constants read by the inline text of instruction `i`.
+    fn constants_of(&self, i: usize, bind: &[bool]) -> Vec<usize> {
+        let mut out = Vec::new();
+        let mut stack = self.p.insts[i].operands();
+        if matches!(self.p.insts[i], Inst::Const(_)) {
+            out.push(i);
+        }
+        while let Some(j) = stack.pop() {
+            let j = j as usize;
+            match self.p.insts[j] {
+                Inst::Const(_) => out.push(j),
+                _ if bind[j] => {}
+                Inst::Symbol(_) => {}
+                _ => stack.extend(self.p.insts[j].operands()),
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The text of instruction `i` as used by another (its name when bound).
+    fn expr(&self, i: usize) -> (String, Prec) {
+        if let Some(n) = &self.names[i] {
+            return (n.clone(), Prec::Atom);
+        }
+        if let Inst::Symbol(s) = self.p.insts[i] {
+            return (self.symbol_text(s), Prec::Atom);
+        }
+        self.expr_inline(i)
+    }
+
+    /// The operands of a commutative operation, ordered so that a nested
+    /// operation of the same level stands on the left, where it needs no
+    /// parentheses (`a * b` and `b * a` are the same IEEE value).
+    fn commuted(&self, a: u32, b: u32, level: Prec) -> ((String, Prec), (String, Prec)) {
+        let (l, r) = (self.expr(a as usize), self.expr(b as usize));
+        if r.1 == level && l.1 != level {
+            (r, l)
+        } else {
+            (l, r)
+        }
+    }
+
+    /// The text of instruction `i` itself.
+    fn expr_inline(&self, i: usize) -> (String, Prec) {
+        let wrap = |(s, p): (String, Prec), min: Prec| {
+            if p < min {
+                format!("({s})")
+            } else {
+                s
+            }
+        };
+        let right = |(s, p): (String, Prec), level: Prec| {
+            if p <= level {
+                format!("({s})")
+            } else {
+                s
+            }
+        };
+        match self.p.insts[i] {
+            Inst::Const(_) | Inst::Symbol(_) => self.expr(i),
+            Inst::Add(a, b) => {
+                let (l, r) = self.commuted(a, b, Prec::Sum);
+                (
+                    format!("{} + {}", wrap(l, Prec::Sum), right(r, Prec::Sum)),
+                    Prec::Sum,
+                )
+            }
+            Inst::Sub(a, b) => (
+                format!(
+                    "{} - {}",
+                    wrap(self.expr(a as usize), Prec::Sum),
+                    right(self.expr(b as usize), Prec::Sum)
+                ),
+                Prec::Sum,
+            ),
+            Inst::Mul(a, b) => {
+                let (l, r) = self.commuted(a, b, Prec::Product);
+                (
+                    format!("{} * {}", wrap(l, Prec::Product), right(r, Prec::Product)),
+                    Prec::Product,
+                )
+            }
+            Inst::Div(a, b) => (
+                format!(
+                    "{} / {}",
+                    wrap(self.expr(a as usize), Prec::Product),
+                    right(self.expr(b as usize), Prec::Product)
+                ),
+                Prec::Product,
+            ),
+            Inst::Neg(a) => (
+                format!("-{}", wrap(self.expr(a as usize), Prec::Atom)),
+                Prec::Unary,
+            ),
+            Inst::Powi(a, e) => (
+                format!("{}.powi({e})", wrap(self.expr(a as usize), Prec::Atom)),
+                Prec::Atom,
+            ),
+            Inst::Call(f, a) => (
+                format!("{}.{}()", wrap(self.expr(a as usize), Prec::Atom), f.name()),
+                Prec::Atom,
+            ),
+            Inst::Atan2(y, x) => (
+                format!(
+                    "{}.atan2({})",
+                    wrap(self.expr(y as usize), Prec::Atom),
+                    self.expr(x as usize).0
+                ),
+                Prec::Atom,
+            ),
+        }
+    }
+}
+
+impl Graph {
+    /// Operation count of the emitted code for `roots`, with shared
+    /// subexpressions computed once (parameter-only work included).
+    pub fn op_count(&self, roots: &[Id]) -> Result<OpCount> {
+        Ok(Program::lower(self, roots).op_count())
+    }
+}

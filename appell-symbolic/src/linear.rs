@@ -1,0 +1,531 @@
+//! Linear structure: coefficients of expressions that must be linear in some
+//! symbols (velocity constraints → D(q,t) and d(q,t), eq. 25; accelerations
+//! split off the Appell function), and a small symbolic solve for the
+//! dependent-speed block D' (eq. 27) that pivots only on entries it can prove
+//! non-zero.
+
+use std::collections::BTreeSet;
+
+use crate::deps::SymbolSet;
+use crate::error::{Result, SymbolicError};
+use crate::graph::{Func, Graph, Id, Node, Symbol};
+
+/// `e = Σ coefficients[i] · symbols[i] + remainder`, with no coefficient and
+/// no remainder depending on any of the symbols.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct LinearForm {
+    /// One coefficient per requested symbol.
+    pub coefficients: Vec<Id>,
+    /// The part free of the symbols.
+    pub remainder: Id,
+}
+
+/// A dense matrix of expressions, row-major.
+///
+/// ```
+/// use appell_symbolic::{Graph, SymMatrix};
+/// let mut g = Graph::new();
+/// let m = SymMatrix::parse(&mut g, &[&["a", "0"], &["1", "b"]]).unwrap();
+/// assert_eq!((m.rows(), m.cols()), (2, 2));
+/// assert!(g.is_zero(m[(0, 1)]));
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct SymMatrix {
+    rows: usize,
+    cols: usize,
+    entries: Vec<Id>,
+}
+
+impl SymMatrix {
+    /// A matrix from row-major entries.
+    pub fn from_rows(rows: usize, cols: usize, entries: Vec<Id>) -> Result<SymMatrix> {
+        if entries.len() != rows * cols {
+            return Err(SymbolicError::DimensionMismatch {
+                expected: format!("{rows}×{cols} = {} entries", rows * cols),
+                found: format!("{} entries", entries.len()),
+            });
+        }
+        Ok(SymMatrix {
+            rows,
+            cols,
+            entries,
+        })
+    }
+
+    /// A matrix of parsed entries (for tests and docs).
+    pub fn parse(g: &mut Graph, rows: &[&[&str]]) -> Result<SymMatrix> {
+        let cols = rows.first().map_or(0, |r| r.len());
+        let mut entries = Vec::new();
+        for r in rows {
+            if r.len() != cols {
+                return Err(SymbolicError::DimensionMismatch {
+                    expected: format!("{cols} columns"),
+                    found: format!("{} columns", r.len()),
+                });
+            }
+            for s in r.iter() {
+                entries.push(g.parse(s)?);
+            }
+        }
+        SymMatrix::from_rows(rows.len(), cols, entries)
+    }
+
+    /// Number of rows.
+    pub fn rows(&self) -> usize {
+        self.rows
+    }
+
+    /// Number of columns.
+    pub fn cols(&self) -> usize {
+        self.cols
+    }
+
+    /// The entries, row-major.
+    pub fn entries(&self) -> &[Id] {
+        &self.entries
+    }
+}
+
+impl std::ops::Index<(usize, usize)> for SymMatrix {
+    type Output = Id;
+    fn index(&self, (r, c): (usize, usize)) -> &Id {
+        &self.entries[r * self.cols + c]
+    }
+}
+
+impl std::ops::IndexMut<(usize, usize)> for SymMatrix {
+    fn index_mut(&mut self, (r, c): (usize, usize)) -> &mut Id {
+        &mut self.entries[r * self.cols + c]
+    }
+}
+
+/// What the caller knows about symbols and expressions: which never vanish
+/// and which are positive. Everything else may be zero.
+#[derive(Clone, Debug, Default)]
+pub struct Assumptions {
+    nonzero_symbols: SymbolSet,
+    positive_symbols: SymbolSet,
+    nonzero_exprs: BTreeSet<Id>,
+}
+
+impl Assumptions {
+    /// Nothing assumed.
+    pub fn new() -> Assumptions {
+        Assumptions::default()
+    }
+
+    /// Declares a symbol positive (e.g. a radius or a mass).
+    pub fn positive(mut self, s: Symbol) -> Assumptions {
+        self.positive_symbols.insert(s);
+        self.nonzero_symbols.insert(s);
+        self
+    }
+
+    /// Declares a symbol non-zero.
+    pub fn nonzero(mut self, s: Symbol) -> Assumptions {
+        self.nonzero_symbols.insert(s);
+        self
+    }
+
+    /// Declares an expression non-vanishing.
+    pub fn nonzero_expr(mut self, e: Id) -> Assumptions {
+        self.nonzero_exprs.insert(e);
+        self
+    }
+}
+
+/// The sign of an expression as far as it can be proven.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Sign {
+    /// Provably > 0.
+    Positive,
+    /// Provably < 0.
+    Negative,
+    /// Provably ≠ 0, sign unknown.
+    NonZero,
+    /// Nothing proven (may vanish).
+    Unknown,
+}
+
+impl Sign {
+    fn nonzero(self) -> bool {
+        self != Sign::Unknown
+    }
+    fn flip(self) -> Sign {
+        match self {
+            Sign::Positive => Sign::Negative,
+            Sign::Negative => Sign::Positive,
+            s => s,
+        }
+    }
+}
+
+/// The result of [`Graph::solve_linear`].
+#[derive(Clone, Debug)]
+pub struct LinearSolution {
+    /// `X` with `A X = B`.
+    pub x: SymMatrix,
+    /// `det A`, the signed product of the pivots.
+    pub determinant: Id,
+    /// The pivot row chosen for each unknown, in elimination order.
+    pub pivot_rows: Vec<usize>,
+}
+
+impl Graph {
+    /// Splits `e` into coefficients of `symbols` and a remainder; an error
+    /// names the first symbol in which `e` is not linear.
+    ///
+    /// ```
+    /// use appell_symbolic::{Graph, SymbolicError};
+    /// let mut g = Graph::new();
+    /// let e = g.parse("x_dot - a*psi_dot*cos(phi) + 3").unwrap();
+    /// let xd = g.symbol_named("x_dot").unwrap();
+    /// let pd = g.symbol_named("psi_dot").unwrap();
+    /// let form = g.linear_coefficients(e, &[xd, pd]).unwrap();
+    /// assert_eq!(g.display(form.coefficients[1]).to_string(), "-a*cos(phi)");
+    /// assert_eq!(g.display(form.remainder).to_string(), "3");
+    ///
+    /// let bad = g.parse("x_dot*psi_dot").unwrap();
+    /// assert!(matches!(g.linear_coefficients(bad, &[xd, pd]),
+    ///                  Err(SymbolicError::NonLinear { .. })));
+    /// ```
+    pub fn linear_coefficients(&mut self, e: Id, symbols: &[Symbol]) -> Result<LinearForm> {
+        let set = SymbolSet::from_symbols(symbols.iter().copied());
+        let mut coefficients = Vec::with_capacity(symbols.len());
+        for &s in symbols {
+            let c = self.diff(e, s)?;
+            if self.depends_on_any(c, &set) {
+                return Err(SymbolicError::NonLinear {
+                    symbol: self.symbol_name(s).to_string(),
+                    expr: self.display(e).to_string(),
+                });
+            }
+            coefficients.push(c);
+        }
+        let zero = self.int(0)?;
+        let pairs: Vec<(Symbol, Id)> = symbols.iter().map(|&s| (s, zero)).collect();
+        let remainder = self.substitute(e, &pairs)?;
+        Ok(LinearForm {
+            coefficients,
+            remainder,
+        })
+    }
+
+    /// What can be proven about the sign of `e` under `assumptions`.
+    ///
+    /// ```
+    /// use appell_symbolic::{Assumptions, Graph, Sign};
+    /// let mut g = Graph::new();
+    /// let m = g.parameter("m").unwrap();
+    /// let a = g.parameter("a").unwrap();
+    /// let assume = Assumptions::new().positive(m).positive(a);
+    /// let e = g.parse("2*a^2*(m + 1)").unwrap();
+    /// assert_eq!(g.sign(e, &assume), Sign::Positive);
+    /// let c = g.parse("a*cos(q)").unwrap();
+    /// assert_eq!(g.sign(c, &assume), Sign::Unknown);
+    /// ```
+    pub fn sign(&self, e: Id, assumptions: &Assumptions) -> Sign {
+        if assumptions.nonzero_exprs.contains(&e) {
+            return Sign::NonZero;
+        }
+        match self.node(e) {
+            Node::Num(n) => {
+                if n.is_zero() {
+                    Sign::Unknown
+                } else if n.is_negative() {
+                    Sign::Negative
+                } else {
+                    Sign::Positive
+                }
+            }
+            Node::Sym(s) => {
+                if assumptions.positive_symbols.contains(*s) {
+                    Sign::Positive
+                } else if assumptions.nonzero_symbols.contains(*s) {
+                    Sign::NonZero
+                } else {
+                    Sign::Unknown
+                }
+            }
+            Node::Mul { coeff, factors } => {
+                let mut sign = if coeff.is_negative() {
+                    Sign::Negative
+                } else {
+                    Sign::Positive
+                };
+                for &(b, p) in factors.iter() {
+                    let s = self.sign(b, assumptions);
+                    let s = match s {
+                        Sign::Unknown => return Sign::Unknown,
+                        _ if p % 2 == 0 => Sign::Positive,
+                        s => s,
+                    };
+                    sign = match (sign, s) {
+                        (Sign::NonZero, _) | (_, Sign::NonZero) => Sign::NonZero,
+                        (a, Sign::Negative) => a.flip(),
+                        (a, _) => a,
+                    };
+                }
+                sign
+            }
+            Node::Add { constant, terms } => {
+                let mut all_pos = !constant.is_negative();
+                let mut all_neg = constant.is_zero() || constant.is_negative();
+                let mut strict = !constant.is_zero();
+                for &(b, k) in terms.iter() {
+                    let s = self.sign(b, assumptions);
+                    let s = if k.is_negative() { s.flip() } else { s };
+                    match s {
+                        Sign::Positive => {
+                            all_neg = false;
+                            strict = true;
+                        }
+                        Sign::Negative => {
+                            all_pos = false;
+                            strict = true;
+                        }
+                        _ => {
+                            // Even powers are non-negative: they keep a sum
+                            // positive if something else makes it strict.
+                            if self.is_even_power(b) {
+                                if k.is_negative() {
+                                    all_pos = false;
+                                } else {
+                                    all_neg = false;
+                                }
+                            } else {
+                                return Sign::Unknown;
+                            }
+                        }
+                    }
+                }
+                match (all_pos, all_neg, strict) {
+                    (true, _, true) => Sign::Positive,
+                    (_, true, true) => Sign::Negative,
+                    _ => Sign::Unknown,
+                }
+            }
+            Node::Fun(Func::Exp, _) => Sign::Positive,
+            Node::Fun(Func::Sqrt, a) => match self.sign(*a, assumptions) {
+                Sign::Positive => Sign::Positive,
+                _ => Sign::Unknown,
+            },
+            Node::Fun(Func::Abs, a) => match self.sign(*a, assumptions) {
+                Sign::Unknown => Sign::Unknown,
+                _ => Sign::Positive,
+            },
+            _ => Sign::Unknown,
+        }
+    }
+
+    fn is_even_power(&self, e: Id) -> bool {
+        match self.node(e) {
+            Node::Mul { coeff, factors } => {
+                !coeff.is_negative() && factors.iter().all(|(_, p)| p % 2 == 0)
+            }
+            _ => false,
+        }
+    }
+
+    /// Whether `e` is provably non-zero under `assumptions`.
+    pub fn is_provably_nonzero(&self, e: Id, assumptions: &Assumptions) -> bool {
+        self.sign(e, assumptions).nonzero()
+    }
+
+    /// Solves `A X = B` by Gauss–Jordan elimination, choosing for each unknown
+    /// a pivot that is provably non-zero (the smallest such entry). Never
+    /// divides by an expression that may vanish: when no entry of a column can
+    /// be proven non-zero it returns [`SymbolicError::NoProvablyNonzeroPivot`]
+    /// so the caller can fall back to a pivoted numeric solve at run time, and
+    /// [`SymbolicError::StructurallySingular`] when every entry is zero.
+    ///
+    /// ```
+    /// use appell_symbolic::{Assumptions, Graph, SymMatrix};
+    /// let mut g = Graph::new();
+    /// let a = g.parameter("a").unwrap();
+    /// let m = SymMatrix::parse(&mut g, &[&["a", "0"], &["1", "1"]]).unwrap();
+    /// let b = SymMatrix::parse(&mut g, &[&["a*u"], &["v"]]).unwrap();
+    /// let sol = g.solve_linear(&m, &b, &Assumptions::new().positive(a)).unwrap();
+    /// assert_eq!(g.display(sol.x[(0, 0)]).to_string(), "u");
+    /// assert_eq!(g.display(sol.x[(1, 0)]).to_string(), "v - u");
+    /// assert_eq!(g.display(sol.determinant).to_string(), "a");
+    /// ```
+    pub fn solve_linear(
+        &mut self,
+        a: &SymMatrix,
+        b: &SymMatrix,
+        assumptions: &Assumptions,
+    ) -> Result<LinearSolution> {
+        let n = a.rows;
+        if a.cols != n || b.rows != n {
+            return Err(SymbolicError::DimensionMismatch {
+                expected: format!("a square A and B with {n} rows"),
+                found: format!("A {}×{}, B {}×{}", a.rows, a.cols, b.rows, b.cols),
+            });
+        }
+        let m = b.cols;
+        let mut a = a.clone();
+        let mut b = b.clone();
+        let mut rows: Vec<usize> = (0..n).collect();
+        let mut det = self.int(1)?;
+        let mut pivot_rows = Vec::with_capacity(n);
+        for col in 0..n {
+            let candidates: Vec<usize> = (col..n).filter(|&r| !self.is_zero(a[(r, col)])).collect();
+            if candidates.is_empty() {
+                return Err(SymbolicError::StructurallySingular { column: col });
+            }
+            let best = candidates
+                .iter()
+                .copied()
+                .filter(|&r| self.is_provably_nonzero(a[(r, col)], assumptions))
+                .min_by_key(|&r| {
+                    let e = a[(r, col)];
+                    (self.as_number(e).is_none(), self.dag_size(&[e]), r)
+                });
+            let Some(p) = best else {
+                return Err(SymbolicError::NoProvablyNonzeroPivot {
+                    column: col,
+                    candidates: candidates
+                        .iter()
+                        .map(|&r| self.display(a[(r, col)]).to_string())
+                        .collect(),
+                });
+            };
+            if p != col {
+                for j in 0..n {
+                    let (x, y) = (a[(p, j)], a[(col, j)]);
+                    a[(p, j)] = y;
+                    a[(col, j)] = x;
+                }
+                for j in 0..m {
+                    let (x, y) = (b[(p, j)], b[(col, j)]);
+                    b[(p, j)] = y;
+                    b[(col, j)] = x;
+                }
+                rows.swap(p, col);
+                det = self.neg(det)?;
+            }
+            pivot_rows.push(rows[col]);
+            let pivot = a[(col, col)];
+            det = self.mul(det, pivot)?;
+            let inv = self.recip(pivot)?;
+            for j in col..n {
+                let x = self.mul(a[(col, j)], inv)?;
+                a[(col, j)] = self.expand(x)?;
+            }
+            for j in 0..m {
+                let x = self.mul(b[(col, j)], inv)?;
+                b[(col, j)] = self.expand(x)?;
+            }
+            for r in 0..n {
+                if r == col || self.is_zero(a[(r, col)]) {
+                    continue;
+                }
+                let f = a[(r, col)];
+                for j in col..n {
+                    let t = self.mul(f, a[(col, j)])?;
+                    let x = self.sub(a[(r, j)], t)?;
+                    a[(r, j)] = self.expand(x)?;
+                }
+                for j in 0..m {
+                    let t = self.mul(f, b[(col, j)])?;
+                    let x = self.sub(b[(r, j)], t)?;
+                    b[(r, j)] = self.expand(x)?;
+                }
+            }
+        }
+        Ok(LinearSolution {
+            x: b,
+            determinant: det,
+            pivot_rows,
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::{Assumptions, Graph, Sign, SymMatrix, SymbolicError};
+
+    #[test]
+    fn structurally_singular() {
+        let mut g = Graph::new();
+        let a = SymMatrix::parse(&mut g, &[&["1", "0"], &["x", "0"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["1"], &["1"]]).unwrap();
+        assert_eq!(
+            g.solve_linear(&a, &b, &Assumptions::new()).unwrap_err(),
+            SymbolicError::StructurallySingular { column: 1 }
+        );
+    }
+    #[test]
+    fn refuses_a_pivot_that_may_vanish() {
+        let mut g = Graph::new();
+        let a = SymMatrix::parse(&mut g, &[&["cos(q)"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["1"]]).unwrap();
+        assert!(matches!(
+            g.solve_linear(&a, &b, &Assumptions::new()),
+            Err(SymbolicError::NoProvablyNonzeroPivot { column: 0, .. })
+        ));
+    }
+    #[test]
+    fn declared_nonzero_expression_is_a_pivot() {
+        let mut g = Graph::new();
+        let a = SymMatrix::parse(&mut g, &[&["cos(q)"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["sin(q)"]]).unwrap();
+        let assume = Assumptions::new().nonzero_expr(a[(0, 0)]);
+        let s = g.solve_linear(&a, &b, &assume).unwrap();
+        assert_eq!(g.display(s.x[(0, 0)]).to_string(), "sin(q)/cos(q)");
+    }
+    #[test]
+    fn row_swap_flips_determinant() {
+        let mut g = Graph::new();
+        let a = SymMatrix::parse(&mut g, &[&["0", "1"], &["1", "0"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["u"], &["v"]]).unwrap();
+        let s = g.solve_linear(&a, &b, &Assumptions::new()).unwrap();
+        assert_eq!(g.display(s.determinant).to_string(), "-1");
+        assert_eq!(g.display(s.x[(0, 0)]).to_string(), "v");
+    }
+    #[test]
+    fn prefers_constant_pivot() {
+        let mut g = Graph::new();
+        let a = g.parameter("a").unwrap();
+        let m = SymMatrix::parse(&mut g, &[&["a", "0"], &["1", "2"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["1"], &["0"]]).unwrap();
+        let s = g
+            .solve_linear(&m, &b, &Assumptions::new().positive(a))
+            .unwrap();
+        assert_eq!(s.pivot_rows[0], 1);
+        assert_eq!(g.display(s.x[(1, 0)]).to_string(), "-1/2/a");
+    }
+    #[test]
+    fn a_determinant_that_may_vanish_is_refused() {
+        // det = 2a − 1 vanishes at a = 1/2 although a > 0.
+        let mut g = Graph::new();
+        let a = g.parameter("a").unwrap();
+        let m = SymMatrix::parse(&mut g, &[&["a", "1"], &["1", "2"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["1"], &["0"]]).unwrap();
+        let r = g.solve_linear(&m, &b, &Assumptions::new().positive(a));
+        assert!(matches!(
+            r,
+            Err(SymbolicError::NoProvablyNonzeroPivot { column: 1, .. })
+        ));
+    }
+    #[test]
+    fn sum_of_squares_plus_positive_is_positive() {
+        let mut g = Graph::new();
+        let e = g.parse("x^2 + y^2 + 1").unwrap();
+        assert_eq!(g.sign(e, &Assumptions::new()), Sign::Positive);
+    }
+    #[test]
+    fn sum_of_squares_alone_may_vanish() {
+        let mut g = Graph::new();
+        let e = g.parse("x^2 + y^2").unwrap();
+        assert_eq!(g.sign(e, &Assumptions::new()), Sign::Unknown);
+    }
+    #[test]
+    fn negative_product() {
+        let mut g = Graph::new();
+        let m = g.parameter("m").unwrap();
+        let e = g.parse("-3*m").unwrap();
+        assert_eq!(g.sign(e, &Assumptions::new().positive(m)), Sign::Negative);
+    }
+}
