@@ -10,6 +10,7 @@
 //! | fold constants exactly | `1/2 + 1/3 → 5/6` |
 //! | identities | `x + 0 → x`, `x·1 → x`, `x·0 → 0`, `x⁰ → 1` |
 //! | distribute a coefficient over a sum | `2(x + y) → 2x + 2y` |
+//! | sums as factors are primitive, leading term positive | `(4y − 2x)/z → −2(x − 2y)/z` |
 //! | square roots and absolute values of powers | `√x² → x` (as `√x·√x`), `|x|² → x²` |
 //! | parity | `sin(−x) → −sin x`, `cos(−x) → cos x`, `|−x| → |x|` |
 //! | inverse pairs | `exp(ln x) → x`, `ln(exp x) → x` |
@@ -286,22 +287,22 @@ impl Graph {
                     } else {
                         Func::Sin
                     };
-                    let Some(other) = self.lookup(&Node::Fun(other_func, x)) else {
-                        continue;
-                    };
+                    let other = self.lookup(&Node::Fun(other_func, x));
                     let mut rest = factors.clone();
                     rest[i].1 -= 2;
                     // Rule A: k·R·f² + k·R·g² → k·R.
-                    let mut with_other = rest.clone();
-                    with_other.push((other, 2));
-                    if let Some(partner) = self.lookup_unit_product(with_other)? {
-                        if partner != b && acc.get(&partner) == Some(&k) {
-                            acc.remove(&b);
-                            acc.remove(&partner);
-                            let r = self.unit_product(rest)?;
-                            self.push_term(acc, constant, r, k)?;
-                            self.stats.trig_collapses += 1;
-                            continue 'pass;
+                    if let Some(other) = other {
+                        let mut with_other = rest.clone();
+                        with_other.push((other, 2));
+                        if let Some(partner) = self.lookup_unit_product(with_other)? {
+                            if partner != b && acc.get(&partner) == Some(&k) {
+                                acc.remove(&b);
+                                acc.remove(&partner);
+                                let r = self.unit_product(rest)?;
+                                self.push_term(acc, constant, r, k)?;
+                                self.stats.trig_collapses += 1;
+                                continue 'pass;
+                            }
                         }
                     }
                     // Rule B: −k·R + k·R·f² → −k·R·g².
@@ -323,6 +324,7 @@ impl Graph {
                                 acc.remove(&r);
                             }
                         }
+                        let other = self.func(other_func, x)?;
                         let mut with_other = rest;
                         with_other.push((other, 2));
                         let t = self.unit_product(with_other)?;
@@ -413,6 +415,34 @@ impl Graph {
                 break;
             }
         }
+        // Sums as factors are primitive and lead with a positive term:
+        // (4y − 2x)·r → −2·(x − 2y)·r, so every spelling of a product meets
+        // in one node. (Sums with float coefficients keep their scale.)
+        let mut normalize = Vec::new();
+        for (&b, &e) in acc.iter() {
+            if let Node::Add { constant, terms } = self.node(b) {
+                let mut coeffs: Vec<Number> = terms.iter().map(|t| t.1).collect();
+                coeffs.push(*constant);
+                let content = Number::content(&coeffs).unwrap_or(Number::ONE);
+                let k = if terms[0].1.is_negative() {
+                    content.neg()
+                } else {
+                    content
+                };
+                if k != Number::ONE {
+                    normalize.push((b, e, k));
+                }
+            }
+        }
+        for (b, e, k) in normalize {
+            acc.remove(&b);
+            let inv = k.recip().expect("content is non-zero");
+            let nb = self.scale(b, inv)?;
+            let x = acc.entry(nb).or_insert(0);
+            *x = x.checked_add(e).ok_or(SymbolicError::ExponentOverflow)?;
+            c = c.mul(k.powi(e).ok_or(SymbolicError::ExponentOverflow)?);
+        }
+        acc.retain(|_, e| *e != 0);
         if c.is_zero() {
             return self.num(Number::ZERO);
         }
@@ -615,6 +645,9 @@ impl Graph {
 
     /// `atan2(y, x)`, the angle of the point `(x, y)`.
     pub fn atan2(&mut self, y: Id, x: Id) -> Result<Id> {
+        if self.is_zero(y) && self.sign(x, &crate::Assumptions::new()) == crate::Sign::Positive {
+            return self.num(Number::ZERO);
+        }
         if let (Some(ny), Some(nx)) = (self.as_number(y), self.as_number(x)) {
             if ny.is_zero() && !nx.is_negative() && !nx.is_zero() {
                 return self.num(Number::ZERO);

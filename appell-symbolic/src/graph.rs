@@ -15,7 +15,7 @@ use crate::number::Number;
 
 /// The handle of a node in a [`Graph`]. Equal ids mean equal expressions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Id(pub(crate) u32);
+pub struct Id(pub u32);
 
 impl Id {
     /// The position of the node in the arena.

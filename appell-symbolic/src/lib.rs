@@ -36,6 +36,11 @@ pub mod number;
 mod parse;
 mod subst;
 
+#[cfg(test)]
+mod proptests;
+#[cfg(test)]
+mod rule_tests;
+
 pub use deps::SymbolSet;
 pub use diff::RateRules;
 pub use display::DisplayExpr;

@@ -86,11 +86,20 @@ impl Number {
     }
 
     /// A float constant. Integral floats stay floats (`2.0` is not `2`), so a
-    /// float literal is never silently made exact. Non-finite input is mapped
-    /// to `0.0` only by callers that have already rejected it; see
-    /// [`Number::try_float`].
+    /// float literal is never silently made exact, except for `0.0` and
+    /// `±1.0`, the identities, which become exact (multiplying by them is
+    /// exact in IEEE arithmetic too). Callers reject non-finite input first;
+    /// see [`Number::try_float`].
     pub fn float(x: f64) -> Number {
-        Number::Float(if x == 0.0 { 0.0 } else { x })
+        if x == 0.0 {
+            Number::ZERO
+        } else if x == 1.0 {
+            Number::ONE
+        } else if x == -1.0 {
+            Number::MINUS_ONE
+        } else {
+            Number::Float(x)
+        }
     }
 
     /// A float constant, or `None` when `x` is NaN or infinite.
@@ -246,6 +255,31 @@ impl Number {
         }
     }
 
+    /// The content of exact rationals: the largest positive rational `c` such
+    /// that every `x / c` is an integer and the integers are coprime. `None`
+    /// when a float is among them or all are zero.
+    pub fn content(values: &[Number]) -> Option<Number> {
+        let mut g_num: i128 = 0;
+        let mut l_den: i128 = 1;
+        for v in values {
+            match *v {
+                Number::Rational { num, den } => {
+                    if num == 0 {
+                        continue;
+                    }
+                    g_num = gcd(g_num, num);
+                    let g = gcd(l_den, den);
+                    l_den = (l_den / g).checked_mul(den)?;
+                }
+                Number::Float(_) => return None,
+            }
+        }
+        if g_num == 0 {
+            return None;
+        }
+        Number::ratio(g_num, l_den)
+    }
+
     /// Total order used for canonical sorting (by value, then exact before float).
     pub fn total_cmp(&self, other: &Number) -> Ordering {
         self.to_f64()
@@ -354,7 +388,7 @@ mod tests {
     }
     #[test]
     fn float_contaminates() {
-        assert!(r(1, 3).add(Number::float(1.0)).is_float());
+        assert!(r(1, 3).add(Number::float(1.5)).is_float());
     }
     #[test]
     fn overflow_falls_back_to_float() {
@@ -367,6 +401,21 @@ mod tests {
     #[test]
     fn negative_zero_is_zero() {
         assert_eq!(Number::float(-0.0), Number::float(0.0));
+    }
+    #[test]
+    fn content_of_rationals() {
+        assert_eq!(
+            Number::content(&[r(4, 1), r(-2, 1), r(6, 1)]),
+            Some(r(2, 1))
+        );
+        assert_eq!(Number::content(&[r(1, 2), r(1, 3)]), Some(r(1, 6)));
+        assert_eq!(Number::content(&[r(1, 2), Number::float(0.3)]), None);
+    }
+    #[test]
+    fn float_identities_are_exact() {
+        assert_eq!(Number::float(1.0), Number::ONE);
+        assert_eq!(Number::float(-1.0), Number::MINUS_ONE);
+        assert!(Number::float(2.0).is_float());
     }
     #[test]
     fn display_roundtrip_forms() {
