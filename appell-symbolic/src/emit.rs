@@ -36,7 +36,8 @@ pub enum Inst {
     Div(u32, u32),
     /// `−a`.
     Neg(u32),
-    /// `aⁿ` (only for exponents too large for a multiplication chain).
+    /// `aⁿ` (only for exponents above 64; smaller ones are multiplication
+    /// chains, whose IEEE result is fully specified).
     Powi(u32, i32),
     /// `f(a)`.
     Call(Func, u32),
@@ -78,7 +79,7 @@ pub struct OpCount {
     pub neg: usize,
     /// Calls of `sin cos tan exp ln abs sqrt atan2`.
     pub calls: usize,
-    /// `powi` calls (exponents above 16).
+    /// `powi` calls (exponents above 64).
     pub powi: usize,
 }
 
@@ -132,7 +133,7 @@ impl fmt::Display for OpCount {
 }
 
 /// Exponents up to this are computed by multiplication chains.
-const MAX_CHAIN_EXPONENT: i32 = 16;
+const MAX_CHAIN_EXPONENT: i32 = 64;
 
 /// A lowered, hash-consed straight-line program computing some roots.
 #[derive(Clone, Debug)]
@@ -510,7 +511,64 @@ impl RustCode {
                 .join(", "),
             self.outputs.len()
         );
+        let mut seen = BTreeSet::new();
         for st in self.prepare.iter().chain(&self.body) {
+            // A constant both sections bind is written once.
+            if seen.insert(st.as_str()) {
+                let _ = writeln!(s, "    {st}");
+            }
+        }
+        let _ = writeln!(s, "    [{}]\n}}", self.outputs.join(", "));
+        s
+    }
+}
+
+impl RustCode {
+    /// Two functions that keep the hoisting visible: `{name}_prepare(params)`
+    /// returns the hoisted values, and `{name}(hoisted, params, state)`
+    /// computes the outputs reading only those, the parameters and the state.
+    /// A body that used a value internal to the preparation would not compile.
+    pub fn split_functions(
+        &self,
+        name: &str,
+        scalar_trait: &str,
+        params: &[String],
+        state: &[String],
+    ) -> String {
+        let h = self.hoisted.len();
+        let typed = |v: &[String]| {
+            v.iter()
+                .map(|a| format!("{a}: T"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "#[allow(clippy::all, unused_variables, unused_parens, non_snake_case)]\n\
+             pub fn {name}_prepare<T: {scalar_trait}>({}) -> [T; {h}] {{",
+            typed(params)
+        );
+        for st in &self.prepare {
+            let _ = writeln!(s, "    {st}");
+        }
+        let _ = writeln!(s, "    [{}]\n}}", self.hoisted.join(", "));
+        let mut args = vec![format!("hoisted: &[T; {h}]")];
+        if !params.is_empty() {
+            args.push(typed(params));
+        }
+        if !state.is_empty() {
+            args.push(typed(state));
+        }
+        let _ = writeln!(
+            s,
+            "#[allow(clippy::all, unused_variables, unused_parens, non_snake_case)]\n\
+             pub fn {name}<T: {scalar_trait}>({}) -> [T; {}] {{",
+            args.join(", "),
+            self.outputs.len()
+        );
+        let _ = writeln!(s, "    let [{}] = *hoisted;", self.hoisted.join(", "));
+        for st in &self.body {
             let _ = writeln!(s, "    {st}");
         }
         let _ = writeln!(s, "    [{}]\n}}", self.outputs.join(", "));
@@ -592,12 +650,12 @@ impl<'a> Writer<'a> {
     }
 
     fn constant_name(n: Number) -> String {
-        let body = match n {
-            Number::Rational { num, den: 1 } => format!("{num}"),
-            Number::Rational { num, den } => format!("{num}_{den}"),
-            Number::Float(x) => format!("{x:?}").replace(['.', '+'], "_"),
-        };
-        format!("k{}", body.replace('-', "m"))
+        match n {
+            Number::Rational { num, den: 1 } => format!("k{num}").replace('-', "m"),
+            Number::Rational { num, den } => format!("k{num}_{den}").replace('-', "m"),
+            // Floats get a short name; the literal is in the binding.
+            Number::Float(_) => "kf".to_string(),
+        }
     }
 
     fn literal(n: Number) -> String {

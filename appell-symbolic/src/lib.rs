@@ -35,6 +35,7 @@ pub mod linear;
 pub mod number;
 mod parse;
 mod subst;
+pub mod workloads;
 
 #[cfg(test)]
 mod proptests;

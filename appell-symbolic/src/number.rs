@@ -159,6 +159,7 @@ impl Number {
     }
 
     /// `-self`.
+    #[allow(clippy::should_implement_trait)] // called by name across the engine; the operator trait is implemented too
     pub fn neg(self) -> Number {
         match self {
             Number::Rational { num, den } => match num.checked_neg() {
@@ -170,6 +171,7 @@ impl Number {
     }
 
     /// `self + other`.
+    #[allow(clippy::should_implement_trait)] // called by name across the engine; the operator trait is implemented too
     pub fn add(self, other: Number) -> Number {
         match (self, other) {
             (Number::Rational { num: a, den: b }, Number::Rational { num: c, den: d }) => {
@@ -187,6 +189,7 @@ impl Number {
     }
 
     /// `self * other`.
+    #[allow(clippy::should_implement_trait)] // called by name across the engine; the operator trait is implemented too
     pub fn mul(self, other: Number) -> Number {
         match (self, other) {
             (Number::Rational { num: a, den: b }, Number::Rational { num: c, den: d }) => {
@@ -300,6 +303,27 @@ fn isqrt(n: i128) -> Option<i128> {
         r += 1;
     }
     (r * r == n).then_some(r)
+}
+
+impl std::ops::Add for Number {
+    type Output = Number;
+    fn add(self, o: Number) -> Number {
+        Number::add(self, o)
+    }
+}
+
+impl std::ops::Mul for Number {
+    type Output = Number;
+    fn mul(self, o: Number) -> Number {
+        Number::mul(self, o)
+    }
+}
+
+impl std::ops::Neg for Number {
+    type Output = Number;
+    fn neg(self) -> Number {
+        Number::neg(self)
+    }
 }
 
 impl PartialEq for Number {

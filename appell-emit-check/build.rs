@@ -1,0 +1,176 @@
+//! Generates Rust from the symbolic engine at build time: random expressions
+//! (fixed seed) and their x-derivatives, emitted both as one function and as
+//! a prepare/body pair, with the values the engine's lowered program gives at
+//! fixed points. The tests then run the compiled code and compare.
+
+use std::fmt::Write;
+
+use appell_symbolic::{EmitOptions, Graph, Id, Program, Symbol, SymbolKind};
+
+const CASES: usize = 200;
+const POINTS: usize = 6;
+
+/// xorshift64*: a tiny deterministic generator (no dependency needed).
+struct Rng(u64);
+
+impl Rng {
+    fn next(&mut self) -> u64 {
+        self.0 ^= self.0 >> 12;
+        self.0 ^= self.0 << 25;
+        self.0 ^= self.0 >> 27;
+        self.0.wrapping_mul(0x2545_f491_4f6c_dd1d)
+    }
+    fn below(&mut self, n: u64) -> u64 {
+        self.next() % n
+    }
+    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        lo + (hi - lo) * (self.next() >> 11) as f64 / (1u64 << 53) as f64
+    }
+}
+
+struct Syms {
+    all: Vec<Symbol>,
+}
+
+/// A random expression, defined and smooth everywhere (denominators, logs and
+/// roots take 1 + e²), mixing parameters (a, b) and state (x, y, z).
+fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
+    if depth == 0 || rng.below(7) == 0 {
+        return match rng.below(8) {
+            0..=4 => g.sym(s.all[rng.below(5) as usize]).unwrap(),
+            5 => g.int(rng.below(9) as i64 - 4).unwrap(),
+            6 => g
+                .rational(rng.below(11) as i64 - 5, rng.below(4) as i64 + 1)
+                .unwrap(),
+            _ => g.float(rng.uniform(-3.0, 3.0)).unwrap(),
+        };
+    }
+    let one = g.int(1).unwrap();
+    let sub = |g: &mut Graph, rng: &mut Rng| random(g, s, rng, depth - 1);
+    let safe = |g: &mut Graph, rng: &mut Rng| {
+        let a = sub(g, rng);
+        let a2 = g.powi(a, 2).unwrap();
+        g.add(one, a2).unwrap()
+    };
+    match rng.below(15) {
+        0 | 1 => {
+            let (a, b) = (sub(g, rng), sub(g, rng));
+            g.add(a, b).unwrap()
+        }
+        2 => {
+            let (a, b) = (sub(g, rng), sub(g, rng));
+            g.sub(a, b).unwrap()
+        }
+        3 | 4 => {
+            let (a, b) = (sub(g, rng), sub(g, rng));
+            g.mul(a, b).unwrap()
+        }
+        5 => {
+            let a = sub(g, rng);
+            let d = safe(g, rng);
+            g.div(a, d).unwrap()
+        }
+        6 => {
+            let a = sub(g, rng);
+            g.powi(a, rng.below(5) as i64).unwrap()
+        }
+        7 => {
+            let a = sub(g, rng);
+            g.sin(a).unwrap()
+        }
+        8 => {
+            let a = sub(g, rng);
+            g.cos(a).unwrap()
+        }
+        9 => {
+            let a = sub(g, rng);
+            let s = g.sin(a).unwrap();
+            g.tan(s).unwrap()
+        }
+        10 => {
+            let a = sub(g, rng);
+            let s = g.sin(a).unwrap();
+            g.exp(s).unwrap()
+        }
+        11 => {
+            let d = safe(g, rng);
+            g.ln(d).unwrap()
+        }
+        12 => {
+            let d = safe(g, rng);
+            g.sqrt(d).unwrap()
+        }
+        13 => {
+            let a = sub(g, rng);
+            let d = safe(g, rng);
+            g.atan2(a, d).unwrap()
+        }
+        _ => {
+            // A large power, emitted as powi.
+            let d = safe(g, rng);
+            g.powi(d, -(65 + rng.below(3) as i64)).unwrap()
+        }
+    }
+}
+
+fn main() {
+    let out_dir = std::env::var("OUT_DIR").expect("OUT_DIR");
+    let mut rng = Rng(0x9e37_79b9_7f4a_7c15);
+    let mut code = String::new();
+    let mut table = String::from(
+        "// Values computed by the engine; some equal well-known constants.\n#[allow(clippy::approx_constant)]\npub static CASES: &[Case] = &[\n",
+    );
+    let names = ["a", "b", "x", "y", "z"];
+    let params: Vec<String> = names[..2].iter().map(|s| s.to_string()).collect();
+    let state: Vec<String> = names[2..].iter().map(|s| s.to_string()).collect();
+    let all: Vec<String> = names.iter().map(|s| s.to_string()).collect();
+    for k in 0..CASES {
+        let mut g = Graph::new();
+        let syms = Syms {
+            all: vec![
+                g.parameter("a").unwrap(),
+                g.parameter("b").unwrap(),
+                g.declare("x", SymbolKind::Auxiliary).unwrap(),
+                g.declare("y", SymbolKind::Auxiliary).unwrap(),
+                g.declare("z", SymbolKind::Auxiliary).unwrap(),
+            ],
+        };
+        let e = random(&mut g, &syms, &mut rng, 5);
+        let dx = g.diff(e, syms.all[2]).unwrap();
+        let program = Program::lower(&g, &[e, dx]);
+        let rust = program.to_rust(&g, &EmitOptions::default());
+        code.push_str(&rust.function(&format!("joint_{k}"), "::appell_runtime::Scalar", &all));
+        code.push_str(&rust.split_functions(
+            &format!("split_{k}"),
+            "::appell_runtime::Scalar",
+            &params,
+            &state,
+        ));
+        let mut points = String::new();
+        for _ in 0..POINTS {
+            let p: Vec<f64> = (0..5).map(|_| rng.uniform(-2.0, 2.0)).collect();
+            let v = program
+                .eval(&|s| syms.all.iter().position(|t| *t == s).map(|i| p[i]))
+                .unwrap();
+            let _ = write!(
+                points,
+                "([{:?}, {:?}, {:?}, {:?}, {:?}], [{:?}, {:?}]), ",
+                p[0], p[1], p[2], p[3], p[4], v[0], v[1]
+            );
+        }
+        let _ = writeln!(
+            table,
+            "    Case {{ text: {:?}, ops: {}, powi: {}, joint_f64: joint_{k}::<f64>, joint_f32: joint_{k}::<f32>, \
+             joint_dual: joint_{k}::<num_dual::Dual64>, \
+             split: |p, s| {{ let h = split_{k}_prepare::<f64>(p[0], p[1]); split_{k}(&h, p[0], p[1], s[0], s[1], s[2]) }}, \
+             points: &[{points}] }},",
+            g.display(e).to_string(),
+            rust.ops.total() + rust.prepare_ops.total(),
+            rust.ops.powi + rust.prepare_ops.powi > 0,
+        );
+    }
+    table.push_str("];\n");
+    std::fs::write(format!("{out_dir}/generated.rs"), code).unwrap();
+    std::fs::write(format!("{out_dir}/cases.rs"), table).unwrap();
+    println!("cargo:rerun-if-changed=build.rs");
+}
