@@ -155,7 +155,7 @@ macro_rules! float_scalar {
 float_scalar!(f64, f64);
 float_scalar!(f32, f32);
 
-#[cfg(feature = "dual")]
+#[cfg(feature = "std")]
 mod dual {
     use super::Scalar;
     use num_dual::{Dual, Dual2, DualNum, HyperDual};
@@ -239,7 +239,7 @@ mod tests {
         assert!((a - b).abs() < 1e-5, "{a} vs {b}");
     }
 
-    #[cfg(feature = "dual")]
+    #[cfg(feature = "std")]
     #[test]
     fn dual_gives_the_derivative() {
         use num_dual::Dual64;

@@ -1,0 +1,309 @@
+//! The interface `#[derive(Appell)]` implements.
+//!
+//! Vocabulary (Wang & Pao 2003): n generalized coordinates q_r; m velocity
+//! constraints D(q,t) q̇ + d = 0 (eq. 25); l = n − m privileged speeds ẏ_k,
+//! which are the rates of the coordinates named in `speeds(...)`; the
+//! transformation q̇_r = Σ_k C_rk ẏ_k + c_r (eqs. 30-31); Appell's equations
+//! M(q,t) ÿ = f(q, ẏ, t) (eq. 56 after splitting off the accelerations).
+//!
+//! The *reduced state* integrated by [`Model::rhs`] is the retained (non-
+//! ignorable) coordinates followed by all privileged speeds; the ignorable
+//! coordinates are recovered by quadrature of [`Model::coordinate_rates`].
+//!
+//! All methods take slices so they can be called generically; their lengths
+//! are given by [`ModelInfo`], and a wrong length is an error, never a panic.
+
+use crate::scalar::Scalar;
+
+/// Operation counts of a generated function.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct OpCounts {
+    /// Additions and subtractions.
+    pub add: usize,
+    /// Multiplications.
+    pub mul: usize,
+    /// Divisions.
+    pub div: usize,
+    /// Function calls (sin, cos, sqrt, ...).
+    pub calls: usize,
+    /// Everything, including negations and the numeric solves.
+    pub total: usize,
+}
+
+/// A rigid body or particle of the model, for the independent solver.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct BodyInfo {
+    /// The name given in `body(...)` or the point of `particle(...)`.
+    pub name: &'static str,
+    /// False for a particle (no rotational inertia).
+    pub rigid: bool,
+}
+
+/// Everything about a model that does not depend on numbers.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelInfo {
+    /// The struct's name.
+    pub name: &'static str,
+    /// Parameter names (the struct's fields), in declaration order.
+    pub parameters: &'static [&'static str],
+    /// Generalized coordinates q_r, in declaration order.
+    pub coordinates: &'static [&'static str],
+    /// Coordinates whose rates are the privileged speeds ẏ_k, in order.
+    pub speeds: &'static [&'static str],
+    /// Coordinates whose rates are dependent (solved from the constraints).
+    pub dependent: &'static [&'static str],
+    /// Cyclic coordinates (Sec. III C): dependent coordinates that appear
+    /// nowhere in the reduced equations.
+    pub cyclic: &'static [&'static str],
+    /// All coordinates left out of the integrated state (the cyclic ones and
+    /// privileged ones that appear nowhere either).
+    pub ignorable: &'static [&'static str],
+    /// Coordinates kept in the reduced state, in order.
+    pub retained: &'static [&'static str],
+    /// Inputs supplied at every call.
+    pub inputs: &'static [&'static str],
+    /// Names of the load effects.
+    pub effects: &'static [&'static str],
+    /// Number of holonomic constraints (configuration level).
+    pub holonomic: usize,
+    /// Number of velocity constraint rows (holonomic ones differentiated
+    /// plus nonholonomic ones): m.
+    pub constraints: usize,
+    /// Bodies and particles, in declaration order.
+    pub bodies: &'static [BodyInfo],
+    /// Number of force application points.
+    pub force_points: usize,
+    /// Number of torques.
+    pub torques: usize,
+    /// Whether the dependent speeds are solved symbolically (true) or by a
+    /// pivoted numeric solve in the generated code (false).
+    pub symbolic_elimination: bool,
+    /// Operations per call of the generated reduced rhs.
+    pub rhs_ops: OpCounts,
+    /// The derived reduced equations, as text.
+    pub equations: &'static str,
+}
+
+impl ModelInfo {
+    /// Length of the reduced state.
+    pub fn state_len(&self) -> usize {
+        self.retained.len() + self.speeds.len()
+    }
+
+    /// The index of a coordinate by name.
+    pub fn coordinate_index(&self, name: &str) -> Option<usize> {
+        self.coordinates.iter().position(|c| *c == name)
+    }
+}
+
+/// Why a generated function could not produce a result.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ModelError {
+    /// A slice had the wrong length.
+    Length {
+        /// Which argument.
+        argument: &'static str,
+        /// The length required.
+        expected: usize,
+        /// The length given.
+        found: usize,
+    },
+    /// The mass matrix of Appell's equations is not positive definite at
+    /// this configuration (pivot `index` was `pivot`).
+    SingularMassMatrix {
+        /// The failing pivot's index.
+        index: usize,
+        /// Its value.
+        pivot: f64,
+    },
+    /// The dependent-speed block D' of the constraints is singular here: the
+    /// chosen privileged speeds do not determine the others.
+    SingularConstraints {
+        /// The column whose best pivot was negligible.
+        column: usize,
+        /// That pivot's magnitude.
+        pivot: f64,
+    },
+    /// A parameter declared positive is not.
+    NonPositiveParameter {
+        /// Its name.
+        name: &'static str,
+        /// Its value.
+        value: f64,
+    },
+    /// An input, a state component or a result is NaN or infinite.
+    NonFinite {
+        /// Which quantity.
+        what: &'static str,
+    },
+}
+
+impl core::fmt::Display for ModelError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            ModelError::Length {
+                argument,
+                expected,
+                found,
+            } => write!(f, "`{argument}` has length {found}, expected {expected}"),
+            ModelError::SingularMassMatrix { index, pivot } => write!(
+                f,
+                "singular configuration: the mass matrix is not positive definite (pivot {index} = {pivot:e})"
+            ),
+            ModelError::SingularConstraints { column, pivot } => write!(
+                f,
+                "singular configuration: the dependent speeds are not determined by the privileged ones (pivot {column} = {pivot:e})"
+            ),
+            ModelError::NonPositiveParameter { name, value } => {
+                write!(f, "parameter `{name}` is declared positive but is {value}")
+            }
+            ModelError::NonFinite { what } => write!(f, "{what} is not finite"),
+        }
+    }
+}
+
+#[cfg(feature = "std")]
+impl std::error::Error for ModelError {}
+
+/// Checks a slice length.
+#[doc(hidden)]
+#[inline]
+pub fn check_len<T>(argument: &'static str, s: &[T], expected: usize) -> Result<(), ModelError> {
+    if s.len() == expected {
+        Ok(())
+    } else {
+        Err(ModelError::Length {
+            argument,
+            expected,
+            found: s.len(),
+        })
+    }
+}
+
+/// A constrained multibody model whose equations of motion were derived at
+/// compile time. Implemented by `#[derive(Appell)]`.
+///
+/// Scalars: every numeric method is generic over [`Scalar`], so the same
+/// generated code runs on `f64`, `f32` and dual numbers (for Jacobians).
+pub trait Model {
+    /// Parameter-only subexpressions of the reduced rhs, computed once per
+    /// parameter set by [`Model::prepare`].
+    type Prepared<T: Scalar>: Copy;
+
+    /// Names, sizes and the derived equations.
+    fn info() -> &'static ModelInfo;
+
+    /// The parameter values, in [`ModelInfo::parameters`] order.
+    fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError>;
+
+    /// Sets a parameter by name; false when there is no such parameter.
+    fn set_parameter(&mut self, name: &str, value: f64) -> bool;
+
+    /// Computes the parameter-only values of the rhs.
+    fn prepare<T: Scalar>(&self) -> Self::Prepared<T>;
+
+    /// The reduced equations of motion (eq. 42): `dstate = rhs(t, state)`,
+    /// state = retained coordinates then privileged speeds.
+    fn rhs<T: Scalar>(
+        &self,
+        prepared: &Self::Prepared<T>,
+        t: T,
+        state: &[T],
+        inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError>;
+
+    /// Appell's equations M ÿ = f at full coordinates `q` and privileged
+    /// speeds `u`; `m` is l×l row-major.
+    fn mass_matrix_and_forcing<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        u: &[T],
+        inputs: &[T],
+        m: &mut [T],
+        f: &mut [T],
+    ) -> Result<(), ModelError>;
+
+    /// C_rk (n×l row-major) and c_r (n) of q̇ = C ẏ + c (eqs. 30-31).
+    fn speed_transform<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        c: &mut [T],
+        c0: &mut [T],
+    ) -> Result<(), ModelError>;
+
+    /// All coordinate rates from the privileged speeds: the dependent speeds
+    /// and the quadrature rates of the ignorable coordinates.
+    fn coordinate_rates<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        u: &[T],
+        qdot: &mut [T],
+    ) -> Result<(), ModelError>;
+
+    /// Residuals of the holonomic constraints (`holonomic`, one per
+    /// constraint) and of all velocity constraint rows D q̇ + d (`velocity`).
+    fn constraint_residuals<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        qdot: &[T],
+        holonomic: &mut [T],
+        velocity: &mut [T],
+    ) -> Result<(), ModelError>;
+
+    /// Kinetic energy at full coordinates and privileged speeds.
+    fn kinetic_energy<T: Scalar>(&self, t: T, q: &[T], u: &[T]) -> Result<T, ModelError>;
+
+    // ----- kinematic description, for the independent multiplier solver ---
+
+    /// Mass and body-frame central inertia (row-major 3×3) of each body.
+    fn mass_properties(
+        &self,
+        masses: &mut [f64],
+        inertias: &mut [[f64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// Mass-centre positions (N components) and rotation matrices (columns
+    /// are the body axes in N, row-major) of every body at `(q, t)`.
+    fn body_poses<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        positions: &mut [[T; 3]],
+        rotations: &mut [[T; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// The velocity constraint rows D (m×n row-major) and d (m) at `(q, t)`.
+    fn constraint_rows<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        d: &mut [T],
+        d0: &mut [T],
+    ) -> Result<(), ModelError>;
+
+    /// Load geometry at `(q, t)`: the position of every force's application
+    /// point and the rotation matrix of every torque's frame.
+    fn load_geometry<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        points: &mut [[T; 3]],
+        frames: &mut [[T; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// Load values (N components) at `(q, q̇, t)` and inputs.
+    fn load_values<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        qdot: &[T],
+        inputs: &[T],
+        forces: &mut [[T; 3]],
+        torques: &mut [[T; 3]],
+    ) -> Result<(), ModelError>;
+}
