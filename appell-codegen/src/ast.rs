@@ -1,0 +1,165 @@
+//! The model as written: what the `#[appell(...)]` attributes say, with the
+//! spans of every name and expression, before any name is resolved.
+
+use proc_macro2::Span;
+use syn::Ident;
+
+/// A scalar or vector expression of the model language.
+#[derive(Clone, Debug)]
+pub enum Expr {
+    /// An integer literal (stays exact).
+    Int(i64, Span),
+    /// A float literal.
+    Float(f64, Span),
+    /// A name: parameter, coordinate, input, `t`, point or frame.
+    Name(Ident),
+    /// `f(args)`: `dt`, `sin`, `cos`, `tan`, `exp`, `ln`, `sqrt`, `abs`,
+    /// `atan2`, `powi`, `dot`, `cross`, `norm`, `unit`.
+    Call(Ident, Vec<Expr>, Span),
+    /// `A.x`, `A.y`, `A.z`: a unit vector of frame `A`.
+    Axis(Ident, usize, Span),
+    /// A binary operation.
+    Binary(BinOp, Box<Expr>, Box<Expr>, Span),
+    /// `-e`.
+    Neg(Box<Expr>, Span),
+}
+
+impl Expr {
+    /// Where the expression stands in the source.
+    pub fn span(&self) -> Span {
+        match self {
+            Expr::Int(_, s) | Expr::Float(_, s) => *s,
+            Expr::Name(i) => i.span(),
+            Expr::Call(_, _, s)
+            | Expr::Axis(_, _, s)
+            | Expr::Binary(_, _, _, s)
+            | Expr::Neg(_, s) => *s,
+        }
+    }
+}
+
+/// `+ - * /`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum BinOp {
+    /// `+`.
+    Add,
+    /// `-`.
+    Sub,
+    /// `*`.
+    Mul,
+    /// `/`.
+    Div,
+}
+
+/// The axis of a simple rotation.
+#[derive(Clone, Debug)]
+pub enum RotationAxis {
+    /// About the parent's x, y or z axis (0, 1, 2).
+    Parent(usize),
+    /// About an arbitrary vector (normalized).
+    Vector(Expr),
+}
+
+/// `frame(A = P.rotate_z(angle))`.
+#[derive(Clone, Debug)]
+pub struct FrameDef {
+    /// The new frame.
+    pub name: Ident,
+    /// The frame it is rotated from.
+    pub parent: Ident,
+    /// The rotation axis.
+    pub axis: RotationAxis,
+    /// The rotation angle.
+    pub angle: Expr,
+}
+
+/// `point(P = Q + vector)`.
+#[derive(Clone, Debug)]
+pub struct PointDef {
+    /// The new point.
+    pub name: Ident,
+    /// Its location (a point expression).
+    pub location: Expr,
+}
+
+/// Inertia about the mass centre, in the body frame.
+#[derive(Clone, Debug)]
+pub enum Inertia {
+    /// `principal(i1, i2, i3)`.
+    Principal([Expr; 3]),
+    /// `matrix(ixx, iyy, izz, ixy, iyz, izx)`.
+    Matrix([Expr; 6]),
+}
+
+/// `body(name, center = P, frame = B, mass = m, inertia = ...)` or
+/// `particle(P, mass = m)` (no frame, no inertia).
+#[derive(Clone, Debug)]
+pub struct BodyDef {
+    /// The body's name (the point's for a particle).
+    pub name: Ident,
+    /// The mass centre.
+    pub center: Ident,
+    /// The body frame (None for a particle).
+    pub frame: Option<Ident>,
+    /// The mass.
+    pub mass: Expr,
+    /// The central inertia (None for a particle).
+    pub inertia: Option<Inertia>,
+    /// The whole attribute item, for errors.
+    pub span: Span,
+}
+
+/// `holonomic(lhs == rhs)` or `nonholonomic(lhs == rhs)`.
+#[derive(Clone, Debug)]
+pub struct ConstraintDef {
+    /// Left side.
+    pub lhs: Expr,
+    /// Right side.
+    pub rhs: Expr,
+    /// The whole constraint, for errors.
+    pub span: Span,
+}
+
+/// A force on a point or a torque on a frame.
+#[derive(Clone, Debug)]
+pub struct LoadDef {
+    /// The point (force) or frame (torque).
+    pub target: Ident,
+    /// The vector.
+    pub vector: Expr,
+    /// The effect it belongs to.
+    pub effect: Ident,
+}
+
+/// The whole model as written.
+#[derive(Clone, Debug)]
+pub struct ModelAst {
+    /// The struct's name.
+    pub name: Ident,
+    /// Its fields (the parameters), with whether their type is `f64`.
+    pub fields: Vec<(Ident, bool)>,
+    /// `coordinates(...)`.
+    pub coordinates: Vec<Ident>,
+    /// `speeds(...)` and the attribute's span.
+    pub speeds: Option<(Vec<Ident>, Span)>,
+    /// `inputs(...)`.
+    pub inputs: Vec<Ident>,
+    /// `positive(...)`: parameters known to be positive.
+    pub positive: Vec<Ident>,
+    /// Frames in order.
+    pub frames: Vec<FrameDef>,
+    /// Points in order.
+    pub points: Vec<PointDef>,
+    /// Bodies and particles in order.
+    pub bodies: Vec<BodyDef>,
+    /// Holonomic constraints.
+    pub holonomic: Vec<ConstraintDef>,
+    /// Nonholonomic constraints.
+    pub nonholonomic: Vec<ConstraintDef>,
+    /// Forces.
+    pub forces: Vec<LoadDef>,
+    /// Torques.
+    pub torques: Vec<LoadDef>,
+    /// `gravity(vector)`.
+    pub gravity: Option<Expr>,
+}

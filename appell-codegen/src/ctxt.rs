@@ -1,0 +1,125 @@
+//! Error collection (serde_derive's `Ctxt` pattern): every stage records its
+//! errors with spans and goes on, so a user with three mistakes sees three
+//! errors at once.
+
+use std::cell::RefCell;
+use std::fmt::Display;
+
+use proc_macro2::Span;
+use quote::ToTokens;
+
+/// Collects errors; [`Ctxt::check`] must be called before it is dropped.
+#[derive(Default)]
+pub struct Ctxt {
+    errors: RefCell<Option<Vec<syn::Error>>>,
+}
+
+impl Ctxt {
+    /// A fresh context.
+    pub fn new() -> Ctxt {
+        Ctxt {
+            errors: RefCell::new(Some(Vec::new())),
+        }
+    }
+
+    /// Records an error underlining `tokens`.
+    pub fn error_spanned_by<T: ToTokens, M: Display>(&self, tokens: T, msg: M) {
+        self.push(syn::Error::new_spanned(tokens.into_token_stream(), msg));
+    }
+
+    /// Records an error at `span`.
+    pub fn error_at<M: Display>(&self, span: Span, msg: M) {
+        self.push(syn::Error::new(span, msg));
+    }
+
+    /// Records a syn error.
+    pub fn syn_error(&self, err: syn::Error) {
+        self.push(err);
+    }
+
+    fn push(&self, err: syn::Error) {
+        self.errors
+            .borrow_mut()
+            .as_mut()
+            .expect("Ctxt used after check")
+            .push(err);
+    }
+
+    /// Whether any error was recorded so far.
+    pub fn has_errors(&self) -> bool {
+        self.errors.borrow().as_ref().is_some_and(|e| !e.is_empty())
+    }
+
+    /// All errors combined, or `Ok` when there were none.
+    pub fn check(self) -> syn::Result<()> {
+        let mut errors = self.errors.take().expect("Ctxt checked twice").into_iter();
+        let Some(mut combined) = errors.next() else {
+            return Ok(());
+        };
+        for rest in errors {
+            combined.combine(rest);
+        }
+        Err(combined)
+    }
+}
+
+impl Drop for Ctxt {
+    fn drop(&mut self) {
+        if !std::thread::panicking() && self.errors.borrow().is_some() {
+            panic!("forgot to check for errors");
+        }
+    }
+}
+
+/// The closest name to `wanted` among `candidates`, if close enough to be a
+/// useful "did you mean".
+pub fn did_you_mean<'a>(
+    wanted: &str,
+    candidates: impl IntoIterator<Item = &'a str>,
+) -> Option<&'a str> {
+    let mut best: Option<(usize, &str)> = None;
+    for c in candidates {
+        let d = levenshtein(wanted, c);
+        let limit = (wanted.len().max(c.len()) / 3).max(1);
+        if d <= limit && best.is_none_or(|(bd, _)| d < bd) {
+            best = Some((d, c));
+        }
+    }
+    best.map(|(_, c)| c)
+}
+
+fn levenshtein(a: &str, b: &str) -> usize {
+    let b: Vec<char> = b.chars().collect();
+    let mut prev: Vec<usize> = (0..=b.len()).collect();
+    for (i, ca) in a.chars().enumerate() {
+        let mut cur = vec![i + 1; b.len() + 1];
+        for (j, cb) in b.iter().enumerate() {
+            let sub = prev[j] + usize::from(ca != *cb);
+            cur[j + 1] = sub.min(prev[j + 1] + 1).min(cur[j] + 1);
+        }
+        prev = cur;
+    }
+    prev[b.len()]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn suggests_a_close_name() {
+        assert_eq!(did_you_mean("phy", ["phi", "psi1", "x1"]), Some("phi"));
+    }
+    #[test]
+    fn no_suggestion_for_a_distant_name() {
+        assert_eq!(did_you_mean("gravity", ["phi", "psi1"]), None);
+    }
+    #[test]
+    fn collects_all_errors() {
+        let cx = Ctxt::new();
+        cx.error_at(Span::call_site(), "one");
+        cx.error_at(Span::call_site(), "two");
+        let err = cx.check().unwrap_err();
+        assert_eq!(err.into_iter().count(), 2);
+    }
+}

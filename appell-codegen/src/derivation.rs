@@ -1,0 +1,856 @@
+//! Stage 3: Appell's equations by Method II (Wang & Pao 2003, Secs. III B-C
+//! and IV B), in the symbolic engine.
+//!
+//! 1. Velocity constraints D(q,t) q̇ + d = 0 (eq. 25): holonomic ones are
+//!    differentiated in time, nonholonomic ones must be linear in q̇.
+//! 2. Partition q̇ into dependent ż and privileged ẏ and solve
+//!    D' ż = −D'' ẏ − d (eq. 27): symbolically when every pivot is provably
+//!    non-zero, otherwise by a pivoted numeric solve in the generated code
+//!    (auxiliary symbols stand for B, b and their rates).
+//! 3. q̇ = C ẏ + c (eqs. 30-31).
+//! 4. Partial velocities β̄ and partial angular velocities γ̄ (eq. 54) as the
+//!    coefficients of ẏ in the velocities with ż eliminated.
+//! 5. Accelerations r̈ = Σ β̄_k ÿ_k + Σ β̄̇_k ẏ_k + β̄̇ (eq. 37, corrected), and
+//!    likewise for angular accelerations; the parts free of ÿ are built
+//!    directly from their pieces (never by substituting zeros).
+//! 6. Appell's equations (eq. 56) as M ÿ = f with
+//!    M_kl = Σ m β̄_k·β̄_l + γ̄_k·I γ̄_l and
+//!    f_k = Σ F·β̄_k + L·γ̄_k − m a_rem·β̄_k − γ̄_k·(I α_rem + ω × I ω),
+//!    rotational terms in the body frame where I is constant.
+//! 7. Cyclic coordinates (Sec. III C): coordinates that appear in none of
+//!    M, f, nor the rates of the coordinates that are kept.
+
+use std::collections::BTreeSet;
+use std::fmt::Write;
+
+use appell_symbolic::{
+    Assumptions, Id, Number, RateRules, Substitution, SymMatrix, Symbol, SymbolKind, SymbolSet,
+    SymbolicError,
+};
+
+use crate::ctxt::Ctxt;
+use crate::model::{cross, dot, Mat3, Model, Vec3};
+
+/// How the dependent speeds are obtained.
+pub enum Elimination {
+    /// B and b are expressions.
+    Symbolic,
+    /// B and b are solved numerically in the generated code.
+    Numeric(NumericElimination),
+}
+
+/// The pieces of a numeric elimination: D' X = R with X = [B | b], then
+/// D' Ẋ = R' with R' = −Ḋ' X − [Ḋ'' | ḋ].
+pub struct NumericElimination {
+    /// D' (m×m), row-major.
+    pub dp: Vec<Id>,
+    /// R = [−D'' | −d] (m×(l+1)), row-major.
+    pub rhs: Vec<Id>,
+    /// R' (m×(l+1)), row-major; contains the X symbols.
+    pub rhs_rate: Vec<Id>,
+    /// Symbols of X (m×(l+1)).
+    pub x: Vec<Symbol>,
+    /// Symbols of Ẋ (m×(l+1)).
+    pub x_rate: Vec<Symbol>,
+}
+
+/// Per body: velocity pieces and, for rigid bodies, body-frame angular ones.
+pub struct BodyTerms {
+    /// β̄_k.
+    pub beta: Vec<Vec3>,
+    /// β̄ (the part of the velocity free of ẏ).
+    pub beta0: Vec3,
+    /// γ̄_k in body components.
+    pub gamma_b: Vec<Vec3>,
+    /// ω in body components.
+    pub omega_b: Vec3,
+}
+
+/// The derived equations and everything the emitter needs.
+pub struct Derivation {
+    /// The model (its graph holds every expression below).
+    pub model: Model,
+    /// Number of coordinates n.
+    pub n: usize,
+    /// Number of constraint rows m.
+    pub m: usize,
+    /// Number of privileged speeds l.
+    pub l: usize,
+    /// Coordinate indices of the dependent speeds.
+    pub dependent: Vec<usize>,
+    /// Constraint rows D (m×n) and d (m).
+    pub d_rows: Vec<Id>,
+    /// d.
+    pub d0: Vec<Id>,
+    /// Holonomic residuals f(q, t).
+    pub holonomic: Vec<Id>,
+    /// C (n×l) and c (n).
+    pub c: Vec<Id>,
+    /// c.
+    pub c0: Vec<Id>,
+    /// How B and b are computed.
+    pub elimination: Elimination,
+    /// q̇_r = Σ C_rk ẏ_k + c_r.
+    pub qdot: Vec<Id>,
+    /// D q̇ + d, with q̇ the coordinate rate symbols.
+    pub velocity_residuals: Vec<Id>,
+    /// Symbols ÿ_k.
+    pub accels: Vec<Symbol>,
+    /// M (l×l), row-major, symmetric.
+    pub mass: Vec<Id>,
+    /// f (l).
+    pub forcing: Vec<Id>,
+    /// Kinetic energy.
+    pub kinetic: Id,
+    /// Coordinates kept in the reduced state.
+    pub retained: Vec<usize>,
+    /// Cyclic (dependent, absent) coordinates.
+    pub cyclic: Vec<usize>,
+    /// All coordinates left out of the reduced state.
+    pub ignorable: Vec<usize>,
+    /// Readable equations.
+    pub text: String,
+}
+
+/// Runs the derivation; errors go to `cx`.
+pub fn derive(cx: &Ctxt, mut model: Model) -> Option<Derivation> {
+    match derive_inner(cx, &mut model) {
+        Ok(Some(parts)) => Some(parts.finish(model)),
+        Ok(None) => None,
+        Err(e) => {
+            cx.error_at(
+                model.name.span(),
+                format!("deriving the equations failed: {e}"),
+            );
+            None
+        }
+    }
+}
+
+struct Parts {
+    n: usize,
+    m: usize,
+    l: usize,
+    dependent: Vec<usize>,
+    d_rows: Vec<Id>,
+    d0: Vec<Id>,
+    holonomic: Vec<Id>,
+    c: Vec<Id>,
+    c0: Vec<Id>,
+    elimination: Elimination,
+    qdot: Vec<Id>,
+    velocity_residuals: Vec<Id>,
+    accels: Vec<Symbol>,
+    mass: Vec<Id>,
+    forcing: Vec<Id>,
+    kinetic: Id,
+    retained: Vec<usize>,
+    cyclic: Vec<usize>,
+    ignorable: Vec<usize>,
+}
+
+impl Parts {
+    fn finish(self, model: Model) -> Derivation {
+        let mut d = Derivation {
+            model,
+            n: self.n,
+            m: self.m,
+            l: self.l,
+            dependent: self.dependent,
+            d_rows: self.d_rows,
+            d0: self.d0,
+            holonomic: self.holonomic,
+            c: self.c,
+            c0: self.c0,
+            elimination: self.elimination,
+            qdot: self.qdot,
+            velocity_residuals: self.velocity_residuals,
+            accels: self.accels,
+            mass: self.mass,
+            forcing: self.forcing,
+            kinetic: self.kinetic,
+            retained: self.retained,
+            cyclic: self.cyclic,
+            ignorable: self.ignorable,
+            text: String::new(),
+        };
+        d.text = equations_text(&d);
+        d
+    }
+}
+
+fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicError> {
+    let n = model.coords.len();
+    let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let rules = RateRules::coordinates();
+    // 1. Velocity constraint rows.
+    let mut rows: Vec<(Id, proc_macro2::Span, bool)> = Vec::new();
+    let mut holonomic = Vec::new();
+    for c in &model.holonomic {
+        holonomic.push(c.residual);
+        let bad: Vec<String> = model
+            .g
+            .dependencies(c.residual)
+            .iter()
+            .filter(|s| {
+                !matches!(
+                    model.g.symbol_kind(*s),
+                    SymbolKind::Coordinate | SymbolKind::Parameter | SymbolKind::Time
+                )
+            })
+            .map(|s| model.g.symbol_name(s).to_string())
+            .collect();
+        if !bad.is_empty() {
+            cx.error_at(c.span, format!("a holonomic constraint relates coordinates, parameters and time only; it uses {}", bad.join(", ")));
+            continue;
+        }
+        match model.g.time_derivative(c.residual, &rules) {
+            Ok(r) => rows.push((r, c.span, true)),
+            Err(e) => cx.error_at(c.span, e),
+        }
+    }
+    for c in &model.nonholonomic {
+        rows.push((c.residual, c.span, false));
+    }
+    let mut d_rows = Vec::new();
+    let mut d0 = Vec::new();
+    for (row, span, holo) in &rows {
+        let bad: Vec<String> = model
+            .g
+            .dependencies(*row)
+            .iter()
+            .filter(|s| {
+                matches!(
+                    model.g.symbol_kind(*s),
+                    SymbolKind::Input | SymbolKind::Acceleration(_)
+                )
+            })
+            .map(|s| model.g.symbol_name(s).to_string())
+            .collect();
+        if !bad.is_empty() {
+            cx.error_at(
+                *span,
+                format!("a velocity constraint cannot depend on {}", bad.join(", ")),
+            );
+            continue;
+        }
+        match model.g.linear_coefficients(*row, &rates) {
+            Ok(form) => {
+                if form.coefficients.iter().all(|c| model.g.is_zero(*c)) {
+                    cx.error_at(
+                        *span,
+                        "this constraint does not involve any coordinate rate",
+                    );
+                    continue;
+                }
+                d_rows.extend(form.coefficients);
+                d0.push(form.remainder);
+            }
+            Err(SymbolicError::NonLinear { symbol, .. }) => {
+                let what = if *holo {
+                    "the differentiated holonomic constraint"
+                } else {
+                    "a nonholonomic constraint"
+                };
+                cx.error_at(
+                    *span,
+                    format!("{what} must be linear in the coordinate rates (eq. 25: D(q,t) q̇ + d = 0), and this one is not linear in `{symbol}`"),
+                );
+            }
+            Err(e) => cx.error_at(*span, e),
+        }
+    }
+    if cx.has_errors() {
+        return Ok(None);
+    }
+    let m = d0.len();
+    let l = model.speeds.len();
+    if l + m != n {
+        cx.error_at(
+            model.speeds_span,
+            format!(
+                "{l} privileged speed(s) with {m} velocity constraint(s) on {n} coordinates: the constraints leave {} independent speed(s), so `speeds(...)` must name {}",
+                n.saturating_sub(m),
+                n.saturating_sub(m)
+            ),
+        );
+        return Ok(None);
+    }
+    let dependent: Vec<usize> = (0..n).filter(|i| !model.speeds.contains(i)).collect();
+    let g = &mut model.g;
+    // 2. Structural rank of D' (a matching of rows to dependent columns).
+    if let Some(col) = unmatched_column(g, &d_rows, n, m, &dependent) {
+        let name = model.coords[dependent[col]].0.to_string();
+        cx.error_at(
+            model.speeds_span,
+            format!("with these privileged speeds the constraints cannot determine the rate of `{name}`: the dependent block D' is structurally singular; choose other speeds"),
+        );
+        return Ok(None);
+    }
+    let mut dp = Vec::with_capacity(m * m);
+    let mut rhs = Vec::with_capacity(m * (l + 1));
+    for r in 0..m {
+        for &c in &dependent {
+            dp.push(d_rows[r * n + c]);
+        }
+        for &k in &model.speeds {
+            rhs.push(g.neg(d_rows[r * n + k])?);
+        }
+        rhs.push(g.neg(d0[r])?);
+    }
+    let mut assume = Assumptions::new();
+    for p in &model.params {
+        if p.positive {
+            assume = assume.positive(p.symbol);
+        }
+    }
+    let dp_m = SymMatrix::from_rows(m, m, dp.clone())?;
+    let rhs_m = SymMatrix::from_rows(m, l + 1, rhs.clone())?;
+    let (x_entries, elimination_numeric): (Vec<Id>, Option<Vec<Symbol>>) = if m == 0 {
+        (Vec::new(), None)
+    } else {
+        match g.solve_linear(&dp_m, &rhs_m, &assume) {
+            Ok(sol) => (sol.x.entries().to_vec(), None),
+            Err(SymbolicError::NoProvablyNonzeroPivot { .. }) => {
+                let mut syms = Vec::new();
+                let mut ids = Vec::new();
+                for i in 0..m {
+                    for j in 0..=l {
+                        let s = g.declare(&format!("__x_{i}_{j}"), SymbolKind::Auxiliary)?;
+                        ids.push(g.sym(s)?);
+                        syms.push(s);
+                    }
+                }
+                (ids, Some(syms))
+            }
+            Err(SymbolicError::StructurallySingular { column }) => {
+                let name = model.coords[dependent[column]].0.to_string();
+                cx.error_at(
+                    model.speeds_span,
+                    format!("with these privileged speeds the constraints cannot determine the rate of `{name}` (D' is singular after elimination); choose other speeds"),
+                );
+                return Ok(None);
+            }
+            Err(e) => return Err(e),
+        }
+    };
+    // 3. C and c.
+    let zero = g.int(0)?;
+    let one = g.int(1)?;
+    let mut c = vec![zero; n * l];
+    let mut c0 = vec![zero; n];
+    for (k, &s) in model.speeds.iter().enumerate() {
+        c[s * l + k] = one;
+    }
+    for (i, &r) in dependent.iter().enumerate() {
+        for k in 0..l {
+            c[r * l + k] = x_entries[i * (l + 1) + k];
+        }
+        c0[r] = x_entries[i * (l + 1) + l];
+    }
+    let speed_rates: Vec<Symbol> = model
+        .speeds
+        .iter()
+        .map(|&i| model.coords[i].1.rate)
+        .collect();
+    let accels: Vec<Symbol> = model
+        .speeds
+        .iter()
+        .map(|&i| model.coords[i].1.accel)
+        .collect();
+    // q̇_r = Σ C_rk ẏ_k + c_r, as expressions.
+    let mut qdot = Vec::with_capacity(n);
+    for r in 0..n {
+        let mut terms = vec![c0[r]];
+        for k in 0..l {
+            let y = g.sym(speed_rates[k])?;
+            terms.push(g.mul(c[r * l + k], y)?);
+        }
+        qdot.push(g.sum(&terms)?);
+    }
+    // Rate rules of the reduced system: q̇ = C ẏ + c; auxiliary X → Ẋ.
+    let mut reduced = RateRules::coordinates();
+    for (r, (_, coord)) in model.coords.iter().enumerate() {
+        reduced = reduced.with(coord.q, qdot[r]);
+    }
+    let mut elimination = Elimination::Symbolic;
+    if let Some(xs) = elimination_numeric {
+        let mut x_rate = Vec::new();
+        for i in 0..m {
+            for j in 0..=l {
+                let s = g.declare(&format!("__xd_{i}_{j}"), SymbolKind::Auxiliary)?;
+                x_rate.push(s);
+            }
+        }
+        for (s, r) in xs.iter().zip(&x_rate) {
+            let rid = g.sym(*r)?;
+            reduced = reduced.with(*s, rid);
+        }
+        // R' = −Ḋ' X − [Ḋ'' | ḋ]: the rate of R = [−D'' | −d] is −[Ḋ'' | ḋ].
+        let dp_rate = g.time_derivatives(&dp, &reduced)?;
+        let rhs_rate_plain = g.time_derivatives(&rhs, &reduced)?;
+        let mut rhs_rate = Vec::with_capacity(m * (l + 1));
+        for i in 0..m {
+            for j in 0..=l {
+                let mut terms = vec![rhs_rate_plain[i * (l + 1) + j]];
+                for k in 0..m {
+                    let xk = g.sym(xs[k * (l + 1) + j])?;
+                    let t = g.mul(dp_rate[i * m + k], xk)?;
+                    terms.push(g.neg(t)?);
+                }
+                rhs_rate.push(g.sum(&terms)?);
+            }
+        }
+        elimination = Elimination::Numeric(NumericElimination {
+            dp: dp.clone(),
+            rhs: rhs.clone(),
+            rhs_rate,
+            x: xs,
+            x_rate,
+        });
+    }
+    // 4. Velocities with ż eliminated: substitute the dependent rates.
+    let mut sub = Substitution::new();
+    for &r in &dependent {
+        sub.insert(model.coords[r].1.rate, qdot[r]);
+    }
+    let vel = |g: &mut appell_symbolic::Graph,
+               sub: &mut Substitution,
+               pos: Vec3|
+     -> Result<(Vec<Vec3>, Vec3), SymbolicError> {
+        let mut v = [zero; 3];
+        for i in 0..3 {
+            let d = g.time_derivative(pos[i], &rules)?;
+            let d = sub.apply(g, d)?;
+            v[i] = expanded(g, d)?;
+        }
+        split_linear(g, v, &speed_rates)
+    };
+    let mut body_terms = Vec::new();
+    let mut beta_rem = Vec::new();
+    for b in &model.bodies {
+        let (beta, beta0) = vel(g, &mut sub, b.center)?;
+        let (gamma_b, omega_b, gamma_n) = match b.frame {
+            Some(fi) => {
+                let frame = &model.frames[fi];
+                let rot = frame.rot;
+                let (gamma, gamma0) = split_omega(g, frame.omega, &mut sub, &speed_rates)?;
+                let gamma_b: Vec<Vec3> = gamma
+                    .iter()
+                    .map(|v| mat_t_vec(g, &rot, *v).and_then(|x| expanded3(g, x)))
+                    .collect::<Result<_, _>>()?;
+                let omega_n = combine(g, &gamma, gamma0, &speed_rates)?;
+                let omega_b = mat_t_vec(g, &rot, omega_n)?;
+                let omega_b = expanded3(g, omega_b)?;
+                (gamma_b, omega_b, Some((gamma, gamma0, rot)))
+            }
+            None => (vec![[zero; 3]; l], [zero; 3], None),
+        };
+        body_terms.push(BodyTerms {
+            beta: beta.clone(),
+            beta0,
+            gamma_b,
+            omega_b,
+        });
+        beta_rem.push((beta, beta0, gamma_n));
+    }
+    let mut force_beta = Vec::new();
+    for f in &model.forces {
+        force_beta.push(vel(g, &mut sub, f.point)?.0);
+    }
+    let mut torque_gamma = Vec::new();
+    for t in &model.torques {
+        let omega = model.frames[t.frame].omega;
+        torque_gamma.push(split_omega(g, omega, &mut sub, &speed_rates)?.0);
+    }
+    // 5. Acceleration remainders: Σ_k (d/dt β̄_k) ẏ_k + d/dt β̄.
+    let remainder =
+        |g: &mut appell_symbolic::Graph, parts: &[Vec3], p0: Vec3| -> Result<Vec3, SymbolicError> {
+            let mut flat: Vec<Id> = parts.iter().flatten().copied().collect();
+            flat.extend(p0);
+            let d = g.time_derivatives(&flat, &reduced)?;
+            let mut out = [zero; 3];
+            for i in 0..3 {
+                let mut terms = vec![d[l * 3 + i]];
+                for k in 0..l {
+                    let y = g.sym(speed_rates[k])?;
+                    terms.push(g.mul(d[k * 3 + i], y)?);
+                }
+                let sum = g.sum(&terms)?;
+                out[i] = expanded(g, sum)?;
+            }
+            Ok(out)
+        };
+    // 6. Appell's equations.
+    let mut mass = vec![zero; l * l];
+    let mut forcing_terms: Vec<Vec<Id>> = vec![Vec::new(); l];
+    for (bi, b) in model.bodies.iter().enumerate() {
+        let t = &body_terms[bi];
+        let (beta, beta0, gamma_n) = &beta_rem[bi];
+        let a_rem = remainder(g, beta, *beta0)?;
+        for k in 0..l {
+            for j in k..l {
+                let bb = dot(g, t.beta[k], t.beta[j])?;
+                let mut e = g.mul(b.mass, bb)?;
+                if b.frame.is_some() {
+                    let ig = mat_vec(g, &b.inertia, t.gamma_b[j])?;
+                    let rot = dot(g, t.gamma_b[k], ig)?;
+                    e = g.add(e, rot)?;
+                }
+                mass[k * l + j] = g.add(mass[k * l + j], e)?;
+            }
+            let ab = dot(g, a_rem, t.beta[k])?;
+            let inertial = g.mul(b.mass, ab)?;
+            forcing_terms[k].push(g.neg(inertial)?);
+        }
+        if let Some((gamma, gamma0, rot)) = gamma_n {
+            let alpha_n = remainder(g, gamma, *gamma0)?;
+            let alpha_b = mat_t_vec(g, rot, alpha_n)?;
+            let alpha_b = expanded3(g, alpha_b)?;
+            let i_alpha = mat_vec(g, &b.inertia, alpha_b)?;
+            let i_omega = mat_vec(g, &b.inertia, t.omega_b)?;
+            let gyro = cross(g, t.omega_b, i_omega)?;
+            let mut total = [zero; 3];
+            for i in 0..3 {
+                total[i] = g.add(i_alpha[i], gyro[i])?;
+            }
+            for k in 0..l {
+                let e = dot(g, t.gamma_b[k], total)?;
+                forcing_terms[k].push(g.neg(e)?);
+            }
+        }
+    }
+    for (fi, f) in model.forces.iter().enumerate() {
+        for k in 0..l {
+            forcing_terms[k].push(dot(g, f.vector, force_beta[fi][k])?);
+        }
+    }
+    for (ti, t) in model.torques.iter().enumerate() {
+        for k in 0..l {
+            forcing_terms[k].push(dot(g, t.vector, torque_gamma[ti][k])?);
+        }
+    }
+    for k in 0..l {
+        for j in k..l {
+            mass[k * l + j] = expanded(g, mass[k * l + j])?;
+        }
+        for j in 0..k {
+            mass[k * l + j] = mass[j * l + k];
+        }
+    }
+    let forcing: Vec<Id> = forcing_terms
+        .iter()
+        .map(|t| g.sum(t).and_then(|e| expanded(g, e)))
+        .collect::<Result<_, _>>()?;
+    // Kinetic energy ½ Σ m v·v + ½ ω·I ω.
+    let mut ke_terms = Vec::new();
+    for (bi, b) in model.bodies.iter().enumerate() {
+        let t = &body_terms[bi];
+        let v = combine(g, &t.beta, t.beta0, &speed_rates)?;
+        let vv = dot(g, v, v)?;
+        ke_terms.push(g.mul(b.mass, vv)?);
+        if b.frame.is_some() {
+            let iw = mat_vec(g, &b.inertia, t.omega_b)?;
+            ke_terms.push(dot(g, t.omega_b, iw)?);
+        }
+    }
+    let ke = g.sum(&ke_terms)?;
+    let kinetic = g.scale(ke, Number::ratio(1, 2).expect("1/2"))?;
+    let kinetic = expanded(g, kinetic)?;
+    // 7. Retained and ignorable coordinates.
+    let aux_deps = match &elimination {
+        Elimination::Symbolic => Vec::new(),
+        Elimination::Numeric(ne) => {
+            let mut all = SymbolSet::new();
+            for &e in ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate) {
+                all.union_with(g.dependencies(e));
+            }
+            ne.x.iter()
+                .chain(&ne.x_rate)
+                .map(|&s| (s, all.clone()))
+                .collect::<Vec<_>>()
+        }
+    };
+    let deps_of = |g: &appell_symbolic::Graph, e: Id| -> SymbolSet {
+        let mut set = g.dependencies(e).clone();
+        for (s, d) in &aux_deps {
+            if set.contains(*s) {
+                set.union_with(d);
+            }
+        }
+        set
+    };
+    let coord_of = |set: &SymbolSet| -> BTreeSet<usize> {
+        model
+            .coords
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, c))| set.contains(c.q))
+            .map(|(i, _)| i)
+            .collect()
+    };
+    let mut retained: BTreeSet<usize> = BTreeSet::new();
+    for &e in mass.iter().chain(&forcing) {
+        retained.extend(coord_of(&deps_of(g, e)));
+    }
+    loop {
+        let before = retained.len();
+        for r in retained.clone() {
+            retained.extend(coord_of(&deps_of(g, qdot[r])));
+        }
+        if retained.len() == before {
+            break;
+        }
+    }
+    let retained: Vec<usize> = retained.into_iter().collect();
+    let ignorable: Vec<usize> = (0..n).filter(|i| !retained.contains(i)).collect();
+    let cyclic: Vec<usize> = ignorable
+        .iter()
+        .copied()
+        .filter(|i| dependent.contains(i))
+        .collect();
+    let mut velocity_residuals = Vec::with_capacity(m);
+    for i in 0..m {
+        let mut terms = vec![d0[i]];
+        for (r, rate) in rates.iter().enumerate() {
+            let q = g.sym(*rate)?;
+            terms.push(g.mul(d_rows[i * n + r], q)?);
+        }
+        velocity_residuals.push(g.sum(&terms)?);
+    }
+    Ok(Some(Parts {
+        n,
+        m,
+        l,
+        dependent,
+        d_rows,
+        d0,
+        holonomic,
+        c,
+        c0,
+        elimination,
+        qdot,
+        velocity_residuals,
+        accels,
+        mass,
+        forcing,
+        kinetic,
+        retained,
+        cyclic,
+        ignorable,
+    }))
+}
+
+/// Multiplies out products of sums so cancellations happen (the velocity
+/// terms of the wheel-axle's forcing vanish only then); an expansion that
+/// would exceed the term limit keeps the factored form.
+fn expanded(g: &mut appell_symbolic::Graph, e: Id) -> Result<Id, SymbolicError> {
+    match g.expand(e) {
+        Ok(x) => Ok(x),
+        Err(SymbolicError::TermLimit { .. }) => Ok(e),
+        Err(other) => Err(other),
+    }
+}
+
+fn expanded3(g: &mut appell_symbolic::Graph, v: Vec3) -> Result<Vec3, SymbolicError> {
+    Ok([expanded(g, v[0])?, expanded(g, v[1])?, expanded(g, v[2])?])
+}
+
+/// Splits a vector linear in `speeds` into coefficient vectors and the rest.
+fn split_linear(
+    g: &mut appell_symbolic::Graph,
+    v: Vec3,
+    speeds: &[Symbol],
+) -> Result<(Vec<Vec3>, Vec3), SymbolicError> {
+    let zero = g.int(0)?;
+    let mut parts = vec![[zero; 3]; speeds.len()];
+    let mut rest = [zero; 3];
+    for i in 0..3 {
+        let form = g.linear_coefficients(v[i], speeds)?;
+        for (k, c) in form.coefficients.into_iter().enumerate() {
+            parts[k][i] = c;
+        }
+        rest[i] = form.remainder;
+    }
+    Ok((parts, rest))
+}
+
+fn split_omega(
+    g: &mut appell_symbolic::Graph,
+    omega: Vec3,
+    sub: &mut Substitution,
+    speeds: &[Symbol],
+) -> Result<(Vec<Vec3>, Vec3), SymbolicError> {
+    let mut w = omega;
+    for x in w.iter_mut() {
+        *x = sub.apply(g, *x)?;
+    }
+    split_linear(g, w, speeds)
+}
+
+/// Σ parts_k ẏ_k + p0.
+fn combine(
+    g: &mut appell_symbolic::Graph,
+    parts: &[Vec3],
+    p0: Vec3,
+    speeds: &[Symbol],
+) -> Result<Vec3, SymbolicError> {
+    let mut out = p0;
+    for i in 0..3 {
+        let mut terms = vec![p0[i]];
+        for (k, s) in speeds.iter().enumerate() {
+            let y = g.sym(*s)?;
+            terms.push(g.mul(parts[k][i], y)?);
+        }
+        out[i] = g.sum(&terms)?;
+    }
+    Ok(out)
+}
+
+/// Rᵀ v: N components to body components.
+fn mat_t_vec(g: &mut appell_symbolic::Graph, r: &Mat3, v: Vec3) -> Result<Vec3, SymbolicError> {
+    let col = |k: usize| [r[0][k], r[1][k], r[2][k]];
+    Ok([dot(g, col(0), v)?, dot(g, col(1), v)?, dot(g, col(2), v)?])
+}
+
+/// I v.
+fn mat_vec(g: &mut appell_symbolic::Graph, m: &Mat3, v: Vec3) -> Result<Vec3, SymbolicError> {
+    Ok([dot(g, m[0], v)?, dot(g, m[1], v)?, dot(g, m[2], v)?])
+}
+
+/// A column of D' (dependent rate) that no row can be matched to, by
+/// augmenting paths over the non-zero pattern.
+fn unmatched_column(
+    g: &appell_symbolic::Graph,
+    d: &[Id],
+    n: usize,
+    m: usize,
+    dependent: &[usize],
+) -> Option<usize> {
+    let nonzero = |r: usize, c: usize| !g.is_zero(d[r * n + dependent[c]]);
+    let mut row_of_col: Vec<Option<usize>> = vec![None; m];
+    fn augment(
+        r: usize,
+        seen: &mut [bool],
+        row_of_col: &mut [Option<usize>],
+        m: usize,
+        nonzero: &dyn Fn(usize, usize) -> bool,
+    ) -> bool {
+        for c in 0..m {
+            if nonzero(r, c) && !seen[c] {
+                seen[c] = true;
+                if row_of_col[c].is_none_or(|r2| augment(r2, seen, row_of_col, m, nonzero)) {
+                    row_of_col[c] = Some(r);
+                    return true;
+                }
+            }
+        }
+        false
+    }
+    for r in 0..m {
+        let mut seen = vec![false; m];
+        augment(r, &mut seen, &mut row_of_col, m, &nonzero);
+    }
+    row_of_col.iter().position(|x| x.is_none())
+}
+
+/// The readable form of the derived equations.
+fn equations_text(d: &Derivation) -> String {
+    let g = &d.model.g;
+    let name = |i: usize| d.model.coords[i].0.to_string();
+    let show = |e: Id| -> String {
+        if g.dag_size(&[e]) > 400 {
+            format!(
+                "<expression of {} nodes; see the generated code>",
+                g.dag_size(&[e])
+            )
+        } else {
+            g.display(e).to_string()
+        }
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: Appell's equations (Wang & Pao 2003, eq. 56), reduced (eq. 42)",
+        d.model.name
+    );
+    let _ = writeln!(
+        s,
+        "coordinates q: {}",
+        (0..d.n).map(name).collect::<Vec<_>>().join(", ")
+    );
+    let speeds: Vec<String> = d
+        .model
+        .speeds
+        .iter()
+        .map(|&i| format!("{}_dot", name(i)))
+        .collect();
+    let _ = writeln!(s, "privileged speeds: {}", speeds.join(", "));
+    if !d.dependent.is_empty() {
+        let how = match d.elimination {
+            Elimination::Symbolic => "solved symbolically",
+            Elimination::Numeric(_) => {
+                "solved numerically at run time (no provably non-zero pivot)"
+            }
+        };
+        let _ = writeln!(s, "dependent speeds (q_dot = C y_dot + c, {how}):");
+        for &r in &d.dependent {
+            let mut terms = Vec::new();
+            for k in 0..d.l {
+                let c = d.c[r * d.l + k];
+                if !g.is_zero(c) {
+                    terms.push(format!("({}) * {}", show(c), speeds[k]));
+                }
+            }
+            if !g.is_zero(d.c0[r]) {
+                terms.push(show(d.c0[r]));
+            }
+            if terms.is_empty() {
+                terms.push("0".into());
+            }
+            let _ = writeln!(s, "  {}_dot = {}", name(r), terms.join(" + "));
+        }
+    }
+    let list = |v: &[usize]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ")
+        }
+    };
+    let _ = writeln!(s, "cyclic coordinates: {}", list(&d.cyclic));
+    let _ = writeln!(
+        s,
+        "ignorable coordinates (not integrated): {}",
+        list(&d.ignorable)
+    );
+    let mut state: Vec<String> = d.retained.iter().map(|&i| name(i)).collect();
+    state.extend(speeds.iter().cloned());
+    let _ = writeln!(s, "reduced state: ({})", state.join(", "));
+    let accels: Vec<String> = d
+        .model
+        .speeds
+        .iter()
+        .map(|&i| format!("{}_ddot", name(i)))
+        .collect();
+    let _ = writeln!(
+        s,
+        "M(q) y_ddot = f(q, y_dot, t) with y_ddot = ({}):",
+        accels.join(", ")
+    );
+    for k in 0..d.l {
+        for j in k..d.l {
+            let _ = writeln!(
+                s,
+                "  M[{}, {}] = {}",
+                speeds[k],
+                speeds[j],
+                show(d.mass[k * d.l + j])
+            );
+        }
+    }
+    for k in 0..d.l {
+        let _ = writeln!(s, "  f[{}] = {}", speeds[k], show(d.forcing[k]));
+    }
+    s
+}

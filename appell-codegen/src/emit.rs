@@ -1,0 +1,744 @@
+//! Stage 4: the `Model` implementation, as Rust text parsed into tokens.
+//!
+//! Every numeric function is one straight-line program lowered by the engine
+//! (shared subexpressions bound once), generic over the scalar `__T`. The
+//! reduced rhs reads parameter-only values from `Prepared`, computed once
+//! per parameter set, and solves Appell's equations by an unrolled LDLᵀ
+//! factorization. Paths go through `::appell::__private`; everything is
+//! wrapped in `const _: () = { ... };`.
+
+use std::fmt::Write;
+use std::str::FromStr;
+
+use appell_symbolic::{EmitOptions, Id, Program, RustCode};
+use proc_macro2::TokenStream;
+
+use crate::derivation::{Derivation, Elimination};
+
+const P: &str = "::appell::__private";
+
+fn options(hoist: bool) -> EmitOptions {
+    EmitOptions {
+        scalar: "__T".into(),
+        constant: format!("<__T as {P}::Scalar>::from_f64({{lit}})"),
+        cse: true,
+        hoist_parameters: hoist,
+        symbol_text: Default::default(),
+    }
+}
+
+fn f64_options() -> EmitOptions {
+    EmitOptions {
+        scalar: "f64".into(),
+        constant: "{lit}_f64".into(),
+        cse: true,
+        hoist_parameters: false,
+        symbol_text: Default::default(),
+    }
+}
+
+fn code(d: &Derivation, roots: &[Id], o: &EmitOptions) -> RustCode {
+    Program::lower(&d.model.g, roots).to_rust(&d.model.g, o)
+}
+
+/// Statements (prepare and body) of a code block, indented.
+fn statements(c: &RustCode) -> String {
+    let mut s = String::new();
+    for st in c.prepare.iter().chain(&c.body) {
+        let _ = writeln!(s, "        {st}");
+    }
+    s
+}
+
+struct Emitter<'a> {
+    d: &'a Derivation,
+}
+
+impl Emitter<'_> {
+    fn coord(&self, i: usize) -> String {
+        self.d.model.coords[i].0.to_string()
+    }
+
+    fn params_as(&self, scalar: bool) -> String {
+        let mut s = String::new();
+        for p in &self.d.model.params {
+            let f = &p.ident;
+            if scalar {
+                let _ = writeln!(
+                    s,
+                    "        let {f}: __T = <__T as {P}::Scalar>::from_f64(self.{f});"
+                );
+            } else {
+                let _ = writeln!(s, "        let {f}: f64 = self.{f};");
+            }
+        }
+        s
+    }
+
+    fn positivity(&self) -> String {
+        let mut s = String::new();
+        for p in self.d.model.params.iter().filter(|p| p.positive) {
+            let f = &p.ident;
+            let _ = writeln!(
+                s,
+                "        if !(self.{f} > 0.0) {{ return {P}::Err({P}::ModelError::NonPositiveParameter {{ name: \"{f}\", value: self.{f} }}); }}"
+            );
+        }
+        s
+    }
+
+    fn bind_q(&self, slice: &str) -> String {
+        let mut s = String::new();
+        for i in 0..self.d.n {
+            let _ = writeln!(s, "        let {} = {slice}[{i}];", self.coord(i));
+        }
+        s
+    }
+
+    fn bind_qdot(&self, slice: &str) -> String {
+        let mut s = String::new();
+        for i in 0..self.d.n {
+            let _ = writeln!(s, "        let {}_dot = {slice}[{i}];", self.coord(i));
+        }
+        s
+    }
+
+    fn bind_u(&self, slice: &str) -> String {
+        let mut s = String::new();
+        for (k, &i) in self.d.model.speeds.iter().enumerate() {
+            let _ = writeln!(s, "        let {}_dot = {slice}[{k}];", self.coord(i));
+        }
+        s
+    }
+
+    fn bind_inputs(&self, slice: &str) -> String {
+        let mut s = String::new();
+        for (k, (name, _)) in self.d.model.inputs.iter().enumerate() {
+            let _ = writeln!(s, "        let {name} = {slice}[{k}];");
+        }
+        s
+    }
+
+    fn check(&self, arg: &str, len: usize) -> String {
+        format!("        {P}::check_len(\"{arg}\", {arg}, {len})?;\n")
+    }
+
+    /// Numeric elimination: solve D' X = R (and D' Ẋ = R' when `rates`),
+    /// binding the auxiliary symbols. Returns the text and its op count.
+    fn elimination(&self, rates: bool) -> (String, usize) {
+        let Elimination::Numeric(ne) = &self.d.elimination else {
+            return (String::new(), 0);
+        };
+        let (m, l) = (self.d.m, self.d.l);
+        let mut s = String::new();
+        let mut ops = 0;
+        let mut stage =
+            |s: &mut String, rhs: &[Id], names: &[appell_symbolic::Symbol], tag: &str| {
+                let mut roots: Vec<Id> = ne.dp.clone();
+                roots.extend_from_slice(rhs);
+                let c = code(self.d, &roots, &options(false));
+                ops += c.ops.total() + m * m * m + m * m * (l + 1) * 2;
+                s.push_str("        {\n");
+                s.push_str(
+                    &statements(&c)
+                        .replace("\n        ", "\n            ")
+                        .replacen("        ", "            ", 1),
+                );
+                let rows: Vec<String> = (0..m)
+                    .map(|i| {
+                        format!(
+                            "[{}]",
+                            (0..m)
+                                .map(|j| c.outputs[i * m + j].clone())
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    })
+                    .collect();
+                let rrows: Vec<String> = (0..m)
+                    .map(|i| {
+                        format!(
+                            "[{}]",
+                            (0..=l)
+                                .map(|j| c.outputs[m * m + i * (l + 1) + j].clone())
+                                .collect::<Vec<_>>()
+                                .join(", ")
+                        )
+                    })
+                    .collect();
+                let _ = writeln!(
+                    s,
+                    "            let mut __a{tag}: [[__T; {m}]; {m}] = [{}];",
+                    rows.join(", ")
+                );
+                let _ = writeln!(
+                    s,
+                    "            let mut __b{tag}: [[__T; {}]; {m}] = [{}];",
+                    l + 1,
+                    rrows.join(", ")
+                );
+                let _ = writeln!(
+                    s,
+                    "            {P}::lu_solve(&mut __a{tag}, &mut __b{tag})?;"
+                );
+                let _ = writeln!(s, "            __x{tag} = __b{tag};");
+                s.push_str("        }\n");
+                let _ = names;
+            };
+        let _ = writeln!(s, "        let __x0: [[__T; {}]; {m}];", l + 1);
+        stage(&mut s, &ne.rhs, &ne.x, "0");
+        for i in 0..m {
+            for j in 0..=l {
+                let _ = writeln!(s, "        let __x_{i}_{j} = __x0[{i}][{j}];");
+            }
+        }
+        if rates {
+            let _ = writeln!(s, "        let __x1: [[__T; {}]; {m}];", l + 1);
+            stage(&mut s, &ne.rhs_rate, &ne.x_rate, "1");
+            for i in 0..m {
+                for j in 0..=l {
+                    let _ = writeln!(s, "        let __xd_{i}_{j} = __x1[{i}][{j}];");
+                }
+            }
+        }
+        (s, ops)
+    }
+
+    /// Unrolled LDLᵀ solve of M ÿ = f; `m` and `f` are expressions.
+    fn ldlt(&self, m: &[String], f: &[String]) -> (String, usize) {
+        let l = self.d.l;
+        let mut s = String::new();
+        let mut ops = 0;
+        for i in 0..l {
+            for j in 0..=i {
+                let _ = writeln!(s, "        let __m_{i}_{j} = {};", m[i * l + j]);
+            }
+            let _ = writeln!(s, "        let __f_{i} = {};", f[i]);
+        }
+        let diag: Vec<String> = (0..l)
+            .map(|i| format!("{P}::Scalar::re(__m_{i}_{i}).abs()"))
+            .collect();
+        let _ = writeln!(
+            s,
+            "        let __tol = 1e-13 * {};",
+            if l == 1 {
+                diag[0].clone()
+            } else {
+                format!(
+                    "[{}].iter().fold(0.0f64, |a, b| a.max(*b))",
+                    diag.join(", ")
+                )
+            }
+        );
+        for j in 0..l {
+            let mut e = format!("__m_{j}_{j}");
+            for k in 0..j {
+                e.push_str(&format!(" - __l_{j}_{k} * __l_{j}_{k} * __d_{k}"));
+                ops += 3;
+            }
+            let _ = writeln!(s, "        let __d_{j} = {e};");
+            let _ = writeln!(
+                s,
+                "        if !({P}::Scalar::re(__d_{j}) > __tol) {{ return {P}::Err({P}::ModelError::SingularMassMatrix {{ index: {j}, pivot: {P}::Scalar::re(__d_{j}) }}); }}"
+            );
+            for i in j + 1..l {
+                let mut e = format!("__m_{i}_{j}");
+                for k in 0..j {
+                    e.push_str(&format!(" - __l_{i}_{k} * __l_{j}_{k} * __d_{k}"));
+                    ops += 3;
+                }
+                let _ = writeln!(s, "        let __l_{i}_{j} = ({e}) / __d_{j};");
+                ops += 1;
+            }
+        }
+        for i in 0..l {
+            let mut e = format!("__f_{i}");
+            for k in 0..i {
+                e.push_str(&format!(" - __l_{i}_{k} * __z_{k}"));
+                ops += 2;
+            }
+            let _ = writeln!(s, "        let __z_{i} = {e};");
+        }
+        for i in 0..l {
+            let _ = writeln!(s, "        let __w_{i} = __z_{i} / __d_{i};");
+            ops += 1;
+        }
+        for i in (0..l).rev() {
+            let mut e = format!("__w_{i}");
+            for k in i + 1..l {
+                e.push_str(&format!(" - __l_{k}_{i} * __y_{k}"));
+                ops += 2;
+            }
+            let _ = writeln!(s, "        let __y_{i} = {e};");
+        }
+        (s, ops)
+    }
+
+    fn info(&self, rhs_ops: appell_symbolic::OpCount, extra_ops: usize) -> String {
+        let d = self.d;
+        let model = &d.model;
+        let list = |v: Vec<String>| {
+            format!(
+                "&[{}]",
+                v.iter()
+                    .map(|s| format!("{s:?}"))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            )
+        };
+        let coords = |idx: &[usize]| list(idx.iter().map(|&i| self.coord(i)).collect());
+        let bodies: Vec<String> = model
+            .bodies
+            .iter()
+            .map(|b| {
+                format!(
+                    "{P}::BodyInfo {{ name: {:?}, rigid: {} }}",
+                    b.name,
+                    b.frame.is_some()
+                )
+            })
+            .collect();
+        format!(
+            "{P}::ModelInfo {{
+            name: {name:?},
+            parameters: {params},
+            coordinates: {all},
+            speeds: {speeds},
+            dependent: {dependent},
+            cyclic: {cyclic},
+            ignorable: {ignorable},
+            retained: {retained},
+            inputs: {inputs},
+            effects: {effects},
+            holonomic: {holo},
+            constraints: {m},
+            bodies: &[{bodies}],
+            force_points: {nf},
+            torques: {nt},
+            symbolic_elimination: {symbolic},
+            rhs_ops: {P}::OpCounts {{ add: {add}, mul: {mul}, div: {div}, calls: {calls}, total: {total} }},
+            equations: {text:?},
+        }}",
+            name = model.name.to_string(),
+            params = list(model.params.iter().map(|p| p.ident.to_string()).collect()),
+            all = coords(&(0..d.n).collect::<Vec<_>>()),
+            speeds = coords(&model.speeds),
+            dependent = coords(&d.dependent),
+            cyclic = coords(&d.cyclic),
+            ignorable = coords(&d.ignorable),
+            retained = coords(&d.retained),
+            inputs = list(model.inputs.iter().map(|(i, _)| i.to_string()).collect()),
+            effects = list(model.effects.clone()),
+            holo = d.holonomic.len(),
+            m = d.m,
+            bodies = bodies.join(", "),
+            nf = model.forces.len(),
+            nt = model.torques.len(),
+            symbolic = matches!(d.elimination, Elimination::Symbolic),
+            add = rhs_ops.add,
+            mul = rhs_ops.mul,
+            div = rhs_ops.div,
+            calls = rhs_ops.calls,
+            total = rhs_ops.total() + extra_ops,
+            text = d.text,
+        )
+    }
+
+    fn emit(&self) -> String {
+        let d = self.d;
+        let model = &d.model;
+        let (n, m, l) = (d.n, d.m, d.l);
+        let name = &model.name;
+        let ni = model.inputs.len();
+        let np = model.params.len();
+        let ns = d.retained.len() + l;
+        let g = &model.g;
+        let qdot = &d.qdot;
+
+        // --- rhs: M, f and the retained coordinates' rates, hoisted. ---
+        let mut roots: Vec<Id> = Vec::new();
+        for i in 0..l {
+            for j in 0..=i {
+                roots.push(d.mass[i * l + j]);
+            }
+        }
+        roots.extend(&d.forcing);
+        for &r in &d.retained {
+            roots.push(qdot[r]);
+        }
+        let rhs = code(d, &roots, &options(true));
+        let h = rhs.hoisted.len();
+        let tri = l * (l + 1) / 2;
+        let mut m_text = vec![String::new(); l * l];
+        let mut idx = 0;
+        for i in 0..l {
+            for j in 0..=i {
+                m_text[i * l + j] = rhs.outputs[idx].clone();
+                idx += 1;
+            }
+        }
+        let f_text: Vec<String> = rhs.outputs[tri..tri + l].to_vec();
+        let (ldlt, ldlt_ops) = self.ldlt(&m_text, &f_text);
+        let (elim_rhs, elim_ops) = self.elimination(true);
+        let mut bind_state = String::new();
+        for (k, &r) in d.retained.iter().enumerate() {
+            let _ = writeln!(bind_state, "        let {} = __state[{k}];", self.coord(r));
+        }
+        for (k, &i) in model.speeds.iter().enumerate() {
+            let _ = writeln!(
+                bind_state,
+                "        let {}_dot = __state[{}];",
+                self.coord(i),
+                d.retained.len() + k
+            );
+        }
+        let mut write_out = String::new();
+        for (k, _) in d.retained.iter().enumerate() {
+            let _ = writeln!(
+                write_out,
+                "        __dstate[{k}] = {};",
+                rhs.outputs[tri + l + k]
+            );
+        }
+        for k in 0..l {
+            let _ = writeln!(
+                write_out,
+                "        __dstate[{}] = __y_{k};",
+                d.retained.len() + k
+            );
+        }
+        let mut prepare = String::new();
+        for st in &rhs.prepare {
+            let _ = writeln!(prepare, "        {st}");
+        }
+        let hoisted_list = rhs.hoisted.join(", ");
+        let info = self.info(rhs.ops, ldlt_ops + elim_ops);
+
+        // --- mass matrix and forcing ---
+        let mut mf_roots = d.mass.clone();
+        mf_roots.extend(&d.forcing);
+        let mf = code(d, &mf_roots, &options(false));
+        let (elim_full, _) = self.elimination(true);
+        let (elim_pos, _) = self.elimination(false);
+
+        // --- speed transform, coordinate rates, kinetic energy ---
+        let mut ct_roots = d.c.clone();
+        ct_roots.extend(&d.c0);
+        let ct = code(d, &ct_roots, &options(false));
+        let cr = code(d, qdot, &options(false));
+        let ke = code(d, &[d.kinetic], &options(false));
+
+        // --- constraint residuals: holonomic f(q,t), rows D q̇ + d ---
+        let mut res_roots = d.holonomic.clone();
+        res_roots.extend(&d.velocity_residuals);
+        let res = code(d, &res_roots, &options(false));
+
+        // --- kinematic description for the oracle ---
+        let mut mp_roots = Vec::new();
+        for b in &model.bodies {
+            mp_roots.push(b.mass);
+            for row in &b.inertia {
+                mp_roots.extend(row);
+            }
+        }
+        let mp = code(d, &mp_roots, &f64_options());
+        let zero = g
+            .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ZERO))
+            .expect("zero exists");
+        let one = g
+            .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ONE))
+            .expect("one exists");
+        let identity = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
+        let mut pose_roots = Vec::new();
+        for b in &model.bodies {
+            pose_roots.extend(b.center);
+            let r = b.frame.map(|f| model.frames[f].rot).unwrap_or(identity);
+            for row in &r {
+                pose_roots.extend(row);
+            }
+        }
+        let poses = code(d, &pose_roots, &options(false));
+        let mut rows_roots = d.d_rows.clone();
+        rows_roots.extend(&d.d0);
+        let rows = code(d, &rows_roots, &options(false));
+        let mut geo_roots = Vec::new();
+        for f in &model.forces {
+            geo_roots.extend(f.point);
+        }
+        for t in &model.torques {
+            for row in &model.frames[t.frame].rot {
+                geo_roots.extend(row);
+            }
+        }
+        let geo = code(d, &geo_roots, &options(false));
+        let mut load_roots = Vec::new();
+        for f in &model.forces {
+            load_roots.extend(f.vector);
+        }
+        for t in &model.torques {
+            load_roots.extend(t.vector);
+        }
+        let loads = code(d, &load_roots, &options(false));
+
+        let outputs_into = |c: &RustCode, target: &str| -> String {
+            let mut s = String::new();
+            for (i, o) in c.outputs.iter().enumerate() {
+                let _ = writeln!(s, "        {target}[{i}] = {o};");
+            }
+            s
+        };
+        let triples_into =
+            |c: &RustCode, target: &str, offset: usize, count: usize, width: usize| -> String {
+                let mut s = String::new();
+                for k in 0..count {
+                    let items: Vec<String> = (0..width)
+                        .map(|i| c.outputs[offset + k * width + i].clone())
+                        .collect();
+                    let _ = writeln!(s, "        {target}[{k}] = [{}];", items.join(", "));
+                }
+                s
+            };
+        let nb = model.bodies.len();
+        let mut poses_out = String::new();
+        for k in 0..nb {
+            let p: Vec<String> = (0..3).map(|i| poses.outputs[k * 12 + i].clone()).collect();
+            let r: Vec<String> = (0..9)
+                .map(|i| poses.outputs[k * 12 + 3 + i].clone())
+                .collect();
+            let _ = writeln!(poses_out, "        __positions[{k}] = [{}];", p.join(", "));
+            let _ = writeln!(poses_out, "        __rotations[{k}] = [{}];", r.join(", "));
+        }
+        let mut mp_out = String::new();
+        for k in 0..nb {
+            let _ = writeln!(mp_out, "        __masses[{k}] = {};", mp.outputs[k * 10]);
+            let r: Vec<String> = (1..10).map(|i| mp.outputs[k * 10 + i].clone()).collect();
+            let _ = writeln!(mp_out, "        __inertias[{k}] = [{}];", r.join(", "));
+        }
+        let nf = model.forces.len();
+        let nt = model.torques.len();
+        let mut set_param = String::new();
+        let mut get_param = String::new();
+        for (k, p) in model.params.iter().enumerate() {
+            let f = &p.ident;
+            let _ = writeln!(
+                set_param,
+                "            \"{f}\" => {{ self.{f} = __value; true }}"
+            );
+            let _ = writeln!(get_param, "        __out[{k}] = self.{f};");
+        }
+        let params_t = self.params_as(true);
+        let params_f = self.params_as(false);
+        let pos = self.positivity();
+        let finite = (0..ns)
+            .map(|k| format!("{P}::Scalar::re(__dstate[{k}]).is_finite()"))
+            .collect::<Vec<_>>()
+            .join(" && ");
+        let finite = if ns == 0 { "true".to_string() } else { finite };
+
+        format!(
+            r#"
+const _: () = {{
+    #[allow(unused_imports)]
+    use {P}::Scalar as _;
+    static __INFO: {P}::ModelInfo = {info};
+    #[automatically_derived]
+    #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
+    impl {P}::Model for {name} {{
+    type Prepared<__T: {P}::Scalar> = [__T; {h}];
+    fn info() -> &'static {P}::ModelInfo {{ &__INFO }}
+    fn parameter_values(&self, __out: &mut [f64]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_out}{get_param}        {P}::Ok(())
+    }}
+    fn set_parameter(&mut self, __name: &str, __value: f64) -> bool {{
+        match __name {{
+{set_param}            _ => false,
+        }}
+    }}
+    fn prepare<__T: {P}::Scalar>(&self) -> [__T; {h}] {{
+{params_t}{prepare}        [{hoisted_list}]
+    }}
+    fn rhs<__T: {P}::Scalar>(&self, __prepared: &[__T; {h}], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_state}{chk_inputs}{chk_dstate}{pos}        let [{hoisted_list}] = *__prepared;
+{params_t}{bind_state}{bind_inputs}{elim_rhs}{rhs_body}{ldlt}{write_out}        if !({finite}) {{ return {P}::Err({P}::ModelError::NonFinite {{ what: "the state derivative" }}); }}
+        {P}::Ok(())
+    }}
+    fn mass_matrix_and_forcing<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_u}{chk_inputs}{chk_m}{chk_f}{pos}{params_t}{bind_q}{bind_u}{bind_inputs}{elim_full}{mf_body}{mf_out}        {P}::Ok(())
+    }}
+    fn speed_transform<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_c}{chk_c0}{pos}{params_t}{bind_q}{elim_pos}{ct_body}{ct_out}        {P}::Ok(())
+    }}
+    fn coordinate_rates<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_u}{chk_qdot}{pos}{params_t}{bind_q}{bind_u}{elim_pos}{cr_body}{cr_out}        {P}::Ok(())
+    }}
+    fn constraint_residuals<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_qdot_in}{chk_hol}{chk_vel}{params_t}{bind_q}{bind_qdot}{res_body}{res_out}        {P}::Ok(())
+    }}
+    fn kinetic_energy<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{
+{chk_q}{chk_u}{pos}{params_t}{bind_q}{bind_u}{elim_pos}{ke_body}        {P}::Ok({ke_out})
+    }}
+    fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_masses}{chk_inertias}{params_f}{mp_body}{mp_out}        {P}::Ok(())
+    }}
+    fn body_poses<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __positions: &mut [[__T; 3]], __rotations: &mut [[__T; 9]]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_positions}{chk_rotations}{params_t}{bind_q}{poses_body}{poses_out}        {P}::Ok(())
+    }}
+    fn constraint_rows<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_d}{chk_d0}{params_t}{bind_q}{rows_body}{rows_out}        {P}::Ok(())
+    }}
+    fn load_geometry<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __frames: &mut [[__T; 9]]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_points}{chk_frames}{params_t}{bind_q}{geo_body}{geo_points}{geo_frames}        {P}::Ok(())
+    }}
+    fn load_values<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __inputs: &[__T], __forces: &mut [[__T; 3]], __torques: &mut [[__T; 3]]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_qdot_in}{chk_inputs}{chk_forces}{chk_torques}{params_t}{bind_q}{bind_qdot}{bind_inputs}{loads_body}{loads_forces}{loads_torques}        {P}::Ok(())
+    }}
+    }}
+}};
+"#,
+            chk_out = self.check("__out", np),
+            chk_state = self.check("__state", ns),
+            chk_inputs = self.check("__inputs", ni),
+            chk_dstate = self.check("__dstate", ns),
+            chk_q = self.check("__q", n),
+            chk_u = self.check("__u", l),
+            chk_m = self.check("__m", l * l),
+            chk_f = self.check("__f", l),
+            chk_c = self.check("__c", n * l),
+            chk_c0 = self.check("__c0", n),
+            chk_qdot = self.check("__qdot", n),
+            chk_qdot_in = self.check("__qdot", n),
+            chk_hol = self.check("__holonomic", d.holonomic.len()),
+            chk_vel = self.check("__velocity", m),
+            chk_masses = self.check("__masses", nb),
+            chk_inertias = self.check("__inertias", nb),
+            chk_positions = self.check("__positions", nb),
+            chk_rotations = self.check("__rotations", nb),
+            chk_d = self.check("__d", m * n),
+            chk_d0 = self.check("__d0", m),
+            chk_points = self.check("__points", nf),
+            chk_frames = self.check("__frames", nt),
+            chk_forces = self.check("__forces", nf),
+            chk_torques = self.check("__torques", nt),
+            bind_inputs = self.bind_inputs("__inputs"),
+            bind_q = self.bind_q("__q"),
+            bind_u = self.bind_u("__u"),
+            bind_qdot = self.bind_qdot("__qdot"),
+            rhs_body = {
+                let mut s = String::new();
+                for st in &rhs.body {
+                    let _ = writeln!(s, "        {st}");
+                }
+                s
+            },
+            mf_body = statements(&mf),
+            mf_out = {
+                let mut s = outputs_into(
+                    &RustCode {
+                        outputs: mf.outputs[..l * l].to_vec(),
+                        ..mf.clone()
+                    },
+                    "__m",
+                );
+                for k in 0..l {
+                    let _ = writeln!(s, "        __f[{k}] = {};", mf.outputs[l * l + k]);
+                }
+                s
+            },
+            ct_body = statements(&ct),
+            ct_out = {
+                let mut s = String::new();
+                for i in 0..n * l {
+                    let _ = writeln!(s, "        __c[{i}] = {};", ct.outputs[i]);
+                }
+                for i in 0..n {
+                    let _ = writeln!(s, "        __c0[{i}] = {};", ct.outputs[n * l + i]);
+                }
+                s
+            },
+            cr_body = statements(&cr),
+            cr_out = outputs_into(&cr, "__qdot"),
+            res_body = statements(&res),
+            res_out = {
+                let mut s = String::new();
+                let nh = d.holonomic.len();
+                for i in 0..nh {
+                    let _ = writeln!(s, "        __holonomic[{i}] = {};", res.outputs[i]);
+                }
+                for i in 0..m {
+                    let _ = writeln!(s, "        __velocity[{i}] = {};", res.outputs[nh + i]);
+                }
+                s
+            },
+            ke_body = statements(&ke),
+            ke_out = ke.outputs[0],
+            mp_body = statements(&mp),
+            poses_body = statements(&poses),
+            rows_body = statements(&rows),
+            rows_out = {
+                let mut s = String::new();
+                for i in 0..m * n {
+                    let _ = writeln!(s, "        __d[{i}] = {};", rows.outputs[i]);
+                }
+                for i in 0..m {
+                    let _ = writeln!(s, "        __d0[{i}] = {};", rows.outputs[m * n + i]);
+                }
+                s
+            },
+            geo_body = statements(&geo),
+            geo_points = triples_into(&geo, "__points", 0, nf, 3),
+            geo_frames = triples_into(&geo, "__frames", nf * 3, nt, 9),
+            loads_body = statements(&loads),
+            loads_forces = triples_into(&loads, "__forces", 0, nf, 3),
+            loads_torques = triples_into(&loads, "__torques", nf * 3, nt, 3),
+        )
+    }
+}
+
+/// The `Model` implementation for a derived model.
+pub fn emit(d: &Derivation) -> TokenStream {
+    let text = Emitter { d }.emit();
+    match TokenStream::from_str(&text) {
+        Ok(t) => t,
+        Err(e) => {
+            let msg = format!("appell internal error: generated code does not parse ({e})");
+            quote::quote!(compile_error!(#msg);)
+        }
+    }
+}
+
+/// A stub implementation emitted beside errors, so the user sees only the
+/// real ones (thiserror's fallback).
+pub fn stub(name: &syn::Ident) -> TokenStream {
+    let text = format!(
+        r#"
+const _: () = {{
+    static __INFO: {P}::ModelInfo = {P}::ModelInfo {{
+        name: "{name}", parameters: &[], coordinates: &[], speeds: &[], dependent: &[], cyclic: &[],
+        ignorable: &[], retained: &[], inputs: &[], effects: &[], holonomic: 0, constraints: 0,
+        bodies: &[], force_points: 0, torques: 0, symbolic_elimination: true,
+        rhs_ops: {P}::OpCounts {{ add: 0, mul: 0, div: 0, calls: 0, total: 0 }}, equations: "",
+    }};
+    #[allow(unused_variables, clippy::all)]
+    impl {P}::Model for {name} {{
+        type Prepared<__T: {P}::Scalar> = [__T; 0];
+        fn info() -> &'static {P}::ModelInfo {{ &__INFO }}
+        fn parameter_values(&self, __out: &mut [f64]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn set_parameter(&mut self, __name: &str, __value: f64) -> bool {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn prepare<__T: {P}::Scalar>(&self) -> [__T; 0] {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn rhs<__T: {P}::Scalar>(&self, __p: &[__T; 0], t: __T, __s: &[__T], __i: &[__T], __d: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn mass_matrix_and_forcing<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __i: &[__T], __m: &mut [__T], __f: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn speed_transform<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn coordinate_rates<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qd: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn constraint_residuals<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __qd: &[__T], __h: &mut [__T], __v: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn kinetic_energy<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn mass_properties(&self, __m: &mut [f64], __i: &mut [[f64; 9]]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn body_poses<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __p: &mut [[__T; 3]], __r: &mut [[__T; 9]]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn constraint_rows<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn load_geometry<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __p: &mut [[__T; 3]], __f: &mut [[__T; 9]]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+        fn load_values<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __qd: &[__T], __i: &[__T], __f: &mut [[__T; 3]], __t: &mut [[__T; 3]]) -> {P}::Result<(), {P}::ModelError> {{ ::core::panic!("the model failed to derive; see the compile errors") }}
+    }}
+}};
+"#
+    );
+    TokenStream::from_str(&text).unwrap_or_default()
+}

@@ -1,0 +1,45 @@
+//! # appell-codegen
+//!
+//! Everything `#[derive(Appell)]` does, as a plain library so each stage can
+//! be tested on its own:
+//!
+//! 1. [`parse`]: `#[appell(...)]` attributes → [`ast::ModelAst`] (syntax only);
+//! 2. [`model`]: names resolved, kinematics built in the symbolic engine;
+//! 3. [`derivation`]: D, C_rk, partial velocities, Appell's equations, cyclic
+//!    coordinates (Wang & Pao 2003, Secs. III B-C, IV B);
+//! 4. [`emit`]: the `Model` implementation as tokens.
+//!
+//! Errors are collected with spans ([`ctxt::Ctxt`]) and reported together;
+//! on error a stub implementation is emitted beside `compile_error!` so the
+//! user sees only the real errors.
+#![warn(missing_docs)]
+
+pub mod ast;
+pub mod ctxt;
+pub mod derivation;
+pub mod emit;
+pub mod model;
+pub mod parse;
+
+use proc_macro2::TokenStream;
+
+/// Expands `#[derive(Appell)]` on `input`.
+pub fn expand(input: &syn::DeriveInput) -> TokenStream {
+    let cx = ctxt::Ctxt::new();
+    let ast = parse::parse(&cx, input);
+    let model = if cx.has_errors() {
+        None
+    } else {
+        model::build(&cx, &ast)
+    };
+    let derived = model.and_then(|m| derivation::derive(&cx, m));
+    let tokens = derived.map(|d| emit::emit(&d));
+    match cx.check() {
+        Ok(()) => tokens.expect("no errors means a derivation"),
+        Err(err) => {
+            let mut out = err.to_compile_error();
+            out.extend(emit::stub(&input.ident));
+            out
+        }
+    }
+}

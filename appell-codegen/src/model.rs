@@ -1,0 +1,958 @@
+//! Stage 2: resolve names and build the kinematics in the symbolic engine.
+//!
+//! Frames carry their rotation matrix (columns are the frame's unit vectors
+//! in N components) and angular velocity in N; points carry their position
+//! in N. Everything is an expression in the coordinates, parameters, inputs
+//! and time of one [`Graph`].
+
+use proc_macro2::Span;
+use syn::Ident;
+
+use appell_symbolic::{
+    Coordinate, Graph, Id, Number, RateRules, Symbol, SymbolKind, SymbolicError,
+};
+
+use crate::ast::*;
+use crate::ctxt::{did_you_mean, Ctxt};
+
+/// A vector in N components.
+pub type Vec3 = [Id; 3];
+/// A 3×3 matrix, row-major.
+pub type Mat3 = [[Id; 3]; 3];
+
+/// A parameter (struct field).
+pub struct Param {
+    /// The field.
+    pub ident: Ident,
+    /// Its symbol.
+    pub symbol: Symbol,
+    /// Declared positive.
+    pub positive: bool,
+}
+
+/// A frame: rotation (columns = unit vectors in N) and angular velocity in N.
+pub struct Frame {
+    /// Its name.
+    pub name: String,
+    /// Rotation matrix.
+    pub rot: Mat3,
+    /// Angular velocity, as an expression in the coordinate rates.
+    pub omega: Vec3,
+}
+
+/// A named point and its position in N.
+pub struct Point {
+    /// Its name.
+    pub name: String,
+    /// Position.
+    pub pos: Vec3,
+}
+
+/// A body or particle.
+pub struct Body {
+    /// Its name.
+    pub name: String,
+    /// Mass-centre position.
+    pub center: Vec3,
+    /// Index of its frame (None for a particle).
+    pub frame: Option<usize>,
+    /// Mass.
+    pub mass: Id,
+    /// Central inertia in the body frame (zero for a particle).
+    pub inertia: Mat3,
+}
+
+/// A force at a point or a torque on a frame.
+pub struct Load {
+    /// Application point's position (forces).
+    pub point: Vec3,
+    /// The frame (torques).
+    pub frame: usize,
+    /// The vector in N.
+    pub vector: Vec3,
+    /// Effect name.
+    pub effect: String,
+}
+
+/// A constraint residual with its source span.
+pub struct Constraint {
+    /// `lhs - rhs`.
+    pub residual: Id,
+    /// Where it was written.
+    pub span: Span,
+}
+
+/// The resolved model.
+pub struct Model {
+    /// The expression graph everything lives in.
+    pub g: Graph,
+    /// The struct's name.
+    pub name: Ident,
+    /// Parameters in field order.
+    pub params: Vec<Param>,
+    /// Coordinates in declaration order.
+    pub coords: Vec<(Ident, Coordinate)>,
+    /// Indices (into `coords`) of the privileged speeds, in order.
+    pub speeds: Vec<usize>,
+    /// The span of `speeds(...)`.
+    pub speeds_span: Span,
+    /// Inputs.
+    pub inputs: Vec<(Ident, Symbol)>,
+    /// Time.
+    pub time: Symbol,
+    /// Frames; index 0 is N.
+    pub frames: Vec<Frame>,
+    /// Points; index 0 is O.
+    pub points: Vec<Point>,
+    /// Bodies and particles.
+    pub bodies: Vec<Body>,
+    /// Holonomic constraints f(q, t) = 0.
+    pub holonomic: Vec<Constraint>,
+    /// Nonholonomic constraints, linear in the rates.
+    pub nonholonomic: Vec<Constraint>,
+    /// Forces.
+    pub forces: Vec<Load>,
+    /// Torques.
+    pub torques: Vec<Load>,
+    /// Effect names in order of first use.
+    pub effects: Vec<String>,
+}
+
+#[derive(Clone, Copy)]
+enum Val {
+    Scalar(Id),
+    Vector(Vec3),
+    Point(Vec3),
+}
+
+struct Builder<'a> {
+    cx: &'a Ctxt,
+    g: Graph,
+    params: Vec<Param>,
+    coords: Vec<(Ident, Coordinate)>,
+    inputs: Vec<(Ident, Symbol)>,
+    time: Symbol,
+    frames: Vec<Frame>,
+    points: Vec<Point>,
+}
+
+fn engine_error(cx: &Ctxt, span: Span, e: SymbolicError) {
+    cx.error_at(span, e);
+}
+
+/// Resolves names and builds kinematics; `None` when errors were recorded.
+pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
+    let mut g = Graph::new();
+    let time = g.time().expect("fresh graph");
+    let mut b = Builder {
+        cx,
+        g,
+        params: Vec::new(),
+        coords: Vec::new(),
+        inputs: Vec::new(),
+        time,
+        frames: Vec::new(),
+        points: Vec::new(),
+    };
+    b.declare_symbols(ast);
+    let zero = b.g.int(0).ok()?;
+    let one = b.g.int(1).ok()?;
+    b.frames.push(Frame {
+        name: "N".into(),
+        rot: [[one, zero, zero], [zero, one, zero], [zero, zero, one]],
+        omega: [zero; 3],
+    });
+    b.points.push(Point {
+        name: "O".into(),
+        pos: [zero; 3],
+    });
+    for f in &ast.frames {
+        b.add_frame(f);
+    }
+    for p in &ast.points {
+        b.add_point(p);
+    }
+    let bodies: Vec<Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
+    let holonomic = ast
+        .holonomic
+        .iter()
+        .filter_map(|c| b.constraint(c))
+        .collect();
+    let nonholonomic = ast
+        .nonholonomic
+        .iter()
+        .filter_map(|c| b.constraint(c))
+        .collect();
+    let mut effects = Vec::new();
+    let mut forces = Vec::new();
+    let mut torques = Vec::new();
+    if let Some(gvec) = &ast.gravity {
+        if let Some(v) = b.vector(gvec) {
+            for body in &bodies {
+                let f = b.scale3(v, body.mass);
+                if let Some(f) = f {
+                    forces.push(Load {
+                        point: body.center,
+                        frame: 0,
+                        vector: f,
+                        effect: "gravity".into(),
+                    });
+                }
+            }
+            effects.push("gravity".to_string());
+        }
+    }
+    for l in &ast.forces {
+        let Some(p) = b.point_named(&l.target) else {
+            continue;
+        };
+        let Some(v) = b.vector(&l.vector) else {
+            continue;
+        };
+        let effect = l.effect.to_string();
+        if !effects.contains(&effect) {
+            effects.push(effect.clone());
+        }
+        forces.push(Load {
+            point: p,
+            frame: 0,
+            vector: v,
+            effect,
+        });
+    }
+    for l in &ast.torques {
+        let Some(fi) = b.frame_named(&l.target) else {
+            continue;
+        };
+        let Some(v) = b.vector(&l.vector) else {
+            continue;
+        };
+        let effect = l.effect.to_string();
+        if !effects.contains(&effect) {
+            effects.push(effect.clone());
+        }
+        torques.push(Load {
+            point: [zero; 3],
+            frame: fi,
+            vector: v,
+            effect,
+        });
+    }
+    let (speeds, speeds_span) = b.speeds(ast);
+    if bodies.is_empty() && !cx.has_errors() {
+        cx.error_at(
+            ast.name.span(),
+            "the model has no `body(...)` or `particle(...)`: there is nothing to move",
+        );
+    }
+    if cx.has_errors() {
+        return None;
+    }
+    Some(Model {
+        g: b.g,
+        name: ast.name.clone(),
+        params: b.params,
+        coords: b.coords,
+        speeds,
+        speeds_span,
+        inputs: b.inputs,
+        time: b.time,
+        frames: b.frames,
+        points: b.points,
+        bodies,
+        holonomic,
+        nonholonomic,
+        forces,
+        torques,
+        effects,
+    })
+}
+
+const RESERVED: &[&str] = &["N", "O", "t"];
+
+impl Builder<'_> {
+    fn declare_symbols(&mut self, ast: &ModelAst) {
+        let mut seen: Vec<(String, &'static str)> = Vec::new();
+        let mut check = |cx: &Ctxt, ident: &Ident, what: &'static str| -> bool {
+            let name = ident.to_string();
+            if RESERVED.contains(&name.as_str()) {
+                cx.error_spanned_by(
+                    ident,
+                    format!(
+                        "`{name}` is reserved (N is the Newtonian frame, O its origin, t time)"
+                    ),
+                );
+                return false;
+            }
+            if name.ends_with("_dot") || name.ends_with("_ddot") {
+                cx.error_spanned_by(
+                    ident,
+                    format!("`{name}`: names ending in `_dot` or `_ddot` are reserved for rates"),
+                );
+                return false;
+            }
+            if let Some((_, other)) = seen.iter().find(|(n, _)| *n == name) {
+                if *other == what {
+                    cx.error_spanned_by(ident, format!("duplicate {what} `{name}`"));
+                } else {
+                    cx.error_spanned_by(ident, format!("`{name}` is already a {other}"));
+                }
+                return false;
+            }
+            seen.push((name, what));
+            true
+        };
+        for (f, _) in &ast.fields {
+            if check(self.cx, f, "parameter") {
+                let s = self.g.parameter(&f.to_string()).expect("fresh name");
+                let positive = ast.positive.iter().any(|p| p == f);
+                self.params.push(Param {
+                    ident: f.clone(),
+                    symbol: s,
+                    positive,
+                });
+            }
+        }
+        for p in &ast.positive {
+            if !ast.fields.iter().any(|(f, _)| f == p) {
+                let hint = hint(
+                    &p.to_string(),
+                    ast.fields.iter().map(|(f, _)| f.to_string()),
+                );
+                self.cx.error_spanned_by(
+                    p,
+                    format!("`positive` names a parameter, and `{p}` is not one{hint}"),
+                );
+            }
+        }
+        if ast.coordinates.is_empty() {
+            self.cx
+                .error_at(ast.name.span(), "the model declares no `coordinates(...)`");
+        }
+        for c in &ast.coordinates {
+            if check(self.cx, c, "coordinate") {
+                let coord = self.g.coordinate(&c.to_string()).expect("fresh name");
+                self.coords.push((c.clone(), coord));
+            }
+        }
+        for i in &ast.inputs {
+            if check(self.cx, i, "input") {
+                let s = self.g.input(&i.to_string()).expect("fresh name");
+                self.inputs.push((i.clone(), s));
+            }
+        }
+        for f in &ast.frames {
+            if check(self.cx, &f.name, "frame") {}
+        }
+        for p in &ast.points {
+            if check(self.cx, &p.name, "point") {}
+        }
+    }
+
+    fn speeds(&mut self, ast: &ModelAst) -> (Vec<usize>, Span) {
+        let Some((list, span)) = &ast.speeds else {
+            self.cx.error_at(ast.name.span(), "the model declares no `speeds(...)`: name the coordinates whose rates are independent");
+            return (Vec::new(), ast.name.span());
+        };
+        let mut out = Vec::new();
+        for s in list {
+            match self.coords.iter().position(|(c, _)| c == s) {
+                Some(i) if out.contains(&i) => self
+                    .cx
+                    .error_spanned_by(s, format!("duplicate speed `{s}`")),
+                Some(i) => out.push(i),
+                None => {
+                    let h = hint(
+                        &s.to_string(),
+                        self.coords.iter().map(|(c, _)| c.to_string()),
+                    );
+                    self.cx.error_spanned_by(s, format!("`{s}` is not a coordinate; speeds name the coordinates whose rates are independent{h}"));
+                }
+            }
+        }
+        (out, *span)
+    }
+
+    fn all_names(&self) -> Vec<String> {
+        let mut v: Vec<String> = self.params.iter().map(|p| p.ident.to_string()).collect();
+        v.extend(self.coords.iter().map(|(c, _)| c.to_string()));
+        v.extend(self.inputs.iter().map(|(c, _)| c.to_string()));
+        v.extend(self.points.iter().map(|p| p.name.clone()));
+        v.push("t".into());
+        v
+    }
+
+    fn frame_named(&self, ident: &Ident) -> Option<usize> {
+        let name = ident.to_string();
+        if let Some(i) = self.frames.iter().position(|f| f.name == name) {
+            return Some(i);
+        }
+        let h = hint(&name, self.frames.iter().map(|f| f.name.clone()));
+        self.cx
+            .error_spanned_by(ident, format!("unknown frame `{name}`{h}"));
+        None
+    }
+
+    fn point_named(&self, ident: &Ident) -> Option<Vec3> {
+        let name = ident.to_string();
+        if let Some(p) = self.points.iter().find(|p| p.name == name) {
+            return Some(p.pos);
+        }
+        let h = hint(&name, self.points.iter().map(|p| p.name.clone()));
+        self.cx
+            .error_spanned_by(ident, format!("unknown point `{name}`{h}"));
+        None
+    }
+
+    fn add_frame(&mut self, f: &FrameDef) {
+        let Some(pi) = self.frame_named(&f.parent) else {
+            return;
+        };
+        let Some(angle) = self.scalar(&f.angle) else {
+            return;
+        };
+        let parent_rot = self.frames[pi].rot;
+        let parent_omega = self.frames[pi].omega;
+        let result = match &f.axis {
+            RotationAxis::Parent(k) => {
+                self.parent_axis_rotation(*k, angle, parent_rot, parent_omega)
+            }
+            RotationAxis::Vector(v) => {
+                let Some(u) = self.vector(v) else { return };
+                self.axis_rotation(u, angle, parent_rot, parent_omega)
+            }
+        };
+        match result {
+            Ok((rot, omega)) => self.frames.push(Frame {
+                name: f.name.to_string(),
+                rot,
+                omega,
+            }),
+            Err(e) => engine_error(self.cx, f.angle.span(), e),
+        }
+    }
+
+    /// Rotation about the parent's axis `k`: R = R_parent Rk(θ),
+    /// ω = ω_parent + θ̇ (parent axis k).
+    fn parent_axis_rotation(
+        &mut self,
+        k: usize,
+        angle: Id,
+        parent_rot: Mat3,
+        parent_omega: Vec3,
+    ) -> Result<(Mat3, Vec3), SymbolicError> {
+        let g = &mut self.g;
+        let rate = g.time_derivative(angle, &RateRules::coordinates())?;
+        let c = g.cos(angle)?;
+        let s = g.sin(angle)?;
+        let local = simple_rotation(g, k, c, s)?;
+        let rot = mat_mul(g, &parent_rot, &local)?;
+        let mut omega = parent_omega;
+        for i in 0..3 {
+            let t = g.mul(rate, parent_rot[i][k])?;
+            omega[i] = g.add(omega[i], t)?;
+        }
+        Ok((rot, omega))
+    }
+
+    /// Rotation by `angle` about the unit vector of `u` (N components, fixed
+    /// in the parent): R = Rot(û, θ) R_parent (Rodrigues), ω = ω_parent + θ̇ û.
+    fn axis_rotation(
+        &mut self,
+        u: Vec3,
+        angle: Id,
+        parent_rot: Mat3,
+        parent_omega: Vec3,
+    ) -> Result<(Mat3, Vec3), SymbolicError> {
+        let g = &mut self.g;
+        let n2 = dot(g, u, u)?;
+        if g.is_zero(n2) {
+            return Err(SymbolicError::DivisionByZero {
+                expr: "a zero-length rotation axis".into(),
+            });
+        }
+        let n = g.sqrt(n2)?;
+        let mut uh = [u[0]; 3];
+        for i in 0..3 {
+            uh[i] = g.div(u[i], n)?;
+        }
+        let c = g.cos(angle)?;
+        let s = g.sin(angle)?;
+        let one = g.int(1)?;
+        let omc = g.sub(one, c)?;
+        let mut r = [[one; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                let uu = g.mul(uh[i], uh[j])?;
+                let mut e = g.mul(omc, uu)?;
+                if i == j {
+                    e = g.add(e, c)?;
+                }
+                // [û]× entries: (i, j) = −ε_ijk û_k
+                let k = 3 - i - j;
+                if i != j {
+                    let sign = if (i + 1) % 3 == j { -1 } else { 1 };
+                    let t = g.mul(s, uh[k])?;
+                    let t = g.scale(t, Number::int(sign))?;
+                    e = g.add(e, t)?;
+                }
+                r[i][j] = e;
+            }
+        }
+        let rot = mat_mul(g, &r, &parent_rot)?;
+        let rate = g.time_derivative(angle, &RateRules::coordinates())?;
+        let mut omega = parent_omega;
+        for i in 0..3 {
+            let t = g.mul(rate, uh[i])?;
+            omega[i] = g.add(omega[i], t)?;
+        }
+        Ok((rot, omega))
+    }
+
+    fn add_point(&mut self, p: &PointDef) {
+        match self.eval(&p.location) {
+            Some(Val::Point(pos)) => self.points.push(Point {
+                name: p.name.to_string(),
+                pos,
+            }),
+            Some(_) => self.cx.error_at(
+                p.location.span(),
+                "a point is located from another point: `P = O + vector` or `P = Q + vector`",
+            ),
+            None => {}
+        }
+    }
+
+    fn add_body(&mut self, d: &BodyDef) -> Option<Body> {
+        let center = self.point_named(&d.center);
+        let frame = match &d.frame {
+            Some(f) => Some(self.frame_named(f)?),
+            None => None,
+        };
+        let mass = self.scalar(&d.mass);
+        if let Some(m) = mass {
+            if self.g.is_zero(m) {
+                self.cx
+                    .error_at(d.mass.span(), format!("`{}` has zero mass", d.name));
+            }
+        }
+        let zero = self.g.int(0).ok()?;
+        let mut inertia = [[zero; 3]; 3];
+        match &d.inertia {
+            Some(Inertia::Principal(m)) => {
+                for (i, e) in m.iter().enumerate() {
+                    inertia[i][i] = self.scalar(e)?;
+                }
+            }
+            Some(Inertia::Matrix(m)) => {
+                let v: Vec<Id> = m.iter().map(|e| self.scalar(e)).collect::<Option<_>>()?;
+                inertia = [[v[0], v[3], v[5]], [v[3], v[1], v[4]], [v[5], v[4], v[2]]];
+            }
+            None => {}
+        }
+        Some(Body {
+            name: d.name.to_string(),
+            center: center?,
+            frame,
+            mass: mass?,
+            inertia,
+        })
+    }
+
+    fn constraint(&mut self, c: &ConstraintDef) -> Option<Constraint> {
+        let l = self.scalar(&c.lhs)?;
+        let r = self.scalar(&c.rhs)?;
+        match self.g.sub(l, r) {
+            Ok(residual) => Some(Constraint {
+                residual,
+                span: c.span,
+            }),
+            Err(e) => {
+                engine_error(self.cx, c.span, e);
+                None
+            }
+        }
+    }
+
+    fn scalar(&mut self, e: &Expr) -> Option<Id> {
+        match self.eval(e)? {
+            Val::Scalar(s) => Some(s),
+            Val::Vector(_) => {
+                self.cx
+                    .error_at(e.span(), "expected a scalar, found a vector");
+                None
+            }
+            Val::Point(_) => {
+                self.cx
+                    .error_at(e.span(), "expected a scalar, found a point");
+                None
+            }
+        }
+    }
+
+    fn vector(&mut self, e: &Expr) -> Option<Vec3> {
+        match self.eval(e)? {
+            Val::Vector(v) => Some(v),
+            Val::Scalar(_) => {
+                self.cx.error_at(
+                    e.span(),
+                    "expected a vector (e.g. `m * g * N.x`), found a scalar",
+                );
+                None
+            }
+            Val::Point(_) => {
+                self.cx.error_at(
+                    e.span(),
+                    "expected a vector, found a point (subtract another point to get a vector)",
+                );
+                None
+            }
+        }
+    }
+
+    fn scale3(&mut self, v: Vec3, k: Id) -> Option<Vec3> {
+        let mut out = v;
+        for i in 0..3 {
+            out[i] = self.g.mul(v[i], k).ok()?;
+        }
+        Some(out)
+    }
+
+    fn eval(&mut self, e: &Expr) -> Option<Val> {
+        let span = e.span();
+        let r: Result<Option<Val>, SymbolicError> = (|| {
+            Ok(Some(match e {
+                Expr::Int(n, _) => Val::Scalar(self.g.int(*n)?),
+                Expr::Float(x, _) => Val::Scalar(self.g.float(*x)?),
+                Expr::Name(ident) => return Ok(self.name(ident)),
+                Expr::Axis(frame, k, _) => {
+                    let Some(fi) = self.frame_named(frame) else {
+                        return Ok(None);
+                    };
+                    let r = self.frames[fi].rot;
+                    Val::Vector([r[0][*k], r[1][*k], r[2][*k]])
+                }
+                Expr::Neg(a, _) => match self.eval(a) {
+                    Some(Val::Scalar(s)) => Val::Scalar(self.g.neg(s)?),
+                    Some(Val::Vector(v)) => {
+                        let mut out = v;
+                        for i in 0..3 {
+                            out[i] = self.g.neg(v[i])?;
+                        }
+                        Val::Vector(out)
+                    }
+                    Some(Val::Point(_)) => {
+                        self.cx.error_at(span, "a point cannot be negated");
+                        return Ok(None);
+                    }
+                    None => return Ok(None),
+                },
+                Expr::Binary(op, a, b, _) => {
+                    let (Some(x), Some(y)) = (self.eval(a), self.eval(b)) else {
+                        return Ok(None);
+                    };
+                    return self.binary(*op, x, y, span);
+                }
+                Expr::Call(f, args, _) => return self.call(f, args, span),
+            }))
+        })();
+        match r {
+            Ok(v) => v,
+            Err(err) => {
+                engine_error(self.cx, span, err);
+                None
+            }
+        }
+    }
+
+    fn name(&mut self, ident: &Ident) -> Option<Val> {
+        let name = ident.to_string();
+        let g = &mut self.g;
+        if name == "t" {
+            return g.sym(self.time).ok().map(Val::Scalar);
+        }
+        if let Some(p) = self.params.iter().find(|p| p.ident == name) {
+            return g.sym(p.symbol).ok().map(Val::Scalar);
+        }
+        if let Some((_, c)) = self.coords.iter().find(|(c, _)| c == &name) {
+            return g.sym(c.q).ok().map(Val::Scalar);
+        }
+        if let Some((_, s)) = self.inputs.iter().find(|(c, _)| c == &name) {
+            return g.sym(*s).ok().map(Val::Scalar);
+        }
+        if let Some(p) = self.points.iter().find(|p| p.name == name) {
+            return Some(Val::Point(p.pos));
+        }
+        if self.frames.iter().any(|f| f.name == name) {
+            self.cx.error_spanned_by(
+                ident,
+                format!(
+                    "`{name}` is a frame; its unit vectors are `{name}.x`, `{name}.y`, `{name}.z`"
+                ),
+            );
+            return None;
+        }
+        let h = hint(&name, self.all_names());
+        self.cx
+            .error_spanned_by(ident, format!("unknown name `{name}`{h}"));
+        None
+    }
+
+    fn binary(
+        &mut self,
+        op: BinOp,
+        x: Val,
+        y: Val,
+        span: Span,
+    ) -> Result<Option<Val>, SymbolicError> {
+        use Val::*;
+        let g = &mut self.g;
+        let each = |g: &mut Graph,
+                    a: Vec3,
+                    b: Vec3,
+                    f: fn(&mut Graph, Id, Id) -> Result<Id, SymbolicError>|
+         -> Result<Vec3, SymbolicError> {
+            Ok([f(g, a[0], b[0])?, f(g, a[1], b[1])?, f(g, a[2], b[2])?])
+        };
+        let scaled = |g: &mut Graph, v: Vec3, k: Id| -> Result<Vec3, SymbolicError> {
+            Ok([g.mul(v[0], k)?, g.mul(v[1], k)?, g.mul(v[2], k)?])
+        };
+        Ok(Some(match (op, x, y) {
+            (BinOp::Add, Scalar(a), Scalar(b)) => Scalar(g.add(a, b)?),
+            (BinOp::Sub, Scalar(a), Scalar(b)) => Scalar(g.sub(a, b)?),
+            (BinOp::Mul, Scalar(a), Scalar(b)) => Scalar(g.mul(a, b)?),
+            (BinOp::Div, Scalar(a), Scalar(b)) => Scalar(g.div(a, b)?),
+            (BinOp::Add, Vector(a), Vector(b)) => Vector(each(g, a, b, Graph::add)?),
+            (BinOp::Sub, Vector(a), Vector(b)) => Vector(each(g, a, b, Graph::sub)?),
+            (BinOp::Add, Point(a), Vector(b)) | (BinOp::Add, Vector(b), Point(a)) => {
+                Point(each(g, a, b, Graph::add)?)
+            }
+            (BinOp::Sub, Point(a), Vector(b)) => Point(each(g, a, b, Graph::sub)?),
+            (BinOp::Sub, Point(a), Point(b)) => Vector(each(g, a, b, Graph::sub)?),
+            (BinOp::Mul, Scalar(k), Vector(v)) | (BinOp::Mul, Vector(v), Scalar(k)) => {
+                Vector(scaled(g, v, k)?)
+            }
+            (BinOp::Div, Vector(v), Scalar(k)) => {
+                let inv = g.recip(k).map_err(|_| SymbolicError::DivisionByZero {
+                    expr: "a vector".into(),
+                })?;
+                Vector(scaled(g, v, inv)?)
+            }
+            _ => {
+                let kind = |v: &Val| match v {
+                    Scalar(_) => "a scalar",
+                    Vector(_) => "a vector",
+                    Point(_) => "a point",
+                };
+                let sym = match op {
+                    BinOp::Add => "+",
+                    BinOp::Sub => "-",
+                    BinOp::Mul => "*",
+                    BinOp::Div => "/",
+                };
+                self.cx.error_at(
+                    span,
+                    format!("cannot apply `{sym}` to {} and {}", kind(&x), kind(&y)),
+                );
+                return Ok(None);
+            }
+        }))
+    }
+
+    fn call(&mut self, f: &Ident, args: &[Expr], span: Span) -> Result<Option<Val>, SymbolicError> {
+        let name = f.to_string();
+        let arity = |n: usize| -> bool { args.len() == n };
+        let wrong = |cx: &Ctxt, n: usize| {
+            cx.error_spanned_by(
+                f,
+                format!("`{name}` takes {n} argument(s), found {}", args.len()),
+            );
+        };
+        let unary = |g: &mut Graph, x: Id| -> Result<Id, SymbolicError> {
+            match name.as_str() {
+                "sin" => g.sin(x),
+                "cos" => g.cos(x),
+                "tan" => g.tan(x),
+                "exp" => g.exp(x),
+                "ln" => g.ln(x),
+                "sqrt" => g.sqrt(x),
+                _ => g.abs(x),
+            }
+        };
+        match name.as_str() {
+            "dt" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                if let Expr::Name(i) = &args[0] {
+                    if let Some((_, c)) = self.coords.iter().find(|(c, _)| c == i) {
+                        return Ok(Some(Val::Scalar(self.g.sym(c.rate)?)));
+                    }
+                }
+                let Some(x) = self.scalar(&args[0]) else {
+                    return Ok(None);
+                };
+                let d = self.g.time_derivative(x, &RateRules::coordinates())?;
+                Ok(Some(Val::Scalar(d)))
+            }
+            "sin" | "cos" | "tan" | "exp" | "ln" | "sqrt" | "abs" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                let Some(x) = self.scalar(&args[0]) else {
+                    return Ok(None);
+                };
+                Ok(Some(Val::Scalar(unary(&mut self.g, x)?)))
+            }
+            "atan2" => {
+                if !arity(2) {
+                    wrong(self.cx, 2);
+                    return Ok(None);
+                }
+                let (Some(y), Some(x)) = (self.scalar(&args[0]), self.scalar(&args[1])) else {
+                    return Ok(None);
+                };
+                Ok(Some(Val::Scalar(self.g.atan2(y, x)?)))
+            }
+            "powi" => {
+                if !arity(2) {
+                    wrong(self.cx, 2);
+                    return Ok(None);
+                }
+                let Some(x) = self.scalar(&args[0]) else {
+                    return Ok(None);
+                };
+                let n = match &args[1] {
+                    Expr::Int(n, _) => *n,
+                    Expr::Neg(inner, _) => match **inner {
+                        Expr::Int(n, _) => -n,
+                        _ => {
+                            self.cx.error_at(
+                                args[1].span(),
+                                "the exponent of `powi` is an integer literal",
+                            );
+                            return Ok(None);
+                        }
+                    },
+                    other => {
+                        self.cx
+                            .error_at(other.span(), "the exponent of `powi` is an integer literal");
+                        return Ok(None);
+                    }
+                };
+                Ok(Some(Val::Scalar(self.g.powi(x, n)?)))
+            }
+            "dot" | "cross" => {
+                if !arity(2) {
+                    wrong(self.cx, 2);
+                    return Ok(None);
+                }
+                let (Some(a), Some(b)) = (self.vector(&args[0]), self.vector(&args[1])) else {
+                    return Ok(None);
+                };
+                if name == "dot" {
+                    Ok(Some(Val::Scalar(dot(&mut self.g, a, b)?)))
+                } else {
+                    Ok(Some(Val::Vector(cross(&mut self.g, a, b)?)))
+                }
+            }
+            "norm" | "unit" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                let Some(v) = self.vector(&args[0]) else {
+                    return Ok(None);
+                };
+                let n2 = dot(&mut self.g, v, v)?;
+                if self.g.is_zero(n2) {
+                    self.cx.error_at(
+                        span,
+                        format!("`{name}` of a vector that is identically zero"),
+                    );
+                    return Ok(None);
+                }
+                let n = self.g.sqrt(n2)?;
+                if name == "norm" {
+                    Ok(Some(Val::Scalar(n)))
+                } else {
+                    let inv = self.g.recip(n)?;
+                    Ok(Some(Val::Vector([
+                        self.g.mul(v[0], inv)?,
+                        self.g.mul(v[1], inv)?,
+                        self.g.mul(v[2], inv)?,
+                    ])))
+                }
+            }
+            _ => {
+                const FUNCS: &[&str] = &[
+                    "dt", "sin", "cos", "tan", "exp", "ln", "sqrt", "abs", "atan2", "powi", "dot",
+                    "cross", "norm", "unit",
+                ];
+                let h = hint(&name, FUNCS.iter().map(|s| s.to_string()));
+                self.cx
+                    .error_spanned_by(f, format!("unknown function `{name}`{h}"));
+                Ok(None)
+            }
+        }
+    }
+}
+
+fn hint(name: &str, candidates: impl IntoIterator<Item = String>) -> String {
+    let c: Vec<String> = candidates.into_iter().collect();
+    did_you_mean(name, c.iter().map(|s| s.as_str()))
+        .map(|s| format!("; did you mean `{s}`?"))
+        .unwrap_or_default()
+}
+
+/// Rotation about local axis `k` by an angle with cosine `c` and sine `s`.
+fn simple_rotation(g: &mut Graph, k: usize, c: Id, s: Id) -> Result<Mat3, SymbolicError> {
+    let zero = g.int(0)?;
+    let one = g.int(1)?;
+    let ms = g.neg(s)?;
+    Ok(match k {
+        0 => [[one, zero, zero], [zero, c, ms], [zero, s, c]],
+        1 => [[c, zero, s], [zero, one, zero], [ms, zero, c]],
+        _ => [[c, ms, zero], [s, c, zero], [zero, zero, one]],
+    })
+}
+
+/// `a · b` of 3×3 matrices.
+pub fn mat_mul(g: &mut Graph, a: &Mat3, b: &Mat3) -> Result<Mat3, SymbolicError> {
+    let zero = g.int(0)?;
+    let mut out = [[zero; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let t: Vec<Id> = (0..3)
+                .map(|k| g.mul(a[i][k], b[k][j]))
+                .collect::<Result<_, _>>()?;
+            out[i][j] = g.sum(&t)?;
+        }
+    }
+    Ok(out)
+}
+
+/// `a · b` of vectors.
+pub fn dot(g: &mut Graph, a: Vec3, b: Vec3) -> Result<Id, SymbolicError> {
+    let t: Vec<Id> = (0..3)
+        .map(|k| g.mul(a[k], b[k]))
+        .collect::<Result<_, _>>()?;
+    g.sum(&t)
+}
+
+/// `a × b`.
+pub fn cross(g: &mut Graph, a: Vec3, b: Vec3) -> Result<Vec3, SymbolicError> {
+    let c = |g: &mut Graph, i: usize, j: usize| -> Result<Id, SymbolicError> {
+        let x = g.mul(a[i], b[j])?;
+        let y = g.mul(a[j], b[i])?;
+        g.sub(x, y)
+    };
+    Ok([c(g, 1, 2)?, c(g, 2, 0)?, c(g, 0, 1)?])
+}
+
+/// Whether a symbol is of a kind that may appear in a parameter-only value.
+pub fn is_parameter(g: &Graph, s: Symbol) -> bool {
+    g.symbol_kind(s) == SymbolKind::Parameter
+}

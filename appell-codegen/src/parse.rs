@@ -1,0 +1,477 @@
+//! Stage 1: `#[appell(...)]` attributes (syn) to [`ModelAst`]. Only syntax
+//! is checked here; names are resolved by [`crate::model`].
+
+use proc_macro2::Span;
+use syn::parse::{ParseStream, Parser};
+use syn::punctuated::Punctuated;
+use syn::spanned::Spanned;
+use syn::{Ident, Token};
+
+use crate::ast::*;
+use crate::ctxt::Ctxt;
+
+/// Parses the derive input; errors go to `cx`.
+pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
+    let mut ast = ModelAst {
+        name: input.ident.clone(),
+        fields: Vec::new(),
+        coordinates: Vec::new(),
+        speeds: None,
+        inputs: Vec::new(),
+        positive: Vec::new(),
+        frames: Vec::new(),
+        points: Vec::new(),
+        bodies: Vec::new(),
+        holonomic: Vec::new(),
+        nonholonomic: Vec::new(),
+        forces: Vec::new(),
+        torques: Vec::new(),
+        gravity: None,
+    };
+    match &input.data {
+        syn::Data::Struct(s) => match &s.fields {
+            syn::Fields::Named(named) => {
+                for f in &named.named {
+                    let is_f64 = matches!(&f.ty, syn::Type::Path(p) if p.path.is_ident("f64"));
+                    if !is_f64 {
+                        cx.error_spanned_by(&f.ty, "model parameters must be `f64` fields");
+                    }
+                    ast.fields
+                        .push((f.ident.clone().expect("named field"), is_f64));
+                }
+            }
+            syn::Fields::Unit => {}
+            other => cx.error_spanned_by(
+                other,
+                "a model is a struct with named `f64` fields (its parameters)",
+            ),
+        },
+        _ => cx.error_at(
+            input.ident.span(),
+            "#[derive(Appell)] works on structs whose fields are the model's parameters",
+        ),
+    }
+    if !input.generics.params.is_empty() {
+        cx.error_spanned_by(&input.generics, "a model struct cannot be generic");
+    }
+    for attr in &input.attrs {
+        if !attr.path().is_ident("appell") {
+            continue;
+        }
+        let parser = |stream: ParseStream| {
+            let items = Punctuated::<Item, Token![,]>::parse_terminated(stream)?;
+            Ok(items)
+        };
+        match attr.parse_args_with(parser) {
+            Ok(items) => {
+                for item in items {
+                    add_item(cx, &mut ast, item);
+                }
+            }
+            Err(e) => cx.syn_error(e),
+        }
+    }
+    ast
+}
+
+/// One `name(...)` entry of an `#[appell(...)]` attribute, kept raw.
+struct Item {
+    name: Ident,
+    content: proc_macro2::TokenStream,
+    span: Span,
+}
+
+impl syn::parse::Parse for Item {
+    fn parse(input: ParseStream) -> syn::Result<Item> {
+        let name: Ident = input.parse()?;
+        let content;
+        let paren = syn::parenthesized!(content in input);
+        let content: proc_macro2::TokenStream = content.parse()?;
+        let span = name.span().join(paren.span.close()).unwrap_or(name.span());
+        Ok(Item {
+            name,
+            content,
+            span,
+        })
+    }
+}
+
+const ITEMS: &[&str] = &[
+    "coordinates",
+    "speeds",
+    "inputs",
+    "positive",
+    "frame",
+    "point",
+    "particle",
+    "body",
+    "holonomic",
+    "nonholonomic",
+    "force",
+    "torque",
+    "gravity",
+];
+
+fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
+    let name = item.name.to_string();
+    let tokens = item.content.clone();
+    let result: syn::Result<()> = (|| {
+        match name.as_str() {
+            "coordinates" => ast.coordinates.extend(ident_list(tokens)?),
+            "inputs" => ast.inputs.extend(ident_list(tokens)?),
+            "positive" => ast.positive.extend(ident_list(tokens)?),
+            "speeds" => {
+                let list = ident_list(tokens)?;
+                if ast.speeds.is_some() {
+                    cx.error_at(item.span, "`speeds` is given twice");
+                }
+                ast.speeds = Some((list, item.span));
+            }
+            "frame" => ast.frames.push(Parser::parse2(parse_frame, tokens)?),
+            "point" => ast.points.push(Parser::parse2(parse_point, tokens)?),
+            "particle" => {
+                let span = item.span;
+                ast.bodies.push(Parser::parse2(
+                    move |s: ParseStream| parse_particle(s, span),
+                    tokens,
+                )?)
+            }
+            "body" => {
+                let span = item.span;
+                ast.bodies.push(Parser::parse2(
+                    move |s: ParseStream| parse_body(s, span),
+                    tokens,
+                )?)
+            }
+            "holonomic" | "nonholonomic" => {
+                let span = item.span;
+                let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, span), tokens)?;
+                if name == "holonomic" {
+                    ast.holonomic.push(c)
+                } else {
+                    ast.nonholonomic.push(c)
+                }
+            }
+            "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
+            "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
+            "gravity" => {
+                let e: syn::Expr = syn::parse2(tokens)?;
+                if ast.gravity.is_some() {
+                    cx.error_at(item.span, "`gravity` is given twice");
+                }
+                ast.gravity = Some(convert(&e)?);
+            }
+            _ => {
+                let hint = crate::ctxt::did_you_mean(&name, ITEMS.iter().copied())
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_default();
+                return Err(syn::Error::new(
+                    item.name.span(),
+                    format!("unknown model item `{name}`{hint}"),
+                ));
+            }
+        }
+        Ok(())
+    })();
+    if let Err(e) = result {
+        cx.syn_error(e);
+    }
+}
+
+fn ident_list(tokens: proc_macro2::TokenStream) -> syn::Result<Vec<Ident>> {
+    let list = Parser::parse2(Punctuated::<Ident, Token![,]>::parse_terminated, tokens)?;
+    Ok(list.into_iter().collect())
+}
+
+fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
+    let name: Ident = s.parse()?;
+    s.parse::<Token![=]>()?;
+    let e: syn::Expr = s.parse()?;
+    let syn::Expr::MethodCall(call) = &e else {
+        return Err(syn::Error::new(
+            e.span(),
+            "a frame is a rotation of another frame: `A = N.rotate_z(angle)` or `A = N.rotate(axis, angle)`",
+        ));
+    };
+    let syn::Expr::Path(parent) = &*call.receiver else {
+        return Err(syn::Error::new(
+            call.receiver.span(),
+            "expected the name of the parent frame",
+        ));
+    };
+    let parent =
+        parent.path.get_ident().cloned().ok_or_else(|| {
+            syn::Error::new(parent.span(), "expected the name of the parent frame")
+        })?;
+    let args: Vec<&syn::Expr> = call.args.iter().collect();
+    let method = call.method.to_string();
+    let (axis, angle) = match (method.as_str(), args.as_slice()) {
+        ("rotate_x", [a]) => (RotationAxis::Parent(0), convert(a)?),
+        ("rotate_y", [a]) => (RotationAxis::Parent(1), convert(a)?),
+        ("rotate_z", [a]) => (RotationAxis::Parent(2), convert(a)?),
+        ("rotate", [v, a]) => (RotationAxis::Vector(convert(v)?), convert(a)?),
+        ("rotate_x" | "rotate_y" | "rotate_z", _) => {
+            return Err(syn::Error::new(call.span(), format!("`{method}` takes one argument: the angle")))
+        }
+        ("rotate", _) => {
+            return Err(syn::Error::new(call.span(), "`rotate` takes two arguments: the axis vector and the angle"))
+        }
+        _ => {
+            return Err(syn::Error::new(
+                call.method.span(),
+                format!("unknown rotation `{method}`; use rotate_x, rotate_y, rotate_z or rotate(axis, angle)"),
+            ))
+        }
+    };
+    Ok(FrameDef {
+        name,
+        parent,
+        axis,
+        angle,
+    })
+}
+
+fn parse_point(s: ParseStream) -> syn::Result<PointDef> {
+    let name: Ident = s.parse()?;
+    s.parse::<Token![=]>()?;
+    let e: syn::Expr = s.parse()?;
+    Ok(PointDef {
+        name,
+        location: convert(&e)?,
+    })
+}
+
+/// `key = value` pairs after the leading positional arguments.
+fn key_values(s: ParseStream) -> syn::Result<Vec<(Ident, syn::Expr)>> {
+    let mut out = Vec::new();
+    while !s.is_empty() {
+        s.parse::<Token![,]>()?;
+        if s.is_empty() {
+            break;
+        }
+        let key: Ident = s.parse()?;
+        s.parse::<Token![=]>()?;
+        let value: syn::Expr = s.parse()?;
+        out.push((key, value));
+    }
+    Ok(out)
+}
+
+fn parse_particle(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
+    let point: Ident = s.parse()?;
+    let mut mass = None;
+    for (k, v) in key_values(s)? {
+        match k.to_string().as_str() {
+            "mass" => mass = Some(convert(&v)?),
+            other => {
+                return Err(syn::Error::new(
+                    k.span(),
+                    format!("unknown particle property `{other}`; a particle has `mass`"),
+                ))
+            }
+        }
+    }
+    let mass = mass.ok_or_else(|| syn::Error::new(span, "a particle needs `mass = ...`"))?;
+    Ok(BodyDef {
+        name: point.clone(),
+        center: point,
+        frame: None,
+        mass,
+        inertia: None,
+        span,
+    })
+}
+
+fn parse_body(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
+    let name: Ident = s.parse()?;
+    let (mut center, mut frame, mut mass, mut inertia) = (None, None, None, None);
+    for (k, v) in key_values(s)? {
+        match k.to_string().as_str() {
+            "center" => center = Some(expr_ident(&v)?),
+            "frame" => frame = Some(expr_ident(&v)?),
+            "mass" => mass = Some(convert(&v)?),
+            "inertia" => inertia = Some(parse_inertia(&v)?),
+            other => {
+                return Err(syn::Error::new(
+                    k.span(),
+                    format!("unknown body property `{other}`; a body has `center`, `frame`, `mass` and `inertia`"),
+                ))
+            }
+        }
+    }
+    let missing =
+        |what: &str| syn::Error::new(span, format!("body `{name}` has no `{what} = ...`"));
+    Ok(BodyDef {
+        center: center.ok_or_else(|| missing("center"))?,
+        frame: Some(frame.ok_or_else(|| missing("frame"))?),
+        mass: mass.ok_or_else(|| missing("mass"))?,
+        inertia: Some(inertia.ok_or_else(|| missing("inertia"))?),
+        name,
+        span,
+    })
+}
+
+fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {
+    let syn::Expr::Call(call) = e else {
+        return Err(syn::Error::new(
+            e.span(),
+            "expected `principal(i1, i2, i3)` or `matrix(ixx, iyy, izz, ixy, iyz, izx)`",
+        ));
+    };
+    let name = match &*call.func {
+        syn::Expr::Path(p) => p.path.get_ident().map(|i| i.to_string()),
+        _ => None,
+    };
+    let args: Vec<Expr> = call.args.iter().map(convert).collect::<syn::Result<_>>()?;
+    match (name.as_deref(), args.len()) {
+        (Some("principal"), 3) => Ok(Inertia::Principal(args.try_into().expect("3"))),
+        (Some("matrix"), 6) => Ok(Inertia::Matrix(args.try_into().expect("6"))),
+        (Some("principal"), n) => Err(syn::Error::new(
+            call.span(),
+            format!("`principal` takes 3 moments of inertia, found {n}"),
+        )),
+        (Some("matrix"), n) => Err(syn::Error::new(
+            call.span(),
+            format!("`matrix` takes 6 entries (ixx, iyy, izz, ixy, iyz, izx), found {n}"),
+        )),
+        _ => Err(syn::Error::new(
+            call.func.span(),
+            "expected `principal(...)` or `matrix(...)`",
+        )),
+    }
+}
+
+fn parse_constraint(s: ParseStream, span: Span) -> syn::Result<ConstraintDef> {
+    let e: syn::Expr = s.parse()?;
+    match &e {
+        syn::Expr::Binary(b) if matches!(b.op, syn::BinOp::Eq(_)) => Ok(ConstraintDef {
+            lhs: convert(&b.left)?,
+            rhs: convert(&b.right)?,
+            span,
+        }),
+        _ => Err(syn::Error::new(
+            e.span(),
+            "a constraint is an equation `lhs == rhs`",
+        )),
+    }
+}
+
+fn parse_load(s: ParseStream) -> syn::Result<LoadDef> {
+    let target: Ident = s.parse()?;
+    s.parse::<Token![,]>()?;
+    let vector: syn::Expr = s.parse()?;
+    let mut effect = None;
+    for (k, v) in key_values(s)? {
+        if k == "effect" {
+            effect = Some(expr_ident(&v)?);
+        } else {
+            return Err(syn::Error::new(k.span(), "a load takes `effect = name`"));
+        }
+    }
+    let effect = effect.unwrap_or_else(|| Ident::new("load", target.span()));
+    Ok(LoadDef {
+        target,
+        vector: convert(&vector)?,
+        effect,
+    })
+}
+
+fn expr_ident(e: &syn::Expr) -> syn::Result<Ident> {
+    match e {
+        syn::Expr::Path(p) => p
+            .path
+            .get_ident()
+            .cloned()
+            .ok_or_else(|| syn::Error::new(e.span(), "expected a name")),
+        _ => Err(syn::Error::new(e.span(), "expected a name")),
+    }
+}
+
+/// syn's expression to the model language's, rejecting what it lacks.
+pub fn convert(e: &syn::Expr) -> syn::Result<Expr> {
+    Ok(match e {
+        syn::Expr::Lit(lit) => match &lit.lit {
+            syn::Lit::Int(i) => Expr::Int(i.base10_parse()?, i.span()),
+            syn::Lit::Float(f) => Expr::Float(f.base10_parse()?, f.span()),
+            other => return Err(syn::Error::new(other.span(), "expected a number")),
+        },
+        syn::Expr::Path(p) => Expr::Name(
+            p.path
+                .get_ident()
+                .cloned()
+                .ok_or_else(|| syn::Error::new(p.span(), "expected a name"))?,
+        ),
+        syn::Expr::Paren(p) => convert(&p.expr)?,
+        syn::Expr::Group(g) => convert(&g.expr)?,
+        syn::Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => {
+            Expr::Neg(Box::new(convert(&u.expr)?), u.span())
+        }
+        syn::Expr::Binary(b) => {
+            let op = match b.op {
+                syn::BinOp::Add(_) => BinOp::Add,
+                syn::BinOp::Sub(_) => BinOp::Sub,
+                syn::BinOp::Mul(_) => BinOp::Mul,
+                syn::BinOp::Div(_) => BinOp::Div,
+                _ => {
+                    return Err(syn::Error::new(
+                        b.op.span(),
+                        "only `+ - * /` (and `==` in constraints) are allowed here",
+                    ))
+                }
+            };
+            Expr::Binary(
+                op,
+                Box::new(convert(&b.left)?),
+                Box::new(convert(&b.right)?),
+                b.span(),
+            )
+        }
+        syn::Expr::Call(c) => {
+            let func = match &*c.func {
+                syn::Expr::Path(p) => p.path.get_ident().cloned(),
+                _ => None,
+            }
+            .ok_or_else(|| syn::Error::new(c.func.span(), "expected a function name"))?;
+            let args = c.args.iter().map(convert).collect::<syn::Result<_>>()?;
+            Expr::Call(func, args, c.span())
+        }
+        syn::Expr::MethodCall(m) => {
+            // `x.sin()`, `x.powi(2)`: method syntax for scalar functions.
+            let mut args = vec![convert(&m.receiver)?];
+            for a in &m.args {
+                args.push(convert(a)?);
+            }
+            Expr::Call(m.method.clone(), args, m.span())
+        }
+        syn::Expr::Field(f) => {
+            let frame = match &*f.base {
+                syn::Expr::Path(p) => p.path.get_ident().cloned(),
+                _ => None,
+            }
+            .ok_or_else(|| {
+                syn::Error::new(
+                    f.base.span(),
+                    "expected a frame name before `.x`, `.y` or `.z`",
+                )
+            })?;
+            let axis = match &f.member {
+                syn::Member::Named(m) if m == "x" => 0,
+                syn::Member::Named(m) if m == "y" => 1,
+                syn::Member::Named(m) if m == "z" => 2,
+                other => {
+                    return Err(syn::Error::new(
+                        other.span(),
+                        "a frame's unit vectors are `.x`, `.y` and `.z`",
+                    ))
+                }
+            };
+            Expr::Axis(frame, axis, f.span())
+        }
+        other => {
+            return Err(syn::Error::new(
+                other.span(),
+                "this is not part of the model language",
+            ))
+        }
+    })
+}
