@@ -204,8 +204,10 @@ impl Emitter<'_> {
         (s, ops)
     }
 
-    /// Unrolled LDLᵀ solve of M ÿ = f; `m` and `f` are expressions.
-    fn ldlt(&self, m: &[String], f: &[String]) -> (String, usize) {
+    /// Unrolled LDLᵀ factorization of M (lower triangle given as
+    /// expressions): binds `__l_i_j` and `__d_j`, checking each pivot against
+    /// `__tol` when `checks`.
+    fn ldlt_factor(&self, m: &[String], checks: bool) -> (String, usize) {
         let l = self.d.l;
         let mut s = String::new();
         let mut ops = 0;
@@ -213,7 +215,6 @@ impl Emitter<'_> {
             for j in 0..=i {
                 let _ = writeln!(s, "        let __m_{i}_{j} = {};", m[i * l + j]);
             }
-            let _ = writeln!(s, "        let __f_{i} = {};", f[i]);
         }
         let diag: Vec<String> = (0..l)
             .map(|i| format!("{P}::Scalar::re(__m_{i}_{i}).abs()"))
@@ -237,10 +238,9 @@ impl Emitter<'_> {
                 ops += 3;
             }
             let _ = writeln!(s, "        let __d_{j} = {e};");
-            let _ = writeln!(
-                s,
-                "        if !({P}::Scalar::re(__d_{j}) > __tol) {{ return {P}::Err({P}::ModelError::SingularMassMatrix {{ index: {j}, pivot: {P}::Scalar::re(__d_{j}) }}); }}"
-            );
+            if checks {
+                s.push_str(&self.pivot_check(j, "__tol"));
+            }
             for i in j + 1..l {
                 let mut e = format!("__m_{i}_{j}");
                 for k in 0..j {
@@ -251,8 +251,22 @@ impl Emitter<'_> {
                 ops += 1;
             }
         }
+        (s, ops)
+    }
+
+    fn pivot_check(&self, j: usize, tol: &str) -> String {
+        format!(
+            "        if !({P}::Scalar::re(__d_{j}) > {tol}) {{ return {P}::Err({P}::ModelError::SingularMassMatrix {{ index: {j}, pivot: {P}::Scalar::re(__d_{j}) }}); }}\n"
+        )
+    }
+
+    /// Forward and back substitution with the factors: binds `__y_k` = ÿ_k.
+    fn ldlt_solve(&self, f: &[String]) -> (String, usize) {
+        let l = self.d.l;
+        let mut s = String::new();
+        let mut ops = 0;
         for i in 0..l {
-            let mut e = format!("__f_{i}");
+            let mut e = format!("({})", f[i]);
             for k in 0..i {
                 e.push_str(&format!(" - __l_{i}_{k} * __z_{k}"));
                 ops += 2;
@@ -272,6 +286,22 @@ impl Emitter<'_> {
             let _ = writeln!(s, "        let __y_{i} = {e};");
         }
         (s, ops)
+    }
+
+    /// Names of the factors kept in `Prepared` when M is constant.
+    fn factor_names(&self) -> Vec<String> {
+        let l = self.d.l;
+        let mut v = Vec::new();
+        for i in 0..l {
+            for j in 0..i {
+                v.push(format!("__l_{i}_{j}"));
+            }
+        }
+        for j in 0..l {
+            v.push(format!("__d_{j}"));
+        }
+        v.push("__tolv".into());
+        v
     }
 
     fn info(&self, rhs_ops: appell_symbolic::OpCount, extra_ops: usize) -> String {
@@ -356,29 +386,76 @@ impl Emitter<'_> {
         let qdot = &d.qdot;
 
         // --- rhs: M, f and the retained coordinates' rates, hoisted. ---
-        let mut roots: Vec<Id> = Vec::new();
+        // When M depends on parameters only, its factorization moves into
+        // `prepare` and the rhs keeps only the two triangular solves.
+        let constant_mass = l > 0 && d.mass.iter().all(|&e| g.is_parameter_only(e));
+        let mut tri_roots: Vec<Id> = Vec::new();
         for i in 0..l {
             for j in 0..=i {
-                roots.push(d.mass[i * l + j]);
+                tri_roots.push(d.mass[i * l + j]);
             }
         }
+        let mut roots: Vec<Id> = if constant_mass {
+            Vec::new()
+        } else {
+            tri_roots.clone()
+        };
         roots.extend(&d.forcing);
         for &r in &d.retained {
             roots.push(qdot[r]);
         }
         let rhs = code(d, &roots, &options(true));
-        let h = rhs.hoisted.len();
-        let tri = l * (l + 1) / 2;
-        let mut m_text = vec![String::new(); l * l];
-        let mut idx = 0;
-        for i in 0..l {
-            for j in 0..=i {
-                m_text[i * l + j] = rhs.outputs[idx].clone();
-                idx += 1;
-            }
-        }
+        let tri = if constant_mass { 0 } else { l * (l + 1) / 2 };
         let f_text: Vec<String> = rhs.outputs[tri..tri + l].to_vec();
-        let (ldlt, ldlt_ops) = self.ldlt(&m_text, &f_text);
+        let mut factor_prepare = String::new();
+        let (factor_text, factor_ops, hoisted_names) = if constant_mass {
+            let mc = code(d, &tri_roots, &options(false));
+            let mut m_text = vec![String::new(); l * l];
+            let mut idx = 0;
+            for i in 0..l {
+                for j in 0..=i {
+                    m_text[i * l + j] = mc.outputs[idx].clone();
+                    idx += 1;
+                }
+            }
+            let (fac, _) = self.ldlt_factor(&m_text, false);
+            let names = self.factor_names();
+            let _ = writeln!(
+                factor_prepare,
+                "        let __factors: [__T; {}] = {{",
+                names.len()
+            );
+            factor_prepare.push_str(&statements(&mc));
+            factor_prepare.push_str(&fac);
+            let _ = writeln!(
+                factor_prepare,
+                "        let __tolv = <__T as {P}::Scalar>::from_f64(__tol);"
+            );
+            let _ = writeln!(factor_prepare, "        [{}]", names.join(", "));
+            factor_prepare.push_str("        };\n");
+            let mut checks = String::new();
+            for j in 0..l {
+                checks.push_str(&self.pivot_check(j, &format!("{P}::Scalar::re(__tolv)")));
+            }
+            let mut all = rhs.hoisted.clone();
+            all.extend(names);
+            (checks, 0, all)
+        } else {
+            let mut m_text = vec![String::new(); l * l];
+            let mut idx = 0;
+            for i in 0..l {
+                for j in 0..=i {
+                    m_text[i * l + j] = rhs.outputs[idx].clone();
+                    idx += 1;
+                }
+            }
+            let (fac, ops) = self.ldlt_factor(&m_text, true);
+            (fac, ops, rhs.hoisted.clone())
+        };
+        let h = hoisted_names.len();
+        let (solve_text, solve_ops) = self.ldlt_solve(&f_text);
+        let ldlt = format!("{factor_text}{solve_text}");
+        let ldlt_ops = factor_ops + solve_ops;
         let (elim_rhs, elim_ops) = self.elimination(true);
         let mut bind_state = String::new();
         for (k, &r) in d.retained.iter().enumerate() {
@@ -411,7 +488,15 @@ impl Emitter<'_> {
         for st in &rhs.prepare {
             let _ = writeln!(prepare, "        {st}");
         }
-        let hoisted_list = rhs.hoisted.join(", ");
+        prepare.push_str(&factor_prepare);
+        let prepared_list = {
+            let mut v = rhs.hoisted.clone();
+            if constant_mass {
+                v.extend((0..self.factor_names().len()).map(|i| format!("__factors[{i}]")));
+            }
+            v.join(", ")
+        };
+        let hoisted_list = hoisted_names.join(", ");
         let info = self.info(rhs.ops, ldlt_ops + elim_ops);
 
         // --- mass matrix and forcing ---
@@ -555,7 +640,7 @@ const _: () = {{
         }}
     }}
     fn prepare<__T: {P}::Scalar>(&self) -> [__T; {h}] {{
-{params_t}{prepare}        [{hoisted_list}]
+{params_t}{prepare}        [{prepared_list}]
     }}
     fn rhs<__T: {P}::Scalar>(&self, __prepared: &[__T; {h}], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_state}{chk_inputs}{chk_dstate}{pos}        let [{hoisted_list}] = *__prepared;

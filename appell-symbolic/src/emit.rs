@@ -192,6 +192,74 @@ impl Lowering<'_> {
         Some(it.fold(first, |acc, x| self.push(op(acc, x))))
     }
 
+    /// `coeff · Π bᵉ`: the coefficient and the parameter-only factors form
+    /// one value (hoistable), multiplied by the rest and divided by the rest's
+    /// denominator. A negative coefficient is folded into the parameter-only
+    /// value when there is one, else applied as a negation.
+    fn product(&mut self, coeff: Number, factors: &[(Id, i32)]) -> u32 {
+        let (params, others): (Vec<(Id, i32)>, Vec<(Id, i32)>) = factors
+            .iter()
+            .copied()
+            .partition(|&(b, _)| self.graph.is_parameter_only(b));
+        let fold_sign = !params.is_empty();
+        let k = if fold_sign { coeff } else { coeff.abs() };
+        let group = |l: &mut Self, list: &[(Id, i32)], k: Option<Number>| -> Option<u32> {
+            let mut num = Vec::new();
+            let mut den = Vec::new();
+            if let Some(k) = k {
+                if !(k.is_one() && !k.is_float()) {
+                    num.push(l.constant(k));
+                }
+            }
+            for &(b, e) in list {
+                let base = l.memo[&b];
+                if e > 0 {
+                    num.push(l.power(base, e));
+                } else {
+                    den.push(l.power(base, -e));
+                }
+            }
+            let n = l.chain(&num, Inst::Mul);
+            let d = l.chain(&den, Inst::Mul);
+            match (n, d) {
+                (n, None) => n,
+                (Some(n), Some(d)) => Some(l.push(Inst::Div(n, d))),
+                (None, Some(d)) => {
+                    let one = l.constant(Number::ONE);
+                    Some(l.push(Inst::Div(one, d)))
+                }
+            }
+        };
+        let p = group(self, &params, Some(k));
+        // The rest: numerator times the parameter value, then one division.
+        let mut num = Vec::new();
+        let mut den = Vec::new();
+        for &(b, e) in &others {
+            let base = self.memo[&b];
+            if e > 0 {
+                num.push(self.power(base, e));
+            } else {
+                den.push(self.power(base, -e));
+            }
+        }
+        let mut items = Vec::new();
+        items.extend(p);
+        items.extend(num);
+        let n = match self.chain(&items, Inst::Mul) {
+            Some(n) => n,
+            None => self.constant(Number::ONE),
+        };
+        let v = match self.chain(&den, Inst::Mul) {
+            Some(d) => self.push(Inst::Div(n, d)),
+            None => n,
+        };
+        if coeff.is_negative() && !fold_sign {
+            self.push(Inst::Neg(v))
+        } else {
+            v
+        }
+    }
+
     fn lower_node(&mut self, id: Id) -> u32 {
         let node = self.graph.node(id);
         match node {
@@ -206,18 +274,22 @@ impl Lowering<'_> {
                     .collect();
                 ordered.sort_by_key(|t| (t.0, t.1));
                 for (_, b, k) in ordered {
-                    let base = self.memo[&b];
-                    let mag = k.abs();
-                    let v = if mag.is_one() && !mag.is_float() {
-                        base
-                    } else {
-                        let c = self.constant(mag);
-                        self.push(Inst::Mul(c, base))
+                    let factors: Vec<(Id, i32)> = match self.graph.node(b) {
+                        Node::Mul { factors, .. } => factors.to_vec(),
+                        _ => vec![(b, 1)],
                     };
-                    if k.is_negative() {
-                        neg.push(v)
+                    // A coefficient joins the term's parameter-only factors
+                    // (sign included, so the term is simply added); without
+                    // such factors the sign becomes a subtraction.
+                    let has_param = factors
+                        .iter()
+                        .any(|&(f, _)| self.graph.is_parameter_only(f));
+                    if has_param {
+                        pos.push(self.product(k, &factors));
+                    } else if k.is_negative() {
+                        neg.push(self.product(k.abs(), &factors));
                     } else {
-                        pos.push(v)
+                        pos.push(self.product(k, &factors));
                     }
                 }
                 if !constant.is_zero() {
@@ -239,40 +311,8 @@ impl Lowering<'_> {
                     .fold(start, |acc, &x| self.push(Inst::Sub(acc, x)))
             }
             Node::Mul { coeff, factors } => {
-                // Parameter-only factors first, so their product is one
-                // hoistable value; the coefficient joins them.
-                let mut num = Vec::new();
-                let mut den = Vec::new();
-                let mag = coeff.abs();
-                if !mag.is_one() || mag.is_float() {
-                    num.push(self.constant(mag));
-                }
-                let mut ordered: Vec<(bool, Id, i32)> = factors
-                    .iter()
-                    .map(|&(b, e)| (!self.graph.is_parameter_only(b), b, e))
-                    .collect();
-                ordered.sort();
-                for (_, b, e) in ordered {
-                    let base = self.memo[&b];
-                    if e > 0 {
-                        num.push(self.power(base, e));
-                    } else {
-                        den.push(self.power(base, -e));
-                    }
-                }
-                let n = match self.chain(&num, Inst::Mul) {
-                    Some(n) => n,
-                    None => self.constant(Number::ONE),
-                };
-                let v = match self.chain(&den, Inst::Mul) {
-                    Some(d) => self.push(Inst::Div(n, d)),
-                    None => n,
-                };
-                if coeff.is_negative() {
-                    self.push(Inst::Neg(v))
-                } else {
-                    v
-                }
+                let factors = factors.to_vec();
+                self.product(*coeff, &factors)
             }
             Node::Fun(f, a) => {
                 let a = self.memo[a];
