@@ -9,9 +9,11 @@ use crate::model::ModelError;
 use crate::scalar::Scalar;
 
 /// Solves `A X = B` in place by LU with partial pivoting: on success `b`
-/// holds `X`. A pivot smaller than `1e-12 ×` the largest entry of `A` in
-/// magnitude is reported as [`ModelError::SingularConstraints`] (the use this
-/// solve has in generated code).
+/// holds `X`. A pivot smaller than `1e-12 ×` the largest entry of `A` and `B`
+/// in magnitude is reported as [`ModelError::SingularConstraints`] (the use
+/// this solve has in generated code, where `A` is the dependent block D' and
+/// `B` holds −D'' and −d: a pivot is negligible relative to the whole
+/// constraint matrix, not only to D').
 ///
 /// ```
 /// use appell_runtime::linalg::lu_solve;
@@ -38,6 +40,14 @@ pub fn lu_solve<T: Scalar, const N: usize, const M: usize>(
                 });
             }
             scale = scale.max(v);
+        }
+    }
+    for row in b.iter() {
+        for x in row {
+            let v = x.re().abs();
+            if v.is_finite() {
+                scale = scale.max(v);
+            }
         }
     }
     let tol = 1e-12 * scale;
@@ -165,6 +175,17 @@ mod tests {
                 assert!(r.abs() < 1e-13);
             }
         }
+    }
+
+    #[test]
+    fn lu_pivot_is_judged_against_the_whole_system() {
+        // 1×1 D' = cos(π/2) ≈ 6e-17 beside a right side of order 1.
+        let mut a = [[std::f64::consts::FRAC_PI_2.cos()]];
+        let mut b = [[1.0, 0.0]];
+        assert!(matches!(
+            lu_solve(&mut a, &mut b),
+            Err(ModelError::SingularConstraints { column: 0, .. })
+        ));
     }
 
     #[test]
