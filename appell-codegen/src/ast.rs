@@ -116,8 +116,8 @@ pub struct ConstraintDef {
     pub lhs: Expr,
     /// Right side.
     pub rhs: Expr,
-    /// The whole constraint, for errors.
-    pub span: Span,
+    /// The whole constraint's tokens, for errors that underline it.
+    pub at: proc_macro2::TokenStream,
 }
 
 /// A force on a point or a torque on a frame.
@@ -140,8 +140,8 @@ pub struct ModelAst {
     pub fields: Vec<(Ident, bool)>,
     /// `coordinates(...)`.
     pub coordinates: Vec<Ident>,
-    /// `speeds(...)` and the attribute's span.
-    pub speeds: Option<(Vec<Ident>, Span)>,
+    /// `speeds(...)` and its tokens (for errors).
+    pub speeds: Option<(Vec<Ident>, proc_macro2::TokenStream)>,
     /// `inputs(...)`.
     pub inputs: Vec<Ident>,
     /// `positive(...)`: parameters known to be positive.

@@ -184,7 +184,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
     let rules = RateRules::coordinates();
     // 1. Velocity constraint rows.
-    let mut rows: Vec<(Id, proc_macro2::Span, bool)> = Vec::new();
+    let mut rows: Vec<(Id, proc_macro2::TokenStream, bool)> = Vec::new();
     let mut holonomic = Vec::new();
     for c in &model.holonomic {
         holonomic.push(c.residual);
@@ -201,16 +201,16 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             .map(|s| model.g.symbol_name(s).to_string())
             .collect();
         if !bad.is_empty() {
-            cx.error_at(c.span, format!("a holonomic constraint relates coordinates, parameters and time only; it uses {}", bad.join(", ")));
+            cx.error_spanned_by(&c.at, format!("a holonomic constraint relates coordinates, parameters and time only; it uses {}", bad.join(", ")));
             continue;
         }
         match model.g.time_derivative(c.residual, &rules) {
-            Ok(r) => rows.push((r, c.span, true)),
-            Err(e) => cx.error_at(c.span, e),
+            Ok(r) => rows.push((r, c.at.clone(), true)),
+            Err(e) => cx.error_spanned_by(&c.at, e),
         }
     }
     for c in &model.nonholonomic {
-        rows.push((c.residual, c.span, false));
+        rows.push((c.residual, c.at.clone(), false));
     }
     let mut d_rows = Vec::new();
     let mut d0 = Vec::new();
@@ -228,8 +228,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             .map(|s| model.g.symbol_name(s).to_string())
             .collect();
         if !bad.is_empty() {
-            cx.error_at(
-                *span,
+            cx.error_spanned_by(span,
                 format!("a velocity constraint cannot depend on {}", bad.join(", ")),
             );
             continue;
@@ -237,8 +236,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         match model.g.linear_coefficients(*row, &rates) {
             Ok(form) => {
                 if form.coefficients.iter().all(|c| model.g.is_zero(*c)) {
-                    cx.error_at(
-                        *span,
+                    cx.error_spanned_by(span,
                         "this constraint does not involve any coordinate rate",
                     );
                     continue;
@@ -252,12 +250,12 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 } else {
                     "a nonholonomic constraint"
                 };
-                cx.error_at(
-                    *span,
+                cx.error_spanned_by(
+                    span,
                     format!("{what} must be linear in the coordinate rates (eq. 25: D(q,t) q̇ + d = 0), and this one is not linear in `{symbol}`"),
                 );
             }
-            Err(e) => cx.error_at(*span, e),
+            Err(e) => cx.error_spanned_by(span, e),
         }
     }
     if cx.has_errors() {
@@ -266,8 +264,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let m = d0.len();
     let l = model.speeds.len();
     if l + m != n {
-        cx.error_at(
-            model.speeds_span,
+        cx.error_spanned_by(
+            &model.speeds_at,
             format!(
                 "{l} privileged speed(s) with {m} velocity constraint(s) on {n} coordinates: the constraints leave {} independent speed(s), so `speeds(...)` must name {}",
                 n.saturating_sub(m),
@@ -281,8 +279,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // 2. Structural rank of D' (a matching of rows to dependent columns).
     if let Some(col) = unmatched_column(g, &d_rows, n, m, &dependent) {
         let name = model.coords[dependent[col]].0.to_string();
-        cx.error_at(
-            model.speeds_span,
+        cx.error_spanned_by(
+            &model.speeds_at,
             format!("with these privileged speeds the constraints cannot determine the rate of `{name}`: the dependent block D' is structurally singular; choose other speeds"),
         );
         return Ok(None);
@@ -325,8 +323,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             }
             Err(SymbolicError::StructurallySingular { column }) => {
                 let name = model.coords[dependent[column]].0.to_string();
-                cx.error_at(
-                    model.speeds_span,
+                cx.error_spanned_by(
+                    &model.speeds_at,
                     format!("with these privileged speeds the constraints cannot determine the rate of `{name}` (D' is singular after elimination); choose other speeds"),
                 );
                 return Ok(None);

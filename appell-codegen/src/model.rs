@@ -78,8 +78,8 @@ pub struct Load {
 pub struct Constraint {
     /// `lhs - rhs`.
     pub residual: Id,
-    /// Where it was written.
-    pub span: Span,
+    /// Its tokens, for errors.
+    pub at: proc_macro2::TokenStream,
 }
 
 /// The resolved model.
@@ -94,8 +94,8 @@ pub struct Model {
     pub coords: Vec<(Ident, Coordinate)>,
     /// Indices (into `coords`) of the privileged speeds, in order.
     pub speeds: Vec<usize>,
-    /// The span of `speeds(...)`.
-    pub speeds_span: Span,
+    /// The tokens of `speeds(...)`, for errors.
+    pub speeds_at: proc_macro2::TokenStream,
     /// Inputs.
     pub inputs: Vec<(Ident, Symbol)>,
     /// Time.
@@ -134,6 +134,9 @@ struct Builder<'a> {
     time: Symbol,
     frames: Vec<Frame>,
     points: Vec<Point>,
+    /// Frames and points whose definition failed: references to them are
+    /// not reported again.
+    poisoned: Vec<String>,
 }
 
 fn engine_error(cx: &Ctxt, span: Span, e: SymbolicError) {
@@ -153,6 +156,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         time,
         frames: Vec::new(),
         points: Vec::new(),
+        poisoned: Vec::new(),
     };
     b.declare_symbols(ast);
     let zero = b.g.int(0).ok()?;
@@ -167,10 +171,18 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         pos: [zero; 3],
     });
     for f in &ast.frames {
+        let before = b.frames.len();
         b.add_frame(f);
+        if b.frames.len() == before {
+            b.poisoned.push(f.name.to_string());
+        }
     }
     for p in &ast.points {
+        let before = b.points.len();
         b.add_point(p);
+        if b.points.len() == before {
+            b.poisoned.push(p.name.to_string());
+        }
     }
     let bodies: Vec<Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
     let holonomic = ast
@@ -238,7 +250,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             effect,
         });
     }
-    let (speeds, speeds_span) = b.speeds(ast);
+    let (speeds, speeds_at) = b.speeds(ast);
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
             ast.name.span(),
@@ -254,7 +266,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         params: b.params,
         coords: b.coords,
         speeds,
-        speeds_span,
+        speeds_at,
         inputs: b.inputs,
         time: b.time,
         frames: b.frames,
@@ -349,10 +361,11 @@ impl Builder<'_> {
         }
     }
 
-    fn speeds(&mut self, ast: &ModelAst) -> (Vec<usize>, Span) {
-        let Some((list, span)) = &ast.speeds else {
+    fn speeds(&mut self, ast: &ModelAst) -> (Vec<usize>, proc_macro2::TokenStream) {
+        let Some((list, at)) = &ast.speeds else {
             self.cx.error_at(ast.name.span(), "the model declares no `speeds(...)`: name the coordinates whose rates are independent");
-            return (Vec::new(), ast.name.span());
+            let name = &ast.name;
+            return (Vec::new(), quote::quote!(#name));
         };
         let mut out = Vec::new();
         for s in list {
@@ -370,7 +383,7 @@ impl Builder<'_> {
                 }
             }
         }
-        (out, *span)
+        (out, at.clone())
     }
 
     fn all_names(&self) -> Vec<String> {
@@ -387,6 +400,9 @@ impl Builder<'_> {
         if let Some(i) = self.frames.iter().position(|f| f.name == name) {
             return Some(i);
         }
+        if self.poisoned.contains(&name) {
+            return None;
+        }
         let h = hint(&name, self.frames.iter().map(|f| f.name.clone()));
         self.cx
             .error_spanned_by(ident, format!("unknown frame `{name}`{h}"));
@@ -397,6 +413,9 @@ impl Builder<'_> {
         let name = ident.to_string();
         if let Some(p) = self.points.iter().find(|p| p.name == name) {
             return Some(p.pos);
+        }
+        if self.poisoned.contains(&name) {
+            return None;
         }
         let h = hint(&name, self.points.iter().map(|p| p.name.clone()));
         self.cx
@@ -565,10 +584,10 @@ impl Builder<'_> {
         match self.g.sub(l, r) {
             Ok(residual) => Some(Constraint {
                 residual,
-                span: c.span,
+                at: c.at.clone(),
             }),
             Err(e) => {
-                engine_error(self.cx, c.span, e);
+                self.cx.error_spanned_by(&c.at, e);
                 None
             }
         }
@@ -682,6 +701,9 @@ impl Builder<'_> {
         }
         if let Some(p) = self.points.iter().find(|p| p.name == name) {
             return Some(Val::Point(p.pos));
+        }
+        if self.poisoned.contains(&name) {
+            return None;
         }
         if self.frames.iter().any(|f| f.name == name) {
             self.cx.error_spanned_by(

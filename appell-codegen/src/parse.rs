@@ -78,6 +78,8 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
 struct Item {
     name: Ident,
     content: proc_macro2::TokenStream,
+    /// The whole `name(...)`, for errors.
+    all: proc_macro2::TokenStream,
     span: Span,
 }
 
@@ -87,10 +89,16 @@ impl syn::parse::Parse for Item {
         let content;
         let paren = syn::parenthesized!(content in input);
         let content: proc_macro2::TokenStream = content.parse()?;
-        let span = name.span().join(paren.span.close()).unwrap_or(name.span());
+        let span = name.span();
+        let mut all = quote::quote!(#name);
+        let group = proc_macro2::Group::new(proc_macro2::Delimiter::Parenthesis, content.clone());
+        let mut group = group;
+        group.set_span(paren.span.join());
+        all.extend(std::iter::once(proc_macro2::TokenTree::Group(group)));
         Ok(Item {
             name,
             content,
+            all,
             span,
         })
     }
@@ -123,9 +131,9 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
             "speeds" => {
                 let list = ident_list(tokens)?;
                 if ast.speeds.is_some() {
-                    cx.error_at(item.span, "`speeds` is given twice");
+                    cx.error_spanned_by(&item.all, "`speeds` is given twice");
                 }
-                ast.speeds = Some((list, item.span));
+                ast.speeds = Some((list, item.all.clone()));
             }
             "frame" => ast.frames.push(Parser::parse2(parse_frame, tokens)?),
             "point" => ast.points.push(Parser::parse2(parse_point, tokens)?),
@@ -144,8 +152,8 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
                 )?)
             }
             "holonomic" | "nonholonomic" => {
-                let span = item.span;
-                let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, span), tokens)?;
+                let at = item.content.clone();
+                let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, at), tokens)?;
                 if name == "holonomic" {
                     ast.holonomic.push(c)
                 } else {
@@ -341,13 +349,13 @@ fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {
     }
 }
 
-fn parse_constraint(s: ParseStream, span: Span) -> syn::Result<ConstraintDef> {
+fn parse_constraint(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<ConstraintDef> {
     let e: syn::Expr = s.parse()?;
     match &e {
         syn::Expr::Binary(b) if matches!(b.op, syn::BinOp::Eq(_)) => Ok(ConstraintDef {
             lhs: convert(&b.left)?,
             rhs: convert(&b.right)?,
-            span,
+            at,
         }),
         _ => Err(syn::Error::new(
             e.span(),
