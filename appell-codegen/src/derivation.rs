@@ -228,7 +228,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             .map(|s| model.g.symbol_name(s).to_string())
             .collect();
         if !bad.is_empty() {
-            cx.error_spanned_by(span,
+            cx.error_spanned_by(
+                span,
                 format!("a velocity constraint cannot depend on {}", bad.join(", ")),
             );
             continue;
@@ -236,7 +237,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         match model.g.linear_coefficients(*row, &rates) {
             Ok(form) => {
                 if form.coefficients.iter().all(|c| model.g.is_zero(*c)) {
-                    cx.error_spanned_by(span,
+                    cx.error_spanned_by(
+                        span,
                         "this constraint does not involve any coordinate rate",
                     );
                     continue;

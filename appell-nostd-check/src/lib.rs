@@ -27,7 +27,12 @@ pub struct CartPendulum {
 /// One explicit Euler step on `f32`, with fixed-size arrays only: the kind
 /// of loop a microcontroller runs. The cart position is cyclic, so the
 /// reduced state is (θ, ẋ, θ̇).
-pub fn euler_step(model: &CartPendulum, state: [f32; 3], push: f32, h: f32) -> Result<[f32; 3], ModelError> {
+pub fn euler_step(
+    model: &CartPendulum,
+    state: [f32; 3],
+    push: f32,
+    h: f32,
+) -> Result<[f32; 3], ModelError> {
     let prepared = model.prepare::<f32>();
     let mut d = [0.0f32; 3];
     model.rhs(&prepared, 0.0, &state, &[push], &mut d)?;
@@ -44,7 +49,12 @@ mod tests {
 
     #[test]
     fn hanging_at_rest_stays_at_rest() {
-        let m = CartPendulum { m_cart: 1.0, m_bob: 0.2, l: 0.5, g: 9.81 };
+        let m = CartPendulum {
+            m_cart: 1.0,
+            m_bob: 0.2,
+            l: 0.5,
+            g: 9.81,
+        };
         let s = euler_step(&m, [0.0; 3], 0.0, 0.01).unwrap();
         assert_eq!(s, [0.0; 3]);
         assert_eq!(CartPendulum::info().ignorable, &["x"]);
@@ -52,7 +62,12 @@ mod tests {
 
     #[test]
     fn a_push_accelerates_the_cart() {
-        let m = CartPendulum { m_cart: 1.0, m_bob: 0.2, l: 0.5, g: 9.81 };
+        let m = CartPendulum {
+            m_cart: 1.0,
+            m_bob: 0.2,
+            l: 0.5,
+            g: 9.81,
+        };
         let s = euler_step(&m, [0.0; 3], 1.2, 0.1).unwrap();
         // At rest with the rod vertical, ẍ = F / m_cart: the bob exerts no
         // horizontal force at that instant.

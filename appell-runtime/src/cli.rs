@@ -1,1 +1,765 @@
-//! CLI.
+//! The model command line every example gets: a stable, scriptable interface
+//! to a [`Model`].
+//!
+//! ```text
+//! <program>              run the example's own default action
+//! <program> eval         JSON states on stdin (one per line) -> rates on stdout
+//! <program> info         the model's metadata as JSON
+//! <program> equations    the derived reduced equations, as text
+//! <program> bench        time the generated rhs against the oracle, as JSON
+//! <program> help         usage (also -h, --help)
+//! ```
+//!
+//! An example's `main` is just
+//!
+//! ```no_run
+//! # use appell_runtime::Model;
+//! # fn demo<M: Model>(model: M) -> std::process::ExitCode {
+//! appell_runtime::cli::run(model, |model| {
+//!     // what the example does without a subcommand
+//!     Ok(())
+//! })
+//! # }
+//! ```
+//!
+//! Exit status: 0 on success (also when `eval` answered some lines with
+//! errors), 2 for a usage error (unknown subcommand or extra arguments), 1
+//! for any other failure.
+//!
+//! # `eval`
+//!
+//! Every non-empty line of stdin is one JSON object
+//!
+//! ```text
+//! {"t": 0.0, "params": {"a": 0.3}, "q": {"phi": 0.2, "x": 1.0}, "u": {"phi": 0.1}, "inputs": {"tau": 0.5}}
+//! ```
+//!
+//! * `q`: coordinates by name. Every [retained](ModelInfo::retained)
+//!   coordinate is required; the others default to 0 (their values do not
+//!   enter the reduced equations but are passed to
+//!   [`Model::coordinate_rates`]).
+//! * `u`: the privileged speeds, keyed by their coordinate's name
+//!   ([`ModelInfo::speeds`]); all are required.
+//! * `params`: parameters by name; omitted ones keep the model's values (the
+//!   values it had when the command started, for every line).
+//! * `inputs`: inputs by name; omitted ones are 0.
+//! * `t`: the time; 0 when omitted.
+//!
+//! Unknown fields or names, missing values, values that are not finite
+//! numbers, malformed JSON and any [`ModelError`] (for example a singular
+//! configuration) answer that line with `{"error": "..."}`; evaluation goes on
+//! with the next line. A good line is answered with
+//!
+//! ```text
+//! {"qdot": {<every coordinate>: rate}, "udot": {<every speed's coordinate>: acceleration}}
+//! ```
+//!
+//! where `qdot` comes from [`Model::coordinate_rates`] and `udot` from
+//! [`Model::rhs`] (after [`Model::prepare`]).
+//!
+//! # `info`
+//!
+//! One JSON object: `name`, `parameters` (a list of `{"name", "value"}` in
+//! declaration order, with the model's current values), `coordinates`,
+//! `speeds`, `dependent`, `cyclic`, `ignorable`, `retained`, `state` (the
+//! retained names then the speeds' names suffixed `_dot`), `inputs`,
+//! `effects`, `bodies` (a list of `{"name", "rigid"}`), `holonomic`,
+//! `constraints`, `force_points`, `torques`, `symbolic_elimination` and
+//! `rhs_ops` (`{"add", "mul", "div", "calls", "total"}`). See [`info_json`].
+//!
+//! # `bench`
+//!
+//! Times [`Model::rhs`] (prepared once) and the oracle's
+//! [`reduced_rhs`](crate::oracle::reduced_rhs) over 256 fixed pseudo-random
+//! states and prints `{"rhs_ns": .., "oracle_ns": .., "ops": .., "states": ..}`
+//! (nanoseconds per call, [`OpCounts::total`](crate::OpCounts::total) of the
+//! rhs, number of states used). See [`bench()`].
+
+use crate::model::{Model, ModelError, ModelInfo};
+use serde_json::{json, Map, Value};
+use std::error::Error;
+use std::hint::black_box;
+use std::io::{BufRead, Write};
+use std::process::ExitCode;
+use std::time::{Duration, Instant};
+
+/// Why the command line failed.
+#[derive(Debug)]
+pub enum CliError {
+    /// Unknown subcommand or unexpected arguments; holds the usage text.
+    Usage(String),
+    /// Reading stdin or writing stdout failed.
+    Io(std::io::Error),
+    /// The model could not report its parameters.
+    Model(ModelError),
+    /// `bench` found no state where both the rhs and the oracle succeed.
+    Bench(String),
+    /// The example's default action failed.
+    Action(Box<dyn Error>),
+}
+
+impl core::fmt::Display for CliError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            CliError::Usage(usage) => write!(f, "{usage}"),
+            CliError::Io(e) => write!(f, "i/o error: {e}"),
+            CliError::Model(e) => write!(f, "{e}"),
+            CliError::Bench(why) => write!(f, "bench: {why}"),
+            CliError::Action(e) => write!(f, "{e}"),
+        }
+    }
+}
+
+impl Error for CliError {
+    fn source(&self) -> Option<&(dyn Error + 'static)> {
+        match self {
+            CliError::Io(e) => Some(e),
+            CliError::Model(e) => Some(e),
+            CliError::Action(e) => Some(e.as_ref()),
+            CliError::Usage(_) | CliError::Bench(_) => None,
+        }
+    }
+}
+
+impl From<std::io::Error> for CliError {
+    fn from(e: std::io::Error) -> Self {
+        CliError::Io(e)
+    }
+}
+
+impl From<ModelError> for CliError {
+    fn from(e: ModelError) -> Self {
+        CliError::Model(e)
+    }
+}
+
+/// The usage text for `program` running model `info`.
+///
+/// ```
+/// # use appell_runtime::{ModelInfo, OpCounts};
+/// # let info = ModelInfo {
+/// #     name: "Pendulum", parameters: &[], coordinates: &[], speeds: &[], dependent: &[],
+/// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[],
+/// #     holonomic: 0, constraints: 0, bodies: &[], force_points: 0, torques: 0,
+/// #     symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
+/// # };
+/// let text = appell_runtime::cli::usage("pendulum", &info);
+/// assert!(text.starts_with("usage: pendulum [eval|info|equations|bench|help]"));
+/// assert!(text.contains("Pendulum"));
+/// ```
+pub fn usage(program: &str, info: &ModelInfo) -> String {
+    format!(
+        "usage: {program} [eval|info|equations|bench|help]\n\
+         \n\
+         Model `{name}`.\n\
+         \n\
+         Commands:\n\
+         \x20 (none)      run this program's default action\n\
+         \x20 eval        read JSON states from stdin, one per line, and print their rates:\n\
+         \x20             {{\"t\": 0, \"params\": {{..}}, \"q\": {{coordinate: value}},\n\
+         \x20              \"u\": {{speed coordinate: value}}, \"inputs\": {{..}}}}\n\
+         \x20             -> {{\"qdot\": {{..}}, \"udot\": {{..}}}} or {{\"error\": \"..\"}}\n\
+         \x20 info        print the model's metadata as JSON\n\
+         \x20 equations   print the derived equations\n\
+         \x20 bench       time the generated rhs against the oracle, print JSON\n\
+         \x20 help        print this text (also -h, --help)\n",
+        name = info.name
+    )
+}
+
+/// Runs the command line on the process's arguments, stdin and stdout, and
+/// returns the exit status (see the module documentation). Errors are
+/// printed to stderr, except a closed stdout (broken pipe), which ends the
+/// program quietly with status 1. Never panics on bad arguments or input; arguments that
+/// are not valid Unicode are converted lossily.
+pub fn run<M: Model>(
+    model: M,
+    default_action: impl FnOnce(&M) -> Result<(), Box<dyn Error>>,
+) -> ExitCode {
+    let args: Vec<String> = std::env::args_os()
+        .map(|a| a.to_string_lossy().into_owned())
+        .collect();
+    let stdin = std::io::stdin();
+    let mut input = stdin.lock();
+    let stdout = std::io::stdout();
+    let mut output = stdout.lock();
+    match run_with(model, &args, &mut input, &mut output, default_action) {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(CliError::Usage(text)) => {
+            eprint!("{text}");
+            ExitCode::from(2)
+        }
+        // The reader went away (`... | head`): stop quietly, like a tool
+        // killed by SIGPIPE would.
+        Err(CliError::Io(e)) if e.kind() == std::io::ErrorKind::BrokenPipe => ExitCode::FAILURE,
+        Err(e) => {
+            eprintln!("error: {e}");
+            ExitCode::FAILURE
+        }
+    }
+}
+
+/// The testable core of [`run`]: `args` is the whole argument list including
+/// the program name (an empty list is allowed), `stdin` and `stdout` are the
+/// streams the subcommands use.
+///
+/// `help` writes the usage to `stdout` and succeeds; an unknown subcommand
+/// or an extra argument is [`CliError::Usage`]; without a subcommand
+/// `default_action` is called.
+///
+/// ```
+/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Free { m: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Free", parameters: &["m"], coordinates: &["x"], speeds: &["x"],
+/// #     dependent: &[], cyclic: &[], ignorable: &["x"], retained: &[], inputs: &["f"],
+/// #     effects: &["push"], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+/// #     torques: 0, symbolic_elimination: true,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
+/// #     equations: "x'' = f/m",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Free {
+/// #     type Prepared<T: Scalar> = T;
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
+/// #         appell_runtime::check_len("out", out, 1)?; out[0] = self.m; Ok(())
+/// #     }
+/// #     fn set_parameter(&mut self, name: &str, v: f64) -> bool {
+/// #         if name == "m" { self.m = v; true } else { false }
+/// #     }
+/// #     fn prepare<T: Scalar>(&self) -> T { T::one() / T::from_f64(self.m) }
+/// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
+/// #         appell_runtime::check_len("state", s, 1)?; appell_runtime::check_len("dstate", ds, 1)?;
+/// #         appell_runtime::check_len("inputs", i, 1)?;
+/// #         ds[0] = i[0] * *p; Ok(())
+/// #     }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, q: &[T], u: &[T], qd: &mut [T]) -> Result<(), ModelError> {
+/// #         appell_runtime::check_len("q", q, 1)?; appell_runtime::check_len("u", u, 1)?;
+/// #         appell_runtime::check_len("qdot", qd, 1)?; qd[0] = u[0]; Ok(())
+/// #     }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// use appell_runtime::cli::{run_with, CliError};
+///
+/// let args: Vec<String> = ["free", "eval"].iter().map(|s| s.to_string()).collect();
+/// let mut stdin = &b"{\"q\": {}, \"u\": {\"x\": 1.5}, \"inputs\": {\"f\": 6.0}, \"params\": {\"m\": 2.0}}\n\
+///                    {\"u\": {\"x\": 1.5}, \"inputs\": {\"g\": 1.0}}\n"[..];
+/// let mut stdout = Vec::new();
+/// run_with(Free { m: 1.0 }, &args, &mut stdin, &mut stdout, |_| Ok(())).unwrap();
+/// let text = String::from_utf8(stdout).unwrap();
+/// let lines: Vec<&str> = text.lines().collect();
+/// assert_eq!(lines[0], r#"{"qdot":{"x":1.5},"udot":{"x":3.0}}"#);
+/// assert!(lines[1].starts_with(r#"{"error":"#));
+///
+/// let bad: Vec<String> = ["free", "frobnicate"].iter().map(|s| s.to_string()).collect();
+/// let err = run_with(Free { m: 1.0 }, &bad, &mut &b""[..], &mut Vec::new(), |_| Ok(()));
+/// assert!(matches!(err, Err(CliError::Usage(_))));
+/// ```
+pub fn run_with<M: Model>(
+    model: M,
+    args: &[String],
+    stdin: &mut dyn BufRead,
+    stdout: &mut dyn Write,
+    default_action: impl FnOnce(&M) -> Result<(), Box<dyn Error>>,
+) -> Result<(), CliError> {
+    let info = M::info();
+    let program = args.first().map(String::as_str).unwrap_or(info.name);
+    let rest = args.get(1..).unwrap_or(&[]);
+    let command = match rest {
+        [] => return default_action(&model).map_err(CliError::Action),
+        [command] => command.as_str(),
+        [command, extra, ..] => {
+            return Err(CliError::Usage(format!(
+                "unexpected argument `{extra}` after `{command}`\n{}",
+                usage(program, info)
+            )))
+        }
+    };
+    match command {
+        "eval" => {
+            let mut evaluator = Evaluator::new(model)?;
+            eval_stream(&mut evaluator, stdin, stdout)
+        }
+        "info" => {
+            writeln!(stdout, "{}", info_json(&model)?)?;
+            Ok(stdout.flush()?)
+        }
+        "equations" => {
+            let eq = info.equations;
+            if eq.ends_with('\n') {
+                write!(stdout, "{eq}")?;
+            } else {
+                writeln!(stdout, "{eq}")?;
+            }
+            Ok(stdout.flush()?)
+        }
+        "bench" => match bench(&model) {
+            Ok(report) => {
+                writeln!(stdout, "{}", report.to_json())?;
+                Ok(stdout.flush()?)
+            }
+            Err(e) => {
+                writeln!(stdout, "{}", json!({ "error": e.to_string() }))?;
+                stdout.flush()?;
+                Err(e)
+            }
+        },
+        "help" | "-h" | "--help" => {
+            write!(stdout, "{}", usage(program, info))?;
+            Ok(stdout.flush()?)
+        }
+        other => Err(CliError::Usage(format!(
+            "unknown command `{other}`\n{}",
+            usage(program, info)
+        ))),
+    }
+}
+
+/// Answers every non-empty line of `stdin` on `stdout`.
+fn eval_stream<M: Model>(
+    evaluator: &mut Evaluator<M>,
+    stdin: &mut dyn BufRead,
+    stdout: &mut dyn Write,
+) -> Result<(), CliError> {
+    let mut buf = Vec::new();
+    loop {
+        buf.clear();
+        if stdin.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        let answer = match std::str::from_utf8(&buf) {
+            Ok(line) if line.trim().is_empty() => continue,
+            Ok(line) => evaluator.eval_line(line),
+            Err(_) => json!({ "error": "the line is not valid UTF-8" }),
+        };
+        writeln!(stdout, "{answer}")?;
+        stdout.flush()?;
+    }
+    Ok(())
+}
+
+/// The metadata printed by `info` (layout in the module documentation).
+///
+/// ```
+/// # use appell_runtime::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Spin { i: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Spin", parameters: &["i"], coordinates: &["phi"], speeds: &["phi"],
+/// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["phi"], inputs: &["tau"],
+/// #     effects: &["motor"], holonomic: 0, constraints: 0,
+/// #     bodies: &[BodyInfo { name: "B", rigid: true }], force_points: 0, torques: 1,
+/// #     symbolic_elimination: true,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
+/// #     equations: "phi'' = tau/i",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Spin {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
+/// #         appell_runtime::check_len("out", out, 1)?; out[0] = self.i; Ok(())
+/// #     }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// let info = appell_runtime::cli::info_json(&Spin { i: 0.25 }).unwrap();
+/// assert_eq!(info["name"], "Spin");
+/// assert_eq!(info["parameters"][0]["value"], 0.25);
+/// assert_eq!(info["state"], serde_json::json!(["phi", "phi_dot"]));
+/// assert_eq!(info["rhs_ops"]["total"], 1);
+/// ```
+pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
+    let info = M::info();
+    let mut values = vec![0.0; info.parameters.len()];
+    model.parameter_values(&mut values)?;
+    let parameters: Vec<Value> = info
+        .parameters
+        .iter()
+        .zip(&values)
+        .map(|(name, value)| json!({ "name": name, "value": finite_or_null(*value) }))
+        .collect();
+    let state: Vec<String> = info
+        .retained
+        .iter()
+        .map(|r| r.to_string())
+        .chain(info.speeds.iter().map(|s| format!("{s}_dot")))
+        .collect();
+    let bodies: Vec<Value> = info
+        .bodies
+        .iter()
+        .map(|b| json!({ "name": b.name, "rigid": b.rigid }))
+        .collect();
+    let ops = info.rhs_ops;
+    Ok(json!({
+        "name": info.name,
+        "parameters": parameters,
+        "coordinates": info.coordinates,
+        "speeds": info.speeds,
+        "dependent": info.dependent,
+        "cyclic": info.cyclic,
+        "ignorable": info.ignorable,
+        "retained": info.retained,
+        "state": state,
+        "inputs": info.inputs,
+        "effects": info.effects,
+        "bodies": bodies,
+        "holonomic": info.holonomic,
+        "constraints": info.constraints,
+        "force_points": info.force_points,
+        "torques": info.torques,
+        "symbolic_elimination": info.symbolic_elimination,
+        "rhs_ops": {
+            "add": ops.add,
+            "mul": ops.mul,
+            "div": ops.div,
+            "calls": ops.calls,
+            "total": ops.total,
+        },
+    }))
+}
+
+/// A JSON number, or `null` for a value JSON cannot hold.
+fn finite_or_null(x: f64) -> Value {
+    serde_json::Number::from_f64(x).map_or(Value::Null, Value::Number)
+}
+
+/// Evaluates `eval` lines against a model (the state of the `eval`
+/// subcommand, usable on its own).
+///
+/// Every line starts from the parameter values the model had when the
+/// evaluator was created. The accepted format is described in the module
+/// documentation; see [`run_with`] for an example through the command line.
+pub struct Evaluator<M: Model> {
+    model: M,
+    defaults: Vec<f64>,
+}
+
+impl<M: Model> Evaluator<M> {
+    /// Takes the model and records its current parameter values.
+    pub fn new(model: M) -> Result<Self, ModelError> {
+        let mut defaults = vec![0.0; M::info().parameters.len()];
+        model.parameter_values(&mut defaults)?;
+        Ok(Evaluator { model, defaults })
+    }
+
+    /// The model (with the parameters of the last evaluated line).
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// Answers one line: `{"qdot": {..}, "udot": {..}}` or
+    /// `{"error": ".."}`.
+    pub fn eval_line(&mut self, line: &str) -> Value {
+        match self.try_eval(line) {
+            Ok(v) => v,
+            Err(message) => json!({ "error": message }),
+        }
+    }
+
+    fn try_eval(&mut self, line: &str) -> Result<Value, String> {
+        let info = M::info();
+        let value: Value =
+            serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
+        let Value::Object(obj) = value else {
+            return Err("expected a JSON object".to_string());
+        };
+        for key in obj.keys() {
+            if !["t", "params", "q", "u", "inputs"].contains(&key.as_str()) {
+                return Err(format!(
+                    "unknown field `{key}` (expected t, params, q, u, inputs)"
+                ));
+            }
+        }
+        let t = match obj.get("t") {
+            None => 0.0,
+            Some(v) => number(v, "`t`")?,
+        };
+        let params = named(obj.get("params"), "params", "parameter", info.parameters)?;
+        let q_given = named(obj.get("q"), "q", "coordinate", info.coordinates)?;
+        let u_given = named(obj.get("u"), "u", "privileged speed", info.speeds)?;
+        let inputs_given = named(obj.get("inputs"), "inputs", "input", info.inputs)?;
+
+        for (i, name) in info.parameters.iter().enumerate() {
+            let value = params[i].unwrap_or(self.defaults[i]);
+            if !self.model.set_parameter(name, value) {
+                return Err(format!("the model does not accept parameter `{name}`"));
+            }
+        }
+        for r in info.retained {
+            if info
+                .coordinate_index(r)
+                .is_some_and(|i| q_given[i].is_none())
+            {
+                return Err(format!("missing coordinate `{r}` in `q`"));
+            }
+        }
+        if let Some(k) = u_given.iter().position(Option::is_none) {
+            return Err(format!(
+                "missing privileged speed `{}` in `u`",
+                info.speeds[k]
+            ));
+        }
+        let q: Vec<f64> = q_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+        let u: Vec<f64> = u_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+        let inputs: Vec<f64> = inputs_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+
+        let mut state = Vec::with_capacity(info.state_len());
+        for r in info.retained {
+            let i = info
+                .coordinate_index(r)
+                .ok_or_else(|| format!("retained `{r}` is not a coordinate"))?;
+            state.push(q[i]);
+        }
+        state.extend_from_slice(&u);
+        let prepared = self.model.prepare::<f64>();
+        let mut dstate = vec![0.0; info.state_len()];
+        self.model
+            .rhs(&prepared, t, &state, &inputs, &mut dstate)
+            .map_err(|e| e.to_string())?;
+        let mut qdot = vec![0.0; info.coordinates.len()];
+        self.model
+            .coordinate_rates(t, &q, &u, &mut qdot)
+            .map_err(|e| e.to_string())?;
+
+        let mut qdot_out = Map::new();
+        for (name, v) in info.coordinates.iter().zip(&qdot) {
+            qdot_out.insert(name.to_string(), result_number(*v, name)?);
+        }
+        let mut udot_out = Map::new();
+        let udot = dstate.get(info.retained.len()..).unwrap_or(&[]);
+        for (name, v) in info.speeds.iter().zip(udot) {
+            udot_out.insert(name.to_string(), result_number(*v, name)?);
+        }
+        Ok(json!({ "qdot": qdot_out, "udot": udot_out }))
+    }
+}
+
+/// A finite JSON number from a value.
+fn number(v: &Value, what: &str) -> Result<f64, String> {
+    match v.as_f64() {
+        Some(x) if x.is_finite() => Ok(x),
+        Some(_) => Err(format!("{what} is not a finite number")),
+        None => Err(format!("{what} must be a number, found {v}")),
+    }
+}
+
+/// A finite result as a JSON number.
+fn result_number(x: f64, name: &str) -> Result<Value, String> {
+    serde_json::Number::from_f64(x)
+        .map(Value::Number)
+        .ok_or_else(|| format!("the result for `{name}` is not finite"))
+}
+
+/// Parses an optional object of named numbers; entry `i` of the result is the
+/// value given for `names[i]`.
+fn named(
+    v: Option<&Value>,
+    field: &str,
+    kind: &str,
+    names: &[&str],
+) -> Result<Vec<Option<f64>>, String> {
+    let mut out = vec![None; names.len()];
+    let Some(v) = v else { return Ok(out) };
+    let Value::Object(obj) = v else {
+        return Err(format!("`{field}` must be an object of {kind} values"));
+    };
+    for (key, value) in obj {
+        let i = names
+            .iter()
+            .position(|n| n == key)
+            .ok_or_else(|| format!("unknown {kind} `{key}` in `{field}`"))?;
+        out[i] = Some(number(value, &format!("`{field}.{key}`"))?);
+    }
+    Ok(out)
+}
+
+/// The result of [`bench()`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BenchReport {
+    /// Median nanoseconds per call of the generated [`Model::rhs`].
+    pub rhs_ns: f64,
+    /// Median nanoseconds per call of [`crate::oracle::reduced_rhs`].
+    pub oracle_ns: f64,
+    /// [`OpCounts::total`](crate::OpCounts::total) of the generated rhs.
+    pub ops: usize,
+    /// Number of states timed (those where both succeeded).
+    pub states: usize,
+}
+
+impl BenchReport {
+    /// `{"rhs_ns": .., "oracle_ns": .., "ops": .., "states": ..}`.
+    ///
+    /// ```
+    /// use appell_runtime::cli::BenchReport;
+    /// let r = BenchReport { rhs_ns: 12.5, oracle_ns: 4000.0, ops: 40, states: 256 };
+    /// assert_eq!(r.to_json()["oracle_ns"], 4000.0);
+    /// ```
+    pub fn to_json(&self) -> Value {
+        json!({
+            "rhs_ns": finite_or_null(self.rhs_ns),
+            "oracle_ns": finite_or_null(self.oracle_ns),
+            "ops": self.ops,
+            "states": self.states,
+        })
+    }
+}
+
+/// Number of benchmark states.
+pub const BENCH_STATES: usize = 256;
+/// Number of timed batches (the median is reported).
+pub const BENCH_BATCHES: usize = 15;
+/// Seed of the benchmark states.
+pub const BENCH_SEED: u64 = 0x00A9_9E11_5EED_2003;
+/// The shortest duration of one timed batch.
+const MIN_BATCH: Duration = Duration::from_millis(2);
+
+/// SplitMix64: a small deterministic generator.
+struct SplitMix(u64);
+
+impl SplitMix {
+    fn next_u64(&mut self) -> u64 {
+        self.0 = self.0.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        let mut z = self.0;
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        z ^ (z >> 31)
+    }
+
+    /// Uniform in [-1, 1).
+    fn symmetric(&mut self) -> f64 {
+        let unit = (self.next_u64() >> 11) as f64 / (1u64 << 53) as f64;
+        2.0 * unit - 1.0
+    }
+}
+
+struct BenchState {
+    q_full: Vec<f64>,
+    state: Vec<f64>,
+    u: Vec<f64>,
+    inputs: Vec<f64>,
+}
+
+/// Median nanoseconds per call of `pass` (which makes `calls` calls), after
+/// one warm-up pass, over [`BENCH_BATCHES`] batches of at least 2 ms each.
+fn time_per_call(calls: usize, mut pass: impl FnMut()) -> f64 {
+    let start = Instant::now();
+    pass();
+    let once = start.elapsed().max(Duration::from_nanos(1));
+    let reps = (MIN_BATCH.as_nanos() / once.as_nanos()).max(1) as usize + 1;
+    let mut samples: Vec<f64> = (0..BENCH_BATCHES)
+        .map(|_| {
+            let start = Instant::now();
+            for _ in 0..reps {
+                pass();
+            }
+            start.elapsed().as_nanos() as f64 / (reps * calls) as f64
+        })
+        .collect();
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
+/// Times the generated [`Model::rhs`] (with [`Model::prepare`] done once)
+/// and the oracle's [`reduced_rhs`](crate::oracle::reduced_rhs) over
+/// [`BENCH_STATES`] pseudo-random states from [`BENCH_SEED`]: every
+/// coordinate (ignorable ones included, for the oracle), every privileged
+/// speed and every input uniform in [-1, 1], t = 0. States where either
+/// fails are skipped; [`CliError::Bench`] when all fail.
+///
+/// The reported times are medians over [`BENCH_BATCHES`] batches, each
+/// repeating the whole set of states for at least 2 ms, after a warm-up.
+/// This takes a noticeable time (about 16 passes of the oracle over the
+/// states at least); a runnable example would be slow, so see the module
+/// documentation and the crate's tests.
+pub fn bench<M: Model>(model: &M) -> Result<BenchReport, CliError> {
+    let info = M::info();
+    let n = info.coordinates.len();
+    let mut retained = Vec::with_capacity(info.retained.len());
+    for r in info.retained {
+        retained.push(
+            info.coordinate_index(r)
+                .ok_or_else(|| CliError::Bench(format!("retained `{r}` is not a coordinate")))?,
+        );
+    }
+    let prepared = model.prepare::<f64>();
+    let mut rng = SplitMix(BENCH_SEED);
+    let mut states = Vec::with_capacity(BENCH_STATES);
+    let mut dstate = vec![0.0; info.state_len()];
+    let mut last_error = String::from("no states");
+    for _ in 0..BENCH_STATES {
+        let q_full: Vec<f64> = (0..n).map(|_| rng.symmetric()).collect();
+        let u: Vec<f64> = info.speeds.iter().map(|_| rng.symmetric()).collect();
+        let inputs: Vec<f64> = info.inputs.iter().map(|_| rng.symmetric()).collect();
+        let mut state: Vec<f64> = retained.iter().map(|&i| q_full[i]).collect();
+        state.extend_from_slice(&u);
+        let rhs = model.rhs(&prepared, 0.0, &state, &inputs, &mut dstate);
+        let oracle = crate::oracle::reduced_rhs(model, 0.0, &q_full, &u, &inputs);
+        match (rhs, oracle) {
+            (Ok(()), Ok(_)) if dstate.iter().all(|x| x.is_finite()) => states.push(BenchState {
+                q_full,
+                state,
+                u,
+                inputs,
+            }),
+            (Err(e), _) => last_error = format!("rhs: {e}"),
+            (_, Err(e)) => last_error = format!("oracle: {e}"),
+            (Ok(()), Ok(_)) => last_error = "rhs: the result is not finite".to_string(),
+        }
+    }
+    if states.is_empty() {
+        return Err(CliError::Bench(format!(
+            "no state where both the rhs and the oracle succeed (last error: {last_error})"
+        )));
+    }
+
+    let rhs_ns = time_per_call(states.len(), || {
+        for s in &states {
+            let r = model.rhs(
+                black_box(&prepared),
+                black_box(0.0),
+                black_box(&s.state),
+                black_box(&s.inputs),
+                black_box(&mut dstate),
+            );
+            let _ = black_box((r, &dstate));
+        }
+    });
+    let oracle_ns = time_per_call(states.len(), || {
+        for s in &states {
+            let r = crate::oracle::reduced_rhs(
+                model,
+                black_box(0.0),
+                black_box(&s.q_full),
+                black_box(&s.u),
+                black_box(&s.inputs),
+            );
+            let _ = black_box(r);
+        }
+    });
+    Ok(BenchReport {
+        rhs_ns,
+        oracle_ns,
+        ops: info.rhs_ops.total,
+        states: states.len(),
+    })
+}

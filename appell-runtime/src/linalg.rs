@@ -5,6 +5,10 @@
 //!
 //! Singular systems are reported as [`ModelError`]s, never as NaN.
 
+// Index loops mirror the textbook elimination formulas (rows, columns,
+// pivots); iterator chains would hide which entry is which.
+#![allow(clippy::needless_range_loop)]
+
 use crate::model::ModelError;
 use crate::scalar::Scalar;
 
@@ -126,7 +130,7 @@ pub fn ldlt_solve<T: Scalar, const N: usize>(
             dj -= l[j][k] * l[j][k] * d[k];
         }
         let pivot = dj.re();
-        if !(pivot > tol) {
+        if pivot.is_nan() || pivot <= tol {
             return Err(ModelError::SingularMassMatrix { index: j, pivot });
         }
         d[j] = dj;

@@ -197,7 +197,8 @@ impl Lowering<'_> {
     /// denominator. A negative coefficient is folded into the parameter-only
     /// value when there is one, else applied as a negation.
     fn product(&mut self, coeff: Number, factors: &[(Id, i32)]) -> u32 {
-        let (params, others): (Vec<(Id, i32)>, Vec<(Id, i32)>) = factors
+        type Factors = Vec<(Id, i32)>;
+        let (params, others): (Factors, Factors) = factors
             .iter()
             .copied()
             .partition(|&(b, _)| self.graph.is_parameter_only(b));
@@ -207,7 +208,7 @@ impl Lowering<'_> {
             let mut num = Vec::new();
             let mut den = Vec::new();
             if let Some(k) = k {
-                if !(k.is_one() && !k.is_float()) {
+                if !k.is_one() || k.is_float() {
                     num.push(l.constant(k));
                 }
             }

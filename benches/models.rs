@@ -1,0 +1,128 @@
+//! Generated reduced rhs against the multiplier oracle, and the expansion
+//! time of `#[derive(Appell)]`, for each example model.
+//!
+//! Run: `cargo bench --bench models`.
+
+#[path = "../examples/models/double_pendulum.rs"]
+mod double_pendulum;
+#[path = "../examples/models/wheel_axle.rs"]
+mod wheel_axle;
+
+use std::hint::black_box;
+use std::time::Instant;
+
+use appell::oracle::reduced_rhs;
+use appell::Model;
+use criterion::{criterion_group, criterion_main, Criterion};
+
+/// The `#[derive(Appell)]` struct of a model file, as a derive input.
+fn derive_input(source: &str) -> syn::DeriveInput {
+    let start = source.find("#[derive(Appell").expect("derive");
+    let end = source.find("impl Default").expect("impl Default");
+    syn::parse_str(&source[start..end]).expect("struct")
+}
+
+/// Fixed states in [-1, 1] (deterministic) for the retained coordinates and
+/// speeds, with full coordinates for the oracle.
+fn states<M: Model>(count: usize) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+    let info = M::info();
+    let mut seed = 0x1234_5678_9abc_def0u64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    (0..count)
+        .map(|_| {
+            let q: Vec<f64> = info.coordinates.iter().map(|_| next()).collect();
+            let u: Vec<f64> = info.speeds.iter().map(|_| next()).collect();
+            let mut s: Vec<f64> = info
+                .retained
+                .iter()
+                .map(|c| q[info.coordinate_index(c).unwrap()])
+                .collect();
+            s.extend(&u);
+            (s, q, u)
+        })
+        .collect()
+}
+
+fn bench_model<M: Model>(c: &mut Criterion, name: &str, model: &M, source: &str) {
+    let info = M::info();
+    let inputs = vec![0.1; info.inputs.len()];
+    let prepared = model.prepare::<f64>();
+    let set = states::<M>(64);
+    let mut d = vec![0.0; info.state_len()];
+    let mut group = c.benchmark_group(name);
+    group.bench_function("rhs generated (per call)", |b| {
+        b.iter(|| {
+            for (s, _, _) in &set {
+                model
+                    .rhs(&prepared, 0.0, black_box(s), &inputs, &mut d)
+                    .unwrap();
+            }
+            black_box(&d);
+        })
+    });
+    group.bench_function("rhs oracle (per call)", |b| {
+        b.iter(|| {
+            for (_, q, u) in &set {
+                black_box(reduced_rhs(model, 0.0, black_box(q), u, &inputs).unwrap());
+            }
+        })
+    });
+    let input = derive_input(source);
+    group.bench_function("derive expansion", |b| {
+        b.iter(|| appell_codegen::expand(black_box(&input)))
+    });
+    group.finish();
+    // One summary line measured side by side (criterion's numbers above are
+    // per batch of 64 states).
+    let t = Instant::now();
+    let reps = 2000;
+    for _ in 0..reps {
+        for (s, _, _) in &set {
+            model
+                .rhs(&prepared, 0.0, black_box(s), &inputs, &mut d)
+                .unwrap();
+        }
+    }
+    let rhs_ns = t.elapsed().as_secs_f64() * 1e9 / (reps * set.len()) as f64;
+    let t = Instant::now();
+    let reps = 20;
+    for _ in 0..reps {
+        for (_, q, u) in &set {
+            black_box(reduced_rhs(model, 0.0, black_box(q), u, &inputs).unwrap());
+        }
+    }
+    let oracle_ns = t.elapsed().as_secs_f64() * 1e9 / (reps * set.len()) as f64;
+    let t = Instant::now();
+    for _ in 0..20 {
+        black_box(appell_codegen::expand(&input));
+    }
+    let expand_ms = t.elapsed().as_secs_f64() * 1e3 / 20.0;
+    println!(
+        "{name}: {} ops, rhs {rhs_ns:.1} ns, oracle {oracle_ns:.0} ns ({:.0}x), derive expansion {expand_ms:.2} ms",
+        info.rhs_ops.total,
+        oracle_ns / rhs_ns
+    );
+}
+
+fn bench(c: &mut Criterion) {
+    bench_model(
+        c,
+        "wheel_axle",
+        &wheel_axle::WheelAxle::default(),
+        include_str!("../examples/models/wheel_axle.rs"),
+    );
+    bench_model(
+        c,
+        "double_pendulum",
+        &double_pendulum::DoublePendulum::default(),
+        include_str!("../examples/models/double_pendulum.rs"),
+    );
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
