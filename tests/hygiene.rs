@@ -52,11 +52,17 @@ mod shadowed {
 #[test]
 fn shadowed_models_compile_and_run() {
     use appell::Model;
-    let s = shadowed::Sleigh { m: 1.0, i0: 0.2, b: 0.3 };
+    let s = shadowed::Sleigh {
+        m: 1.0,
+        i0: 0.2,
+        b: 0.3,
+    };
     let mut d = [0.0; 3];
-    s.rhs(&s.prepare::<f64>(), 0.0, &[0.1, 1.0, 0.5], &[], &mut d).unwrap();
+    s.rhs(&s.prepare::<f64>(), 0.0, &[0.1, 1.0, 0.5], &[], &mut d)
+        .unwrap();
     let b = shadowed::Block { m: 2.0 };
     let mut d = [0.0; 1];
-    b.rhs(&b.prepare::<f64>(), 0.0, &[0.0], &[3.0], &mut d).unwrap();
+    b.rhs(&b.prepare::<f64>(), 0.0, &[0.0], &[3.0], &mut d)
+        .unwrap();
     assert_eq!(d[0], 1.5);
 }

@@ -5,22 +5,13 @@
 #[path = "../examples/models/wheel_axle.rs"]
 mod wheel_axle;
 
+mod common;
+#[path = "../examples/models/double_pendulum.rs"]
+mod double_pendulum;
 use appell::oracle::reduced_rhs;
 use appell::{Appell, Model};
-
-#[derive(Appell, Clone)]
-#[appell(coordinates(q1, q2), speeds(q1, q2))]
-#[appell(point(P1 = O + l1 * sin(q1) * N.x - l1 * cos(q1) * N.y))]
-#[appell(point(P2 = P1 + l2 * sin(q2) * N.x - l2 * cos(q2) * N.y))]
-#[appell(particle(P1, mass = m1), particle(P2, mass = m2))]
-#[appell(gravity(-g * N.y))]
-struct DoublePendulum {
-    m1: f64,
-    m2: f64,
-    l1: f64,
-    l2: f64,
-    g: f64,
-}
+use common::Rng;
+use double_pendulum::DoublePendulum;
 
 /// A knife edge with an offset mass centre, a drive force along the blade
 /// and a steering torque, so forces, torques and the nonholonomic
@@ -58,17 +49,6 @@ struct SwingingArm {
     i12: f64,
     i23: f64,
     i31: f64,
-}
-
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
-        lo + (hi - lo) * x as f64 / (1u64 << 53) as f64
-    }
 }
 
 /// Compares generated and oracle reduced rhs at `count` random states;

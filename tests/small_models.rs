@@ -3,23 +3,12 @@
 //! pivot that can vanish, so it is solved numerically at run time), and a
 //! pendulum in Cartesian coordinates (a holonomic constraint).
 
+mod common;
+#[path = "../examples/models/double_pendulum.rs"]
+mod double_pendulum;
 use appell::{Appell, Model, ModelError};
-
-/// Point masses at the ends of massless links, absolute angles from the
-/// downward vertical.
-#[derive(Appell, Clone)]
-#[appell(coordinates(q1, q2), speeds(q1, q2))]
-#[appell(point(P1 = O + l1 * sin(q1) * N.x - l1 * cos(q1) * N.y))]
-#[appell(point(P2 = P1 + l2 * sin(q2) * N.x - l2 * cos(q2) * N.y))]
-#[appell(particle(P1, mass = m1), particle(P2, mass = m2))]
-#[appell(gravity(-g * N.y))]
-pub struct DoublePendulum {
-    pub m1: f64,
-    pub m2: f64,
-    pub l1: f64,
-    pub l2: f64,
-    pub g: f64,
-}
+use common::{close, Rng};
+use double_pendulum::DoublePendulum;
 
 /// A rigid body on a knife edge at P = (x, y), heading θ, mass centre a
 /// distance `b` ahead of the edge; the edge cannot slide sideways.
@@ -45,21 +34,6 @@ pub struct CartesianPendulum {
     pub m: f64,
     pub l: f64,
     pub g: f64,
-}
-
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
-        lo + (hi - lo) * x as f64 / (1u64 << 53) as f64
-    }
-}
-
-fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * (1.0 + a.abs().max(b.abs()))
 }
 
 #[test]

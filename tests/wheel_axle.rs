@@ -5,20 +5,10 @@
 #[path = "../examples/models/wheel_axle.rs"]
 mod model;
 
+mod common;
 use appell::Model;
+use common::{close, Rng};
 use model::WheelAxle;
-
-/// A small deterministic generator (xorshift64*), so failures reproduce.
-struct Rng(u64);
-impl Rng {
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 >> 12;
-        self.0 ^= self.0 << 25;
-        self.0 ^= self.0 >> 27;
-        let x = self.0.wrapping_mul(0x2545_f491_4f6c_dd1d) >> 11;
-        lo + (hi - lo) * x as f64 / (1u64 << 53) as f64
-    }
-}
 
 fn random_model(rng: &mut Rng) -> WheelAxle {
     WheelAxle {
@@ -48,10 +38,6 @@ fn eq64(p: &WheelAxle, phi: f64, tau: f64) -> (f64, f64) {
     let psi = (b1 * a22 - a12 * b2) / det;
     let phi_dd = (a11 * b2 - b1 * a21) / det;
     (phi_dd, psi)
-}
-
-fn close(a: f64, b: f64, rel: f64) -> bool {
-    (a - b).abs() <= rel * (1.0 + a.abs().max(b.abs()))
 }
 
 #[test]

@@ -3,7 +3,7 @@
 //! Every node is stored once (hash-consing). A node's children are always
 //! earlier entries of the arena, so the arena order is a topological order and
 //! structural equality is identity of [`Id`]s. Nodes are built only through the
-//! canonicalizing constructors in [`crate::construct`], so every stored node is
+//! canonicalizing constructors (the `construct` module), so every stored node is
 //! in canonical form.
 
 use std::collections::HashMap;
