@@ -508,8 +508,8 @@ impl Builder<'_> {
                     e = g.add(e, c)?;
                 }
                 // [û]× entries: (i, j) = −ε_ijk û_k
-                let k = 3 - i - j;
                 if i != j {
+                    let k = 3 - i - j;
                     let sign = if (i + 1) % 3 == j { -1 } else { 1 };
                     let t = g.mul(s, uh[k])?;
                     let t = g.scale(t, Number::int(sign))?;

@@ -10,5 +10,25 @@ use proc_macro::TokenStream;
 #[proc_macro_derive(Appell, attributes(appell))]
 pub fn derive_appell(input: TokenStream) -> TokenStream {
     let input = syn::parse_macro_input!(input as syn::DeriveInput);
-    appell_codegen::expand(&input).into()
+    // A bug in the derivation must not crash the user's build with a bare
+    // panic: report it as a compile error on the struct.
+    let span = input.ident.span();
+    match std::panic::catch_unwind(|| appell_codegen::expand(&input)) {
+        Ok(tokens) => tokens.into(),
+        Err(payload) => {
+            let what = payload
+                .downcast_ref::<&str>()
+                .map(|s| s.to_string())
+                .or_else(|| payload.downcast_ref::<String>().cloned())
+                .unwrap_or_else(|| "unknown panic".into());
+            syn::Error::new(
+                span,
+                format!(
+                    "appell internal error while deriving this model: {what}; please report it"
+                ),
+            )
+            .to_compile_error()
+            .into()
+        }
+    }
 }
