@@ -60,17 +60,18 @@ pub enum RotationAxis {
     Vector(Expr),
 }
 
-/// `frame(A = P.rotate_z(angle))`.
+/// `frame(A = P.rotate_z(angle))`, or a three-angle body sequence
+/// `frame(A = P.body_zxy(a, b, c))` (successive rotations about the new
+/// frame's own axes; the intermediate frames are anonymous).
 #[derive(Clone, Debug)]
 pub struct FrameDef {
     /// The new frame.
     pub name: Ident,
     /// The frame it is rotated from.
     pub parent: Ident,
-    /// The rotation axis.
-    pub axis: RotationAxis,
-    /// The rotation angle.
-    pub angle: Expr,
+    /// The rotations, applied in order, each about the axis of the frame
+    /// produced by the previous one.
+    pub rotations: Vec<(RotationAxis, Expr)>,
 }
 
 /// `point(P = Q + vector)`.
@@ -131,6 +132,22 @@ pub struct LoadDef {
     pub effect: Ident,
 }
 
+/// `rolls(body, contact = P)` or `rolls(body, contact = P, along = [u, v])`:
+/// the body's material point at P has zero velocity (along the given
+/// directions only, when given).
+#[derive(Clone, Debug)]
+pub struct RollsDef {
+    /// The rolling body.
+    pub body: Ident,
+    /// The contact point.
+    pub contact: Ident,
+    /// Directions of the velocity components constrained (default: N.x,
+    /// N.y, N.z, identically zero ones dropped).
+    pub along: Option<Vec<Expr>>,
+    /// The item's tokens, for errors.
+    pub at: proc_macro2::TokenStream,
+}
+
 /// The whole model as written.
 #[derive(Clone, Debug)]
 pub struct ModelAst {
@@ -162,4 +179,6 @@ pub struct ModelAst {
     pub torques: Vec<LoadDef>,
     /// `gravity(vector)`.
     pub gravity: Option<Expr>,
+    /// `rolls(body, contact = P)`.
+    pub rolls: Vec<RollsDef>,
 }

@@ -212,8 +212,46 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     for c in &model.nonholonomic {
         rows.push((c.residual, c.at.clone(), false));
     }
+    // Rolling: v(material point at P) = v(centre) + ω × (P − centre) = 0.
+    for r in &model.rolling {
+        let body = &model.bodies[r.body];
+        let omega = model.frames[body.frame.expect("rigid")].omega;
+        let g = &mut model.g;
+        let mut v = [body.center[0]; 3];
+        let mut arm = [body.center[0]; 3];
+        for i in 0..3 {
+            v[i] = g.time_derivative(body.center[i], &rules)?;
+            arm[i] = g.sub(r.contact[i], body.center[i])?;
+        }
+        let w = cross(g, omega, arm)?;
+        for i in 0..3 {
+            let sum = g.add(v[i], w[i])?;
+            v[i] = expanded(g, sum)?;
+        }
+        let components: Vec<Id> = match &r.along {
+            Some(dirs) => dirs
+                .iter()
+                .map(|d| dot(g, v, *d).and_then(|e| expanded(g, e)))
+                .collect::<Result<_, _>>()?,
+            None => v.to_vec(),
+        };
+        let before = rows.len();
+        for (k, c) in components.into_iter().enumerate() {
+            if g.is_zero(c) {
+                if r.along.is_some() {
+                    cx.error_spanned_by(&r.at, format!("the velocity component along direction {} is identically zero: that direction constrains nothing", k + 1));
+                }
+                continue;
+            }
+            rows.push((c, r.at.clone(), false));
+        }
+        if rows.len() == before && r.along.is_none() {
+            cx.error_spanned_by(&r.at, "this rolling contact constrains nothing: the contact point's velocity is identically zero");
+        }
+    }
     let mut d_rows = Vec::new();
     let mut d0 = Vec::new();
+    let mut row_sources = Vec::new();
     for (row, span, holo) in &rows {
         let bad: Vec<String> = model
             .g
@@ -245,6 +283,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 }
                 d_rows.extend(form.coefficients);
                 d0.push(form.remainder);
+                row_sources.push(span.clone());
             }
             Err(SymbolicError::NonLinear { symbol, .. }) => {
                 let what = if *holo {
@@ -265,6 +304,13 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }
     let m = d0.len();
     let l = model.speeds.len();
+    if let Some(row) = dependent_row(&model.g, &d_rows, n, m) {
+        cx.error_spanned_by(
+            &row_sources[row],
+            "this constraint row is a linear combination of the others (the velocity constraints are linearly dependent); drop it, or give a rolling contact `along = [...]` directions",
+        );
+        return Ok(None);
+    }
     if l + m != n {
         cx.error_spanned_by(
             &model.speeds_at,
@@ -716,6 +762,62 @@ fn mat_t_vec(g: &mut appell_symbolic::Graph, r: &Mat3, v: Vec3) -> Result<Vec3, 
 /// I v.
 fn mat_vec(g: &mut appell_symbolic::Graph, m: &Mat3, v: Vec3) -> Result<Vec3, SymbolicError> {
     Ok([dot(g, m[0], v)?, dot(g, m[1], v)?, dot(g, m[2], v)?])
+}
+
+/// The first row of D that is numerically a combination of the rows before
+/// it at every one of three pseudo-random configurations (parameters in
+/// [0.5, 1.5], coordinates and rates in [−1, 1]). A dependence that holds only
+/// at special configurations is not reported.
+fn dependent_row(g: &appell_symbolic::Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
+    if m < 2 {
+        return None;
+    }
+    let tape = appell_symbolic::Tape::new(g, d);
+    let mut first_dependent: Option<usize> = None;
+    let mut trials = 0;
+    for trial in 0..6u64 {
+        let value = |s: Symbol| {
+            let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            h ^= h >> 31;
+            let u = (h >> 11) as f64 / (1u64 << 53) as f64;
+            Some(match g.symbol_kind(s) {
+                SymbolKind::Parameter => 0.5 + u,
+                _ => 2.0 * u - 1.0,
+            })
+        };
+        let Ok(vals) = tape.eval(&value) else {
+            continue;
+        };
+        trials += 1;
+        // Incremental Gram–Schmidt rank test, row by row.
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut dep = None;
+        for r in 0..m {
+            let mut v: Vec<f64> = vals[r * n..(r + 1) * n].to_vec();
+            let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            for b in &basis {
+                let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+                for (x, y) in v.iter_mut().zip(b) {
+                    *x -= p * y;
+                }
+            }
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm <= 1e-9 * norm0.max(1e-300) {
+                dep = Some(r);
+                break;
+            }
+            basis.push(v.iter().map(|x| x / norm).collect());
+        }
+        match dep {
+            None => return None,
+            Some(r) => first_dependent = Some(first_dependent.map_or(r, |f: usize| f.min(r))),
+        }
+        if trials == 3 {
+            break;
+        }
+    }
+    first_dependent
 }
 
 /// A column of D' (dependent rate) that no row can be matched to, by

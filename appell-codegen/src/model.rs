@@ -74,6 +74,19 @@ pub struct Load {
     pub effect: String,
 }
 
+/// `rolls(...)`: the material point of a body at a contact point has zero
+/// velocity.
+pub struct Rolling {
+    /// Index of the body in [`Model::bodies`].
+    pub body: usize,
+    /// Position of the contact point.
+    pub contact: Vec3,
+    /// Directions constrained (None: N.x, N.y, N.z, zero rows dropped).
+    pub along: Option<Vec<Vec3>>,
+    /// The item's tokens, for errors.
+    pub at: proc_macro2::TokenStream,
+}
+
 /// A constraint residual with its source span.
 pub struct Constraint {
     /// `lhs - rhs`.
@@ -110,6 +123,8 @@ pub struct Model {
     pub holonomic: Vec<Constraint>,
     /// Nonholonomic constraints, linear in the rates.
     pub nonholonomic: Vec<Constraint>,
+    /// Rolling contacts.
+    pub rolling: Vec<Rolling>,
     /// Forces.
     pub forces: Vec<Load>,
     /// Torques.
@@ -250,6 +265,45 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             effect,
         });
     }
+    let mut rolling = Vec::new();
+    for r in &ast.rolls {
+        let name = r.body.to_string();
+        let Some(bi) = bodies.iter().position(|x| x.name == name) else {
+            let h = hint(&name, bodies.iter().map(|x| x.name.clone()));
+            cx.error_spanned_by(&r.body, format!("unknown body `{name}`{h}"));
+            continue;
+        };
+        if bodies[bi].frame.is_none() {
+            cx.error_spanned_by(
+                &r.body,
+                format!("`{name}` is a particle; only a rigid body rolls"),
+            );
+            continue;
+        }
+        let Some(contact) = b.point_named(&r.contact) else {
+            continue;
+        };
+        let along = match &r.along {
+            Some(list) => {
+                let dirs: Vec<Vec3> = list.iter().filter_map(|e| b.vector(e)).collect();
+                if dirs.len() != list.len() {
+                    continue;
+                }
+                if dirs.is_empty() {
+                    cx.error_spanned_by(&r.at, "`along` needs at least one direction");
+                    continue;
+                }
+                Some(dirs)
+            }
+            None => None,
+        };
+        rolling.push(Rolling {
+            body: bi,
+            contact,
+            along,
+            at: r.at.clone(),
+        });
+    }
     let (speeds, speeds_at) = b.speeds(ast);
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
@@ -274,6 +328,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         bodies,
         holonomic,
         nonholonomic,
+        rolling,
         forces,
         torques,
         effects,
@@ -427,28 +482,36 @@ impl Builder<'_> {
         let Some(pi) = self.frame_named(&f.parent) else {
             return;
         };
-        let Some(angle) = self.scalar(&f.angle) else {
-            return;
-        };
-        let parent_rot = self.frames[pi].rot;
-        let parent_omega = self.frames[pi].omega;
-        let result = match &f.axis {
-            RotationAxis::Parent(k) => {
-                self.parent_axis_rotation(*k, angle, parent_rot, parent_omega)
+        let mut rot = self.frames[pi].rot;
+        let mut omega = self.frames[pi].omega;
+        // Each rotation is about an axis of the frame the previous one made.
+        for (axis, angle_expr) in &f.rotations {
+            let Some(angle) = self.scalar(angle_expr) else {
+                return;
+            };
+            let result = match axis {
+                RotationAxis::Parent(k) => self.parent_axis_rotation(*k, angle, rot, omega),
+                RotationAxis::Vector(v) => {
+                    let Some(u) = self.vector(v) else { return };
+                    self.axis_rotation(u, angle, rot, omega)
+                }
+            };
+            match result {
+                Ok((r, w)) => {
+                    rot = r;
+                    omega = w;
+                }
+                Err(e) => {
+                    engine_error(self.cx, angle_expr.span(), e);
+                    return;
+                }
             }
-            RotationAxis::Vector(v) => {
-                let Some(u) = self.vector(v) else { return };
-                self.axis_rotation(u, angle, parent_rot, parent_omega)
-            }
-        };
-        match result {
-            Ok((rot, omega)) => self.frames.push(Frame {
-                name: f.name.to_string(),
-                rot,
-                omega,
-            }),
-            Err(e) => engine_error(self.cx, f.angle.span(), e),
         }
+        self.frames.push(Frame {
+            name: f.name.to_string(),
+            rot,
+            omega,
+        });
     }
 
     /// Rotation about the parent's axis `k`: R = R_parent Rk(θ),

@@ -27,6 +27,7 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
         forces: Vec::new(),
         torques: Vec::new(),
         gravity: None,
+        rolls: Vec::new(),
     };
     match &input.data {
         syn::Data::Struct(s) => match &s.fields {
@@ -118,6 +119,7 @@ const ITEMS: &[&str] = &[
     "force",
     "torque",
     "gravity",
+    "rolls",
 ];
 
 fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
@@ -162,6 +164,13 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
             }
             "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
             "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
+            "rolls" => {
+                let at = item.all.clone();
+                ast.rolls.push(Parser::parse2(
+                    move |s: ParseStream| parse_rolls(s, at),
+                    tokens,
+                )?)
+            }
             "gravity" => {
                 let e: syn::Expr = syn::parse2(tokens)?;
                 if ast.gravity.is_some() {
@@ -213,29 +222,76 @@ fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
         })?;
     let args: Vec<&syn::Expr> = call.args.iter().collect();
     let method = call.method.to_string();
-    let (axis, angle) = match (method.as_str(), args.as_slice()) {
-        ("rotate_x", [a]) => (RotationAxis::Parent(0), convert(a)?),
-        ("rotate_y", [a]) => (RotationAxis::Parent(1), convert(a)?),
-        ("rotate_z", [a]) => (RotationAxis::Parent(2), convert(a)?),
-        ("rotate", [v, a]) => (RotationAxis::Vector(convert(v)?), convert(a)?),
+    let axis_of = |c: char| match c {
+        'x' => Some(0),
+        'y' => Some(1),
+        'z' => Some(2),
+        _ => None,
+    };
+    let rotations = match (method.as_str(), args.as_slice()) {
+        ("rotate_x", [a]) => vec![(RotationAxis::Parent(0), convert(a)?)],
+        ("rotate_y", [a]) => vec![(RotationAxis::Parent(1), convert(a)?)],
+        ("rotate_z", [a]) => vec![(RotationAxis::Parent(2), convert(a)?)],
+        ("rotate", [v, a]) => vec![(RotationAxis::Vector(convert(v)?), convert(a)?)],
         ("rotate_x" | "rotate_y" | "rotate_z", _) => {
             return Err(syn::Error::new(call.span(), format!("`{method}` takes one argument: the angle")))
         }
         ("rotate", _) => {
             return Err(syn::Error::new(call.span(), "`rotate` takes two arguments: the axis vector and the angle"))
         }
+        (m, _) if m.starts_with("body_") && m.len() == 8 && m[5..].chars().all(|c| axis_of(c).is_some()) => {
+            if args.len() != 3 {
+                return Err(syn::Error::new(call.span(), format!("`{method}` takes three angles")));
+            }
+            let axes: Vec<usize> = m[5..].chars().filter_map(axis_of).collect();
+            if axes[0] == axes[1] || axes[1] == axes[2] {
+                return Err(syn::Error::new(call.method.span(), "consecutive rotations of a body sequence must be about different axes"));
+            }
+            axes.into_iter()
+                .zip(args)
+                .map(|(k, a)| Ok((RotationAxis::Parent(k), convert(a)?)))
+                .collect::<syn::Result<_>>()?
+        }
         _ => {
             return Err(syn::Error::new(
                 call.method.span(),
-                format!("unknown rotation `{method}`; use rotate_x, rotate_y, rotate_z or rotate(axis, angle)"),
+                format!("unknown rotation `{method}`; use rotate_x, rotate_y, rotate_z, rotate(axis, angle) or a body sequence such as body_zxy(a, b, c)"),
             ))
         }
     };
     Ok(FrameDef {
         name,
         parent,
-        axis,
-        angle,
+        rotations,
+    })
+}
+
+fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<RollsDef> {
+    let body: Ident = s.parse()?;
+    let (mut contact, mut along) = (None, None);
+    for (k, v) in key_values(s)? {
+        match k.to_string().as_str() {
+            "contact" => contact = Some(expr_ident(&v)?),
+            "along" => match &v {
+                syn::Expr::Array(a) => along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?),
+                other => return Err(syn::Error::new(other.span(), "`along` takes a list of directions: `along = [A.x, A.y]`")),
+            },
+            other => {
+                return Err(syn::Error::new(k.span(), format!("unknown rolling property `{other}`; use `contact = P` and optionally `along = [u, v]`")))
+            }
+        }
+    }
+    let contact = contact.ok_or_else(|| {
+        syn::Error::new(
+            body.span(),
+            "`rolls` needs `contact = P`, the contact point",
+        )
+    })?;
+    Ok(RollsDef {
+        body,
+        contact,
+        along,
+        at,
     })
 }
 
