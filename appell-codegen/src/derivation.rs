@@ -687,12 +687,22 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }))
 }
 
-/// Multiplies out products of sums so cancellations happen (the velocity
-/// terms of the wheel-axle's forcing vanish only then); an expansion that
-/// would exceed the term limit keeps the factored form.
+/// Multiplies out products of sums when that makes the expression no
+/// larger: cancellations then happen (the velocity terms of the wheel-axle's
+/// forcing vanish only after expansion), while an expansion that would blow
+/// up (a bicycle's nested rotations) is abandoned early by a term budget and
+/// the factored form is kept.
 fn expanded(g: &mut appell_symbolic::Graph, e: Id) -> Result<Id, SymbolicError> {
-    match g.expand(e) {
-        Ok(x) => Ok(x),
+    const TERM_BUDGET: usize = 48;
+    match g.expand_within(e, TERM_BUDGET) {
+        Ok(x) if x == e => Ok(e),
+        Ok(x) => {
+            if g.dag_size(&[x]) <= g.dag_size(&[e]) {
+                Ok(x)
+            } else {
+                Ok(e)
+            }
+        }
         Err(SymbolicError::TermLimit { .. }) => Ok(e),
         Err(other) => Err(other),
     }

@@ -44,3 +44,25 @@ fn several_mistakes_are_reported_together() {
     assert!(out.contains("duplicate coordinate `q`"), "{out}");
     assert!(out.contains("unknown point `P`"), "{out}");
 }
+
+#[test]
+fn whipple_bicycle_expands() {
+    let src = include_str!("../../examples/models/whipple_bicycle.rs");
+    let start = src.find("#[derive(Appell").expect("derive");
+    let end = src.find("impl Default").expect("impl");
+    let t = std::time::Instant::now();
+    let out = expand_str(&src[start..end]);
+    println!(
+        "whipple expansion: {:.3} s, {} bytes",
+        t.elapsed().as_secs_f64(),
+        out.len()
+    );
+    if let Some(i) = out.find("total :") {
+        println!("{}", &out[i..i + 20]);
+    }
+    assert!(
+        !out.contains("compile_error"),
+        "{}",
+        &out[..out.len().min(2000)]
+    );
+}

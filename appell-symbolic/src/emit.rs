@@ -132,6 +132,9 @@ impl fmt::Display for OpCount {
     }
 }
 
+/// Deepest nesting of operations written inline in one expression.
+const MAX_INLINE_DEPTH: usize = 16;
+
 /// Exponents up to this are computed by multiplication chains.
 const MAX_CHAIN_EXPONENT: i32 = 64;
 
@@ -734,6 +737,27 @@ impl<'a> Writer<'a> {
             }
             let shared = p.uses[i] >= 2;
             bind[i] = (self.o.cse && shared) || (self.hoisted[i] && boundary[i]);
+        }
+        // Long chains (a sum of hundreds of terms) are cut by a `let` every
+        // few levels, so no written expression nests deeper than
+        // MAX_INLINE_DEPTH (the writer recurses on nesting, and deep lines do
+        // not read).
+        let mut depth = vec![0usize; n];
+        for i in 0..n {
+            if !nontrivial(i) || bind[i] {
+                continue;
+            }
+            let d = 1 + p.insts[i]
+                .operands()
+                .iter()
+                .map(|&o| depth[o as usize])
+                .max()
+                .unwrap_or(0);
+            if d > MAX_INLINE_DEPTH {
+                bind[i] = true;
+            } else {
+                depth[i] = d;
+            }
         }
         let mut prepare = Vec::new();
         let mut body = Vec::new();

@@ -109,7 +109,15 @@ impl Tape {
             })
             .collect();
         let outputs = roots.iter().map(|r| slot[r.index()]).collect();
-        let text = ids.iter().map(|&id| g.display(id).to_string()).collect();
+        // Names of symbols for error messages; other nodes are named by id
+        // (rendering every node would cost more than the evaluation).
+        let text = ids
+            .iter()
+            .map(|&id| match g.node(id) {
+                Node::Sym(s) => g.symbol_name(*s).to_string(),
+                _ => format!("node #{}", id.index()),
+            })
+            .collect();
         Tape {
             steps,
             ids,

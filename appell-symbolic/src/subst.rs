@@ -127,6 +127,31 @@ impl Graph {
     /// assert_eq!(g.display(x).to_string(), "y^2");
     /// ```
     pub fn expand(&mut self, root: Id) -> Result<Id> {
+        let limit = self.limits.max_terms;
+        self.expand_within(root, limit)
+    }
+
+    /// [`Graph::expand`] with its own term limit: any intermediate product
+    /// of sums with more than `max_terms` terms is a
+    /// [`SymbolicError::TermLimit`] error, so an expansion that would blow
+    /// up is abandoned early.
+    ///
+    /// ```
+    /// use appell_symbolic::{Graph, SymbolicError};
+    /// let mut g = Graph::new();
+    /// let e = g.parse("(a + b + c)*(d + e + f)").unwrap();
+    /// assert!(matches!(g.expand_within(e, 4), Err(SymbolicError::TermLimit { limit: 4 })));
+    /// assert!(g.expand_within(e, 9).is_ok());
+    /// ```
+    pub fn expand_within(&mut self, root: Id, max_terms: usize) -> Result<Id> {
+        let saved = self.limits.max_terms;
+        self.limits.max_terms = max_terms.min(saved);
+        let r = self.expand_inner(root);
+        self.limits.max_terms = saved;
+        r
+    }
+
+    fn expand_inner(&mut self, root: Id) -> Result<Id> {
         let mut memo: FxHashMap<Id, Id> = FxHashMap::default();
         let mut stack = vec![(root, false)];
         while let Some((id, expanded)) = stack.pop() {

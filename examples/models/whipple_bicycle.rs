@@ -1,0 +1,120 @@
+//! The Whipple bicycle (Meijaard et al. 2007 benchmark) in Moore's 2012
+//! formulation: eight coordinates, a holonomic constraint that fixes the
+//! pitch, four rolling rows, three degrees of freedom.
+
+use appell::Appell;
+
+/// The benchmark bicycle: rear frame with rider C, rear wheel D, front frame
+/// E (fork and handlebar), front wheel F; knife-edge wheels rolling without
+/// slip on flat ground, z down. Coordinates: rear contact (q1, q2), yaw q3,
+/// roll q4, pitch q5, rear wheel angle q6, steer q7, front wheel angle q8.
+/// Privileged speeds: roll, rear wheel and steer rates; forward speed
+/// v = −rr·q6'.
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(q1, q2, q3, q4, q5, q6, q7, q8), speeds(q4, q6, q7))]
+#[appell(positive(rf, rr))]
+#[appell(frame(A = N.rotate_z(q3)), frame(B = A.rotate_x(q4)), frame(C = B.rotate_y(q5)))]
+#[appell(frame(D = C.rotate_y(q6)), frame(E = C.rotate_z(q7)), frame(F = E.rotate_y(q8)))]
+#[appell(point(P = O + q1 * N.x + q2 * N.y), point(Do = P - rr * B.z))]
+#[appell(point(Co = Do + l1 * C.x + l2 * C.z))]
+#[appell(point(Fo = Do + d1 * C.x + d2 * E.z + d3 * E.x), point(Eo = Fo + l3 * E.x + l4 * E.z))]
+#[appell(point(Q = Fo + rf * unit(cross(cross(E.y, A.z), E.y))))]
+#[appell(body(rear_frame, center = Co, frame = C, mass = mc,
+              inertia = matrix(ic11, ic22, ic33, 0, 0, ic31)))]
+#[appell(body(rear_wheel, center = Do, frame = D, mass = md, inertia = principal(id11, id22, id11)))]
+#[appell(body(front_frame, center = Eo, frame = E, mass = me,
+              inertia = matrix(ie11, ie22, ie33, 0, 0, ie31)))]
+#[appell(body(front_wheel, center = Fo, frame = F, mass = mf, inertia = principal(if11, if22, if11)))]
+#[appell(holonomic(dot(Q - P, A.z) == 0))]
+#[appell(rolls(rear_wheel, contact = P, along = [A.x, A.y]))]
+#[appell(rolls(front_wheel, contact = Q, along = [A.x, A.y]))]
+#[appell(gravity(g * N.z))]
+pub struct WhippleBicycle {
+    /// Front wheel radius [m].
+    pub rf: f64,
+    /// Rear wheel radius [m].
+    pub rr: f64,
+    /// Rear wheel centre to steer axis, along C.x [m].
+    pub d1: f64,
+    /// Along the steer axis between the offsets [m].
+    pub d2: f64,
+    /// Fork offset [m].
+    pub d3: f64,
+    /// Rear frame mass centre, C.x [m].
+    pub l1: f64,
+    /// Rear frame mass centre, C.z [m].
+    pub l2: f64,
+    /// Front frame mass centre, E.x [m].
+    pub l3: f64,
+    /// Front frame mass centre, E.z [m].
+    pub l4: f64,
+    /// Rear frame mass [kg].
+    pub mc: f64,
+    /// Rear wheel mass [kg].
+    pub md: f64,
+    /// Front frame mass [kg].
+    pub me: f64,
+    /// Front wheel mass [kg].
+    pub mf: f64,
+    /// Rear frame inertia [kg m²].
+    pub ic11: f64,
+    /// Rear frame inertia [kg m²].
+    pub ic22: f64,
+    /// Rear frame inertia [kg m²].
+    pub ic33: f64,
+    /// Rear frame inertia product [kg m²].
+    pub ic31: f64,
+    /// Rear wheel inertia about a diameter [kg m²].
+    pub id11: f64,
+    /// Rear wheel inertia about the axle [kg m²].
+    pub id22: f64,
+    /// Front frame inertia [kg m²].
+    pub ie11: f64,
+    /// Front frame inertia [kg m²].
+    pub ie22: f64,
+    /// Front frame inertia [kg m²].
+    pub ie33: f64,
+    /// Front frame inertia product [kg m²].
+    pub ie31: f64,
+    /// Front wheel inertia about a diameter [kg m²].
+    pub if11: f64,
+    /// Front wheel inertia about the axle [kg m²].
+    pub if22: f64,
+    /// Gravity, along +N.z [m/s²].
+    pub g: f64,
+}
+
+impl Default for WhippleBicycle {
+    /// The benchmark bicycle of Meijaard et al. (2007), converted to Moore's
+    /// parameters.
+    fn default() -> Self {
+        WhippleBicycle {
+            rf: 0.35,
+            rr: 0.3,
+            d1: 0.9534570696121849,
+            d2: 0.2676445084476887,
+            d3: 0.03207142672761929,
+            l1: 0.4707271515135145,
+            l2: -0.47792881146460797,
+            l3: -0.00597083392418685,
+            l4: -0.3699518200282974,
+            mc: 85.0,
+            md: 2.0,
+            me: 4.0,
+            mf: 3.0,
+            ic11: 7.178169776497895,
+            ic22: 11.0,
+            ic33: 4.821830223502103,
+            ic31: 3.8225535938357873,
+            id11: 0.0603,
+            id22: 0.12,
+            ie11: 0.05841337700152972,
+            ie22: 0.06,
+            ie33: 0.007586622998470264,
+            ie31: 0.009119225261946298,
+            if11: 0.1405,
+            if22: 0.28,
+            g: 9.81,
+        }
+    }
+}
