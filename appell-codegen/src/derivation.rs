@@ -39,18 +39,21 @@ pub enum Elimination {
     Numeric(NumericElimination),
 }
 
-/// The pieces of a numeric elimination: D' X = R with X = [B | b], then
-/// D' Ẋ = R' with R' = −Ḋ' X − [Ḋ'' | ḋ].
+/// The numeric part of the elimination: after the unknowns with safe
+/// pivots are eliminated symbolically, the remaining k dependent rates solve
+/// S X = R (X = the free rows of [B | b]), and their rates S Ẋ = Ṙ − Ṡ X.
 pub struct NumericElimination {
-    /// D' (m×m), row-major.
+    /// Number of unknowns solved numerically.
+    pub k: usize,
+    /// S (k×k), row-major.
     pub dp: Vec<Id>,
-    /// R = [−D'' | −d] (m×(l+1)), row-major.
+    /// R (k×(l+1)), row-major.
     pub rhs: Vec<Id>,
-    /// R' (m×(l+1)), row-major; contains the X symbols.
+    /// Ṙ − Ṡ X (k×(l+1)), row-major; contains the X symbols.
     pub rhs_rate: Vec<Id>,
-    /// Symbols of X (m×(l+1)).
+    /// Symbols of X (k×(l+1)).
     pub x: Vec<Symbol>,
-    /// Symbols of Ẋ (m×(l+1)).
+    /// Symbols of Ẋ (k×(l+1)).
     pub x_rate: Vec<Symbol>,
 }
 
@@ -352,22 +355,58 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }
     let dp_m = SymMatrix::from_rows(m, m, dp.clone())?;
     let rhs_m = SymMatrix::from_rows(m, l + 1, rhs.clone())?;
-    let (x_entries, elimination_numeric): (Vec<Id>, Option<Vec<Symbol>>) = if m == 0 {
+    // Unknowns with safe pivots are eliminated symbolically; the rest (the
+    // Schur complement S x_f = R_s) is solved numerically at run time, the
+    // free unknowns standing as auxiliary symbols X_f in the expressions.
+    #[allow(clippy::type_complexity)] // (aux symbols, S, R_s) of the numeric part
+    let (x_entries, numeric_part): (Vec<Id>, Option<(Vec<Symbol>, usize, Vec<Id>, Vec<Id>)>) = if m
+        == 0
+    {
         (Vec::new(), None)
     } else {
-        match g.solve_linear(&dp_m, &rhs_m, &assume) {
-            Ok(sol) => (sol.x.entries().to_vec(), None),
-            Err(SymbolicError::NoProvablyNonzeroPivot { .. }) => {
+        match g.eliminate(&dp_m, &rhs_m, &assume) {
+            Ok(part) => {
+                let k = part.free_cols.len();
+                let zero = g.int(0)?;
+                let mut x_entries = vec![zero; m * (l + 1)];
                 let mut syms = Vec::new();
                 let mut ids = Vec::new();
-                for i in 0..m {
+                for f in 0..k {
                     for j in 0..=l {
-                        let s = g.declare(&format!("__x_{i}_{j}"), SymbolKind::Auxiliary)?;
+                        let s = g.declare(&format!("__x_{f}_{j}"), SymbolKind::Auxiliary)?;
                         ids.push(g.sym(s)?);
                         syms.push(s);
                     }
                 }
-                (ids, Some(syms))
+                for (f, &col) in part.free_cols.iter().enumerate() {
+                    for j in 0..=l {
+                        x_entries[col * (l + 1) + j] = ids[f * (l + 1) + j];
+                    }
+                }
+                for (i, &col) in part.pivot_cols.iter().enumerate() {
+                    for j in 0..=l {
+                        let mut terms = vec![part.pivot_rhs[(i, j)]];
+                        for f in 0..k {
+                            let t = g.mul(part.pivot_free[(i, f)], ids[f * (l + 1) + j])?;
+                            terms.push(g.neg(t)?);
+                        }
+                        let sum = g.sum(&terms)?;
+                        x_entries[col * (l + 1) + j] = expanded(g, sum)?;
+                    }
+                }
+                if k == 0 {
+                    (x_entries, None)
+                } else {
+                    (
+                        x_entries,
+                        Some((
+                            syms,
+                            k,
+                            part.s.entries().to_vec(),
+                            part.s_rhs.entries().to_vec(),
+                        )),
+                    )
+                }
             }
             Err(SymbolicError::StructurallySingular { column }) => {
                 let name = model.coords[dependent[column]].0.to_string();
@@ -420,11 +459,11 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         reduced = reduced.with(coord.q, qdot[r]);
     }
     let mut elimination = Elimination::Symbolic;
-    if let Some(xs) = elimination_numeric {
+    if let Some((xs, k, s_mat, s_rhs)) = numeric_part {
         let mut x_rate = Vec::new();
-        for i in 0..m {
+        for f in 0..k {
             for j in 0..=l {
-                let s = g.declare(&format!("__xd_{i}_{j}"), SymbolKind::Auxiliary)?;
+                let s = g.declare(&format!("__xd_{f}_{j}"), SymbolKind::Auxiliary)?;
                 x_rate.push(s);
             }
         }
@@ -432,24 +471,26 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             let rid = g.sym(*r)?;
             reduced = reduced.with(*s, rid);
         }
-        // R' = −Ḋ' X − [Ḋ'' | ḋ]: the rate of R = [−D'' | −d] is −[Ḋ'' | ḋ].
-        let dp_rate = g.time_derivatives(&dp, &reduced)?;
-        let rhs_rate_plain = g.time_derivatives(&rhs, &reduced)?;
-        let mut rhs_rate = Vec::with_capacity(m * (l + 1));
-        for i in 0..m {
+        // S X = R  ⇒  S Ẋ = Ṙ − Ṡ X.
+        let s_rate = g.time_derivatives(&s_mat, &reduced)?;
+        let rhs_rate_plain = g.time_derivatives(&s_rhs, &reduced)?;
+        let mut rhs_rate = Vec::with_capacity(k * (l + 1));
+        for i in 0..k {
             for j in 0..=l {
                 let mut terms = vec![rhs_rate_plain[i * (l + 1) + j]];
-                for k in 0..m {
-                    let xk = g.sym(xs[k * (l + 1) + j])?;
-                    let t = g.mul(dp_rate[i * m + k], xk)?;
+                for f in 0..k {
+                    let xf = g.sym(xs[f * (l + 1) + j])?;
+                    let t = g.mul(s_rate[i * k + f], xf)?;
                     terms.push(g.neg(t)?);
                 }
-                rhs_rate.push(g.sum(&terms)?);
+                let sum = g.sum(&terms)?;
+                rhs_rate.push(expanded(g, sum)?);
             }
         }
         elimination = Elimination::Numeric(NumericElimination {
-            dp: dp.clone(),
-            rhs: rhs.clone(),
+            k,
+            dp: s_mat,
+            rhs: s_rhs,
             rhs_rate,
             x: xs,
             x_rate,
@@ -603,7 +644,49 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let ke = g.sum(&ke_terms)?;
     let kinetic = g.scale(ke, Number::ratio(1, 2).expect("1/2"))?;
     let kinetic = expanded(g, kinetic)?;
-    // 7. Retained and ignorable coordinates.
+    // 7. Retained and ignorable coordinates. First, coordinates that occur
+    // in the equations but on which they do not depend (an axisymmetric
+    // wheel's angle, a bicycle's heading after the elimination) are found
+    // numerically at pseudo-random points and set to zero in M, f and the
+    // numeric elimination, so they drop out of the reduced state.
+    let mut mass = mass;
+    let mut forcing = forcing;
+    {
+        let mut core: Vec<Id> = mass.iter().chain(&forcing).copied().collect();
+        if let Elimination::Numeric(ne) = &elimination {
+            core.extend(ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate));
+        }
+        let mut deps = SymbolSet::new();
+        for &e in &core {
+            deps.union_with(g.dependencies(e));
+        }
+        let tape = appell_symbolic::Tape::new(g, &core);
+        let independent: Vec<Symbol> = model
+            .coords
+            .iter()
+            .map(|(_, c)| c.q)
+            .filter(|&q| deps.contains(q) && numerically_independent(g, &tape, q))
+            .collect();
+        if !independent.is_empty() {
+            let mut fix = Substitution::new();
+            for &q in &independent {
+                fix.insert(q, zero);
+            }
+            for e in mass.iter_mut().chain(forcing.iter_mut()) {
+                *e = fix.apply(g, *e)?;
+            }
+            if let Elimination::Numeric(ne) = &mut elimination {
+                for e in ne
+                    .dp
+                    .iter_mut()
+                    .chain(ne.rhs.iter_mut())
+                    .chain(ne.rhs_rate.iter_mut())
+                {
+                    *e = fix.apply(g, *e)?;
+                }
+            }
+        }
+    }
     let aux_deps = match &elimination {
         Elimination::Symbolic => Vec::new(),
         Elimination::Numeric(ne) => {
@@ -772,6 +855,52 @@ fn mat_t_vec(g: &mut appell_symbolic::Graph, r: &Mat3, v: Vec3) -> Result<Vec3, 
 /// I v.
 fn mat_vec(g: &mut appell_symbolic::Graph, m: &Mat3, v: Vec3) -> Result<Vec3, SymbolicError> {
     Ok([dot(g, m[0], v)?, dot(g, m[1], v)?, dot(g, m[2], v)?])
+}
+
+/// A value in [0.5, 1.5] for parameters and [−1, 1] for everything else,
+/// fixed by the symbol and the trial number.
+fn pseudo_value(g: &appell_symbolic::Graph, s: Symbol, trial: u64) -> f64 {
+    let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    h ^= h >> 31;
+    h = h.wrapping_mul(0x94d0_49bb_1331_11eb);
+    h ^= h >> 29;
+    let u = (h >> 11) as f64 / (1u64 << 53) as f64;
+    match g.symbol_kind(s) {
+        SymbolKind::Parameter => 0.5 + u,
+        _ => 2.0 * u - 1.0,
+    }
+}
+
+/// Whether the values of `tape` stay the same (to 1e-9, relative) when the
+/// symbol `q` alone changes, at three pseudo-random points and two shifts.
+/// Any evaluation failure counts as a dependence.
+fn numerically_independent(
+    g: &appell_symbolic::Graph,
+    tape: &appell_symbolic::Tape,
+    q: Symbol,
+) -> bool {
+    for trial in 0..3u64 {
+        let base = |s: Symbol| Some(pseudo_value(g, s, trial));
+        let Ok(v0) = tape.eval(&base) else {
+            return false;
+        };
+        for shift in [0.7, 1.9] {
+            let moved =
+                |s: Symbol| Some(pseudo_value(g, s, trial) + if s == q { shift } else { 0.0 });
+            let Ok(v1) = tape.eval(&moved) else {
+                return false;
+            };
+            let same = v0
+                .iter()
+                .zip(&v1)
+                .all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs())));
+            if !same {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 /// The first row of D that is numerically a combination of the rows before

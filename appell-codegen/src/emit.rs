@@ -129,7 +129,7 @@ impl Emitter<'_> {
         let Elimination::Numeric(ne) = &self.d.elimination else {
             return (String::new(), 0);
         };
-        let (m, l) = (self.d.m, self.d.l);
+        let (m, l) = (ne.k, self.d.l);
         let mut s = String::new();
         let mut ops = 0;
         let mut stage =

@@ -49,7 +49,7 @@ pub use emit::{EmitOptions, Inst, OpCount, Program, RustCode};
 pub use error::{Result, SymbolicError};
 pub use eval::{Tape, Value};
 pub use graph::{Coordinate, Func, Graph, Id, Limits, Node, Stats, Symbol, SymbolInfo, SymbolKind};
-pub use linear::{Assumptions, LinearForm, LinearSolution, Sign, SymMatrix};
+pub use linear::{Assumptions, LinearForm, LinearSolution, PartialSolution, Sign, SymMatrix};
 pub use number::Number;
 pub use parse::UnknownNames;
 pub use subst::Substitution;

@@ -171,7 +171,249 @@ pub struct LinearSolution {
     pub pivot_rows: Vec<usize>,
 }
 
+/// The result of [`Graph::eliminate`]: the unknowns with provably safe
+/// pivots solved symbolically in terms of the rest, and the remaining square
+/// system (the Schur complement) left for a numeric solve.
+///
+/// With `x_f` the free unknowns (solved numerically from `s x_f = s_rhs`),
+/// every pivoted unknown `pivot_cols[i]` is `pivot_rhs[i] − Σ_j pivot_free[i][j] x_f[j]`.
+#[derive(Clone, Debug)]
+pub struct PartialSolution {
+    /// Unknowns solved symbolically, in elimination order.
+    pub pivot_cols: Vec<usize>,
+    /// Their right-hand sides (one row per pivoted unknown, one column per
+    /// right-hand side of the system).
+    pub pivot_rhs: SymMatrix,
+    /// Their coefficients on the free unknowns.
+    pub pivot_free: SymMatrix,
+    /// The unknowns left for the numeric solve.
+    pub free_cols: Vec<usize>,
+    /// The remaining square system's matrix (free × free).
+    pub s: SymMatrix,
+    /// Its right-hand sides.
+    pub s_rhs: SymMatrix,
+}
+
 impl Graph {
+    /// Gauss–Jordan elimination that pivots only where it is provably safe and
+    /// leaves the rest for a numeric solve: scalar pivots that are provably
+    /// non-zero first (the smallest), then 2×2 block pivots whose determinant
+    /// is provably non-zero after expansion (a rotation block such as
+    /// `[[cos q, sin q], [−sin q, cos q]]` has determinant 1 although no entry
+    /// is safe). Unknowns without a safe pivot, and the rows left over, form
+    /// the square system of [`PartialSolution::s`]. A structurally zero
+    /// column is [`SymbolicError::StructurallySingular`].
+    ///
+    /// ```
+    /// use appell_symbolic::{Assumptions, Graph, SymMatrix};
+    /// let mut g = Graph::new();
+    /// // Two unknowns rotated by q, a third with a pivot that may vanish.
+    /// let a = SymMatrix::parse(&mut g, &[
+    ///     &["cos(q)", "sin(q)", "0"],
+    ///     &["-sin(q)", "cos(q)", "0"],
+    ///     &["x", "0", "p"],
+    /// ]).unwrap();
+    /// let b = SymMatrix::parse(&mut g, &[&["u"], &["v"], &["w"]]).unwrap();
+    /// let sol = g.eliminate(&a, &b, &Assumptions::new()).unwrap();
+    /// assert_eq!(sol.pivot_cols, vec![0, 1]); // by the rotation block
+    /// assert_eq!(sol.free_cols, vec![2]);     // p may vanish: numeric
+    /// assert_eq!(g.display(sol.s[(0, 0)]).to_string(), "p");
+    /// ```
+    pub fn eliminate(
+        &mut self,
+        a: &SymMatrix,
+        b: &SymMatrix,
+        assumptions: &Assumptions,
+    ) -> Result<PartialSolution> {
+        let n = a.rows;
+        if a.cols != n || b.rows != n {
+            return Err(SymbolicError::DimensionMismatch {
+                expected: format!("a square A and B with {n} rows"),
+                found: format!("A {}×{}, B {}×{}", a.rows, a.cols, b.rows, b.cols),
+            });
+        }
+        let m = b.cols;
+        let mut rows: Vec<Vec<Id>> = (0..n)
+            .map(|r| {
+                let mut v: Vec<Id> = (0..n).map(|c| a[(r, c)]).collect();
+                v.extend((0..m).map(|c| b[(r, c)]));
+                v
+            })
+            .collect();
+        let mut open_rows: Vec<usize> = (0..n).collect();
+        let mut open_cols: Vec<usize> = (0..n).collect();
+        let mut pivots: Vec<(usize, usize)> = Vec::new(); // (row, col)
+        loop {
+            for &c in &open_cols {
+                if open_rows.iter().all(|&r| self.is_zero(rows[r][c])) {
+                    return Err(SymbolicError::StructurallySingular { column: c });
+                }
+            }
+            // Pivot choice, cheapest first: a constant entry; a 2×2 block with
+            // a constant determinant (a rotation); a provably non-zero entry
+            // (the smallest); a 2×2 block with a provably non-zero determinant.
+            let scalar = self.best_scalar_pivot(&rows, &open_rows, &open_cols, assumptions);
+            let constant_scalar = scalar.filter(|&(r, c)| self.as_number(rows[r][c]).is_some());
+            let mut block = None;
+            if constant_scalar.is_none() {
+                block = self.block_pivot(&rows, &open_rows, &open_cols, assumptions, true)?;
+                if block.is_none() && scalar.is_none() {
+                    block = self.block_pivot(&rows, &open_rows, &open_cols, assumptions, false)?;
+                }
+            }
+            if block.is_none() {
+                if let Some((r, c)) = scalar {
+                    let inv = self.recip(rows[r][c])?;
+                    for x in rows[r].iter_mut() {
+                        let t = self.mul(*x, inv)?;
+                        *x = self.expand(t)?;
+                    }
+                    self.clear_column(&mut rows, r, &[c])?;
+                    open_rows.retain(|&x| x != r);
+                    open_cols.retain(|&x| x != c);
+                    pivots.push((r, c));
+                    continue;
+                }
+            }
+            let Some((r1, r2, c1, c2, det)) = block else {
+                break;
+            };
+            let (a11, a12, a21, a22) = (rows[r1][c1], rows[r1][c2], rows[r2][c1], rows[r2][c2]);
+            let inv_det = self.recip(det)?;
+            // [row1; row2] ← adj(B)/det · [row1; row2]
+            let width = rows[r1].len();
+            let (old1, old2) = (rows[r1].clone(), rows[r2].clone());
+            for k in 0..width {
+                let x = self.mul(a22, old1[k])?;
+                let y = self.mul(a12, old2[k])?;
+                let n1 = self.sub(x, y)?;
+                let n1 = self.mul(n1, inv_det)?;
+                rows[r1][k] = self.expand(n1)?;
+                let x = self.mul(a11, old2[k])?;
+                let y = self.mul(a21, old1[k])?;
+                let n2 = self.sub(x, y)?;
+                let n2 = self.mul(n2, inv_det)?;
+                rows[r2][k] = self.expand(n2)?;
+            }
+            self.clear_column(&mut rows, r1, &[c1])?;
+            self.clear_column(&mut rows, r2, &[c2])?;
+            open_rows.retain(|&x| x != r1 && x != r2);
+            open_cols.retain(|&x| x != c1 && x != c2);
+            pivots.push((r1, c1));
+            pivots.push((r2, c2));
+        }
+        let k = open_cols.len();
+        let np = pivots.len();
+        let mut pivot_rhs = Vec::with_capacity(np * m);
+        let mut pivot_free = Vec::with_capacity(np * k);
+        for &(r, _) in &pivots {
+            pivot_rhs.extend((0..m).map(|j| rows[r][n + j]));
+            pivot_free.extend(open_cols.iter().map(|&c| rows[r][c]));
+        }
+        let mut s = Vec::with_capacity(k * k);
+        let mut s_rhs = Vec::with_capacity(k * m);
+        for &r in &open_rows {
+            s.extend(open_cols.iter().map(|&c| rows[r][c]));
+            s_rhs.extend((0..m).map(|j| rows[r][n + j]));
+        }
+        Ok(PartialSolution {
+            pivot_cols: pivots.iter().map(|p| p.1).collect(),
+            pivot_rhs: SymMatrix::from_rows(np, m, pivot_rhs)?,
+            pivot_free: SymMatrix::from_rows(np, k, pivot_free)?,
+            free_cols: open_cols,
+            s: SymMatrix::from_rows(k, k, s)?,
+            s_rhs: SymMatrix::from_rows(k, m, s_rhs)?,
+        })
+    }
+
+    /// The smallest provably non-zero entry among the open rows and columns
+    /// (constants first).
+    fn best_scalar_pivot(
+        &self,
+        rows: &[Vec<Id>],
+        open_rows: &[usize],
+        open_cols: &[usize],
+        assumptions: &Assumptions,
+    ) -> Option<(usize, usize)> {
+        let mut best: Option<(bool, usize, usize, usize)> = None;
+        for &c in open_cols {
+            for &r in open_rows {
+                let e = rows[r][c];
+                if !self.is_zero(e) && self.is_provably_nonzero(e, assumptions) {
+                    let key = (self.as_number(e).is_none(), self.dag_size(&[e]), c, r);
+                    if best.is_none_or(|b| key < b) {
+                        best = Some(key);
+                    }
+                }
+            }
+        }
+        best.map(|(_, _, c, r)| (r, c))
+    }
+
+    /// A 2×2 block of the open rows and columns whose determinant is a
+    /// non-zero constant (`constant_only`) or provably non-zero.
+    #[allow(clippy::type_complexity)] // (r1, r2, c1, c2, determinant)
+    fn block_pivot(
+        &mut self,
+        rows: &[Vec<Id>],
+        open_rows: &[usize],
+        open_cols: &[usize],
+        assumptions: &Assumptions,
+        constant_only: bool,
+    ) -> Result<Option<(usize, usize, usize, usize, Id)>> {
+        for (i, &c1) in open_cols.iter().enumerate() {
+            for &c2 in &open_cols[i + 1..] {
+                for (j, &r1) in open_rows.iter().enumerate() {
+                    for &r2 in &open_rows[j + 1..] {
+                        let (a11, a12, a21, a22) =
+                            (rows[r1][c1], rows[r1][c2], rows[r2][c1], rows[r2][c2]);
+                        if (self.is_zero(a11) || self.is_zero(a22))
+                            && (self.is_zero(a12) || self.is_zero(a21))
+                        {
+                            continue;
+                        }
+                        let p = self.mul(a11, a22)?;
+                        let q = self.mul(a12, a21)?;
+                        let d = self.sub(p, q)?;
+                        let det = self.expand(d)?;
+                        let ok = if constant_only {
+                            self.as_number(det).is_some_and(|n| !n.is_zero())
+                        } else {
+                            self.is_provably_nonzero(det, assumptions)
+                        };
+                        if ok {
+                            return Ok(Some((r1, r2, c1, c2, det)));
+                        }
+                    }
+                }
+            }
+        }
+        Ok(None)
+    }
+
+    /// Subtracts multiples of the (normalized) pivot row `p` from every other
+    /// row so the columns `cols` vanish there.
+    fn clear_column(&mut self, rows: &mut [Vec<Id>], p: usize, cols: &[usize]) -> Result<()> {
+        let width = rows[p].len();
+        for r in 0..rows.len() {
+            if r == p {
+                continue;
+            }
+            for &c in cols {
+                let f = rows[r][c];
+                if self.is_zero(f) {
+                    continue;
+                }
+                for k in 0..width {
+                    let t = self.mul(f, rows[p][k])?;
+                    let x = self.sub(rows[r][k], t)?;
+                    rows[r][k] = self.expand(x)?;
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// Splits `e` into coefficients of `symbols` and a remainder; an error
     /// names the first symbol in which `e` is not linear.
     ///
