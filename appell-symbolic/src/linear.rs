@@ -394,7 +394,7 @@ impl Graph {
     /// Subtracts multiples of the (normalized) pivot row `p` from every other
     /// row so the columns `cols` vanish there.
     fn clear_column(&mut self, rows: &mut [Vec<Id>], p: usize, cols: &[usize]) -> Result<()> {
-        let width = rows[p].len();
+        let pivot_row = rows[p].clone();
         for r in 0..rows.len() {
             if r == p {
                 continue;
@@ -404,10 +404,10 @@ impl Graph {
                 if self.is_zero(f) {
                     continue;
                 }
-                for k in 0..width {
-                    let t = self.mul(f, rows[p][k])?;
-                    let x = self.sub(rows[r][k], t)?;
-                    rows[r][k] = self.expand(x)?;
+                for (x, &pk) in rows[r].iter_mut().zip(&pivot_row) {
+                    let t = self.mul(f, pk)?;
+                    let d = self.sub(*x, t)?;
+                    *x = self.expand(d)?;
                 }
             }
         }
