@@ -395,16 +395,16 @@ impl Graph {
     /// row so the columns `cols` vanish there.
     fn clear_column(&mut self, rows: &mut [Vec<Id>], p: usize, cols: &[usize]) -> Result<()> {
         let pivot_row = rows[p].clone();
-        for r in 0..rows.len() {
+        for (r, row) in rows.iter_mut().enumerate() {
             if r == p {
                 continue;
             }
             for &c in cols {
-                let f = rows[r][c];
+                let f = row[c];
                 if self.is_zero(f) {
                     continue;
                 }
-                for (x, &pk) in rows[r].iter_mut().zip(&pivot_row) {
+                for (x, &pk) in row.iter_mut().zip(&pivot_row) {
                     let t = self.mul(f, pk)?;
                     let d = self.sub(*x, t)?;
                     *x = self.expand(d)?;
