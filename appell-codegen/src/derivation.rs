@@ -625,7 +625,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             mass[k * l + j] = mass[j * l + k];
         }
     }
-    let forcing: Vec<Id> = forcing_terms
+    let mut forcing: Vec<Id> = forcing_terms
         .iter()
         .map(|t| g.sum(t).and_then(|e| expanded(g, e)))
         .collect::<Result<_, _>>()?;
@@ -649,8 +649,6 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // wheel's angle, a bicycle's heading after the elimination) are found
     // numerically at pseudo-random points and set to zero in M, f and the
     // numeric elimination, so they drop out of the reduced state.
-    let mut mass = mass;
-    let mut forcing = forcing;
     {
         let mut core: Vec<Id> = mass.iter().chain(&forcing).copied().collect();
         if let Elimination::Numeric(ne) = &elimination {
