@@ -42,3 +42,28 @@ fn agrees_with_the_oracle() {
     println!("bicycle vs oracle: largest relative difference {worst:.2e}");
     assert!(worst < 1e-9, "{worst:e}");
 }
+
+#[test]
+fn critical_speeds_match_the_benchmark() {
+    let p = WhippleBicycle::default();
+    let (weave, capsize) = whipple_bicycle::critical_speeds(&p).unwrap();
+    println!("weave {weave:.14} m/s, capsize {capsize:.14} m/s");
+    assert!(
+        (weave - 4.29238253634111).abs() < 1e-8,
+        "weave speed {weave}"
+    );
+    assert!(
+        (capsize - 6.02426201538837).abs() < 1e-8,
+        "capsize speed {capsize}"
+    );
+}
+
+#[test]
+fn upright_pitch_is_the_steer_axis_tilt() {
+    let q = whipple_bicycle::operating_point(&WhippleBicycle::default()).unwrap();
+    assert!(
+        (q[4] - std::f64::consts::PI / 10.0).abs() < 1e-12,
+        "pitch {}",
+        q[4]
+    );
+}

@@ -16,6 +16,8 @@
 pub mod cli;
 pub mod integrate;
 pub mod linalg;
+#[cfg(feature = "std")]
+pub mod linearize;
 mod model;
 #[cfg(feature = "std")]
 pub mod oracle;

@@ -118,3 +118,86 @@ impl Default for WhippleBicycle {
         }
     }
 }
+
+/// Upright, straight-ahead running: roll and steer zero, the pitch solved
+/// from the holonomic constraint (it equals the steer-axis tilt λ = π/10 for
+/// the benchmark geometry).
+pub fn operating_point(p: &WhippleBicycle) -> Result<[f64; 8], appell::linearize::LinearizeError> {
+    let mut q = [0.0; 8];
+    q[4] = std::f64::consts::PI / 10.0;
+    appell::linearize::solve_holonomic(p, 0.0, &mut q, &[4], 1e-14, 30)?;
+    Ok(q)
+}
+
+/// The lean and steer dynamics at forward speed `v` (the benchmark's
+/// state [φ, δ, φ̇, δ̇] is our [q4, q7, q4', q7']): the reduced equations
+/// linearized by dual numbers, the pitch eliminated through the holonomic
+/// constraint, the rear-wheel rate held at −v/rr.
+pub fn lean_steer(
+    p: &WhippleBicycle,
+    v: f64,
+) -> Result<appell::linearize::Linearization, appell::linearize::LinearizeError> {
+    let q = operating_point(p)?;
+    let u = [0.0, -v / p.rr, 0.0];
+    appell::linearize::minimal_linearization(p, 0.0, &q, &u, &[], &["q6"])
+}
+
+/// Eigenvalues (re, im) of the lean and steer dynamics at speed `v`.
+pub fn eigenvalues(
+    p: &WhippleBicycle,
+    v: f64,
+) -> Result<Vec<(f64, f64)>, appell::linearize::LinearizeError> {
+    appell::linearize::eigenvalues(&lean_steer(p, v)?.a)
+}
+
+/// Largest real part among the oscillatory (weave) eigenvalues.
+fn weave_growth(p: &WhippleBicycle, v: f64) -> Result<f64, appell::linearize::LinearizeError> {
+    Ok(eigenvalues(p, v)?
+        .iter()
+        .filter(|e| e.1.abs() > 1e-9)
+        .map(|e| e.0)
+        .fold(f64::NEG_INFINITY, f64::max))
+}
+
+/// Largest real eigenvalue (the capsize mode between the critical speeds).
+fn capsize_growth(p: &WhippleBicycle, v: f64) -> Result<f64, appell::linearize::LinearizeError> {
+    Ok(eigenvalues(p, v)?
+        .iter()
+        .filter(|e| e.1.abs() <= 1e-9)
+        .map(|e| e.0)
+        .fold(f64::NEG_INFINITY, f64::max))
+}
+
+/// The root of `f` in `[lo, hi]` (a sign change) by bisection to 1e-13.
+fn bisect(
+    mut lo: f64,
+    mut hi: f64,
+    f: impl Fn(f64) -> Result<f64, appell::linearize::LinearizeError>,
+) -> Result<f64, appell::linearize::LinearizeError> {
+    let flo = f(lo)?;
+    if flo.signum() == f(hi)?.signum() {
+        return Err(appell::linearize::LinearizeError::InvalidArgument(format!(
+            "no sign change in [{lo}, {hi}]"
+        )));
+    }
+    while hi - lo > 1e-13 {
+        let mid = 0.5 * (lo + hi);
+        if f(mid)?.signum() == flo.signum() {
+            lo = mid;
+        } else {
+            hi = mid;
+        }
+    }
+    Ok(0.5 * (lo + hi))
+}
+
+/// The weave speed (the oscillatory pair becomes stable) and the capsize
+/// speed (the real capsize eigenvalue becomes unstable), by root finding
+/// between 3 and 5 m/s and between 5 and 8 m/s.
+pub fn critical_speeds(
+    p: &WhippleBicycle,
+) -> Result<(f64, f64), appell::linearize::LinearizeError> {
+    let weave = bisect(3.0, 5.0, |v| weave_growth(p, v))?;
+    let capsize = bisect(5.0, 8.0, |v| capsize_growth(p, v))?;
+    Ok((weave, capsize))
+}
