@@ -68,8 +68,8 @@ fn four_links_conserve_energy() {
         // V = −g Σ_i m_i y_i with y_i = −Σ_{j≤i} l_j cos q_j.
         let mut y = 0.0;
         let mut v = 0.0;
-        for i in 0..4 {
-            y -= s[i].cos();
+        for q in &s[..4] {
+            y -= q.cos();
             v += 9.81 * y;
         }
         t + v
