@@ -19,7 +19,7 @@ fn demonstrate(p: &ChaplyginSleigh) -> Result<(), Box<dyn Error>> {
     println!("{}", ChaplyginSleigh::info().equations);
     let prepared = p.prepare::<f64>();
     // State (theta, x_dot, theta_dot): heading 0, moving forward, turning.
-    let mut s = [0.0, 1.0, 1.0];
+    let mut s = [0.0f64, 1.0, 1.0];
     println!("{:>6} {:>10} {:>10} {:>10}", "t", "theta", "v", "omega");
     for k in 0..=10 {
         let v = s[1] / s[0].cos();

@@ -108,26 +108,24 @@
 //!
 //! [`linearize`] evaluates [`Model::rhs`] once per state component and input
 //! in [`Dual64`] (one instantiation of the generated code). The alternative,
-//! one pass with num-dual's vector dual number `DualSVec64<W>` carrying W
-//! columns at once, was measured against it (release build, this project's
-//! 2-core machine, medians; derived models, with the generated code hoisting
-//! its sines and cosines):
+//! num-dual's vector dual number `DualSVec64<W>` carrying W columns per pass,
+//! was measured against it on derived models (release build, this project's
+//! 2-core machine, shared with other builds: medians of 7 runs, about ±15%):
 //!
-//! | model | state + inputs | rhs ops | one `DualSVec64` pass | chunks of 4 / 8 |
-//! | --- | ---: | ---: | ---: | ---: |
-//! | triple pendulum | 6 + 0 | 125 | 0.80–0.83× | 0.93–1.30× / 1.05–1.53× |
-//! | triple pendulum on a cart | 7 + 1 | 186 | 0.95–1.17× | 0.97–0.99× / 0.78–0.99× |
-//! | quadruple pendulum | 8 + 0 | 286 | 1.09–1.31× | 0.91–1.24× / 0.87–1.12× |
-//! | Whipple bicycle | 6 + 0 | 4,303 | 0.71–0.86× | 0.75–1.03× / 0.86–1.07× |
+//! | model | columns | rhs ops | Dual64 columns | one `DualSVec64` pass | chunks of 4 | chunks of 8 |
+//! | --- | ---: | ---: | ---: | ---: | ---: | ---: |
+//! | triple pendulum | 6 | 125 | 0.48 µs | 0.79× | 0.90× | 1.10× |
+//! | triple pendulum on a cart (s = 7, one input) | 8 | 186 | 0.80 µs | 0.96× | 0.99× | 0.96× |
+//! | quadruple pendulum | 8 | 286 | 1.1 µs | 1.11× | 1.07× | 1.11× |
+//! | Whipple bicycle | 6 | 4,303 | 16 µs | 0.73× | 0.88× | 0.90× |
 //!
-//! (times relative to the Dual64 columns). The vector pass shares the real
-//! parts and the function calls, but every operation carries W derivatives
-//! behind an `Option`: it wins by up to about 30% on the large bicycle rhs
-//! and only when W is the exact column count, a compile-time constant (one
-//! more instantiation of the generated rhs per width), and is even or slower
-//! on small models. The columns are therefore Dual64. `tests/linearize.rs`
-//! repeats the comparison on hand-written models (ignored test
-//! `dual64_vs_dualsvec64_timing`).
+//! The vector pass shares the real parts and the function calls, but every
+//! operation carries W derivatives behind an `Option`. It gains about a
+//! quarter on the large bicycle rhs, and only when W is the exact column
+//! count (a compile-time constant: one more instantiation of the generated
+//! rhs per width); on small models it is even or slower. The columns are
+//! therefore Dual64. `tests/linearize.rs` repeats the comparison on
+//! hand-written models (ignored test `dual64_vs_dualsvec64_timing`).
 
 use crate::model::{check_len, Model, ModelError, ModelInfo};
 use nalgebra::{DMatrix, DVector};
@@ -173,8 +171,9 @@ pub enum LinearizeError {
         /// Its columns.
         cols: usize,
     },
-    /// A value (an argument, a residual, a Jacobian entry, a matrix entry)
-    /// is NaN or infinite.
+    /// An entry of a matrix given to [`eigenvalues`], or an eigenvalue, is
+    /// NaN or infinite. (Non-finite arguments, residuals and derivatives of a
+    /// model are [`ModelError::NonFinite`] inside [`LinearizeError::Model`].)
     NonFinite {
         /// Which quantity.
         what: &'static str,
