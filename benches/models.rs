@@ -3,10 +3,22 @@
 //!
 //! Run: `cargo bench --bench models`.
 
+// The shared model files carry items (other sizes, root finding) this
+// benchmark does not use.
+#![allow(dead_code)]
+
+#[path = "../examples/models/chaplygin_sleigh.rs"]
+mod chaplygin_sleigh;
 #[path = "../examples/models/double_pendulum.rs"]
 mod double_pendulum;
+#[path = "../examples/models/n_link_pendulum.rs"]
+mod n_link_pendulum;
+#[path = "../examples/models/rolling_disc.rs"]
+mod rolling_disc;
 #[path = "../examples/models/wheel_axle.rs"]
 mod wheel_axle;
+#[path = "../examples/models/whipple_bicycle.rs"]
+mod whipple_bicycle;
 
 use std::hint::black_box;
 use std::time::Instant;
@@ -15,10 +27,13 @@ use appell::oracle::reduced_rhs;
 use appell::Model;
 use criterion::{criterion_group, criterion_main, Criterion};
 
-/// The `#[derive(Appell)]` struct of a model file, as a derive input.
-fn derive_input(source: &str) -> syn::DeriveInput {
-    let start = source.find("#[derive(Appell").expect("derive");
-    let end = source.find("impl Default").expect("impl Default");
+/// The `#[derive(Appell)]` struct `name` of a model file, as a derive input.
+fn derive_input(source: &str, name: &str) -> syn::DeriveInput {
+    let at = source
+        .find(&format!("pub struct {name} {{"))
+        .expect("struct");
+    let start = source[..at].rfind("#[derive(Appell").expect("derive");
+    let end = at + source[at..].find("\n}").expect("end of struct") + 2;
     syn::parse_str(&source[start..end]).expect("struct")
 }
 
@@ -48,7 +63,13 @@ fn states<M: Model>(count: usize) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
         .collect()
 }
 
-fn bench_model<M: Model>(c: &mut Criterion, name: &str, model: &M, source: &str) {
+fn bench_model<M: Model>(
+    c: &mut Criterion,
+    name: &str,
+    model: &M,
+    source: &str,
+    struct_name: &str,
+) {
     let info = M::info();
     let inputs = vec![0.1; info.inputs.len()];
     let prepared = model.prepare::<f64>();
@@ -72,7 +93,7 @@ fn bench_model<M: Model>(c: &mut Criterion, name: &str, model: &M, source: &str)
             }
         })
     });
-    let input = derive_input(source);
+    let input = derive_input(source, struct_name);
     group.bench_function("derive expansion", |b| {
         b.iter(|| appell_codegen::expand(black_box(&input)))
     });
@@ -115,12 +136,54 @@ fn bench(c: &mut Criterion) {
         "wheel_axle",
         &wheel_axle::WheelAxle::default(),
         include_str!("../examples/models/wheel_axle.rs"),
+        "WheelAxle",
     );
     bench_model(
         c,
         "double_pendulum",
         &double_pendulum::DoublePendulum::default(),
         include_str!("../examples/models/double_pendulum.rs"),
+        "DoublePendulum",
+    );
+    bench_model(
+        c,
+        "rolling_disc",
+        &rolling_disc::RollingDisc::default(),
+        include_str!("../examples/models/rolling_disc.rs"),
+        "RollingDisc",
+    );
+    bench_model(
+        c,
+        "chaplygin_sleigh",
+        &chaplygin_sleigh::ChaplyginSleigh::default(),
+        include_str!("../examples/models/chaplygin_sleigh.rs"),
+        "ChaplyginSleigh",
+    );
+    bench_model(
+        c,
+        "n_link_pendulum_8",
+        &n_link_pendulum::Pendulum8::default(),
+        include_str!("../examples/models/n_link_pendulum.rs"),
+        "Pendulum8",
+    );
+    let bike = whipple_bicycle::WhippleBicycle::default();
+    bench_model(
+        c,
+        "whipple_bicycle",
+        &bike,
+        include_str!("../examples/models/whipple_bicycle.rs"),
+        "WhippleBicycle",
+    );
+    c.bench_function("whipple_bicycle/linearize + eigenvalues at 5 m/s", |b| {
+        b.iter(|| whipple_bicycle::eigenvalues(&bike, black_box(5.0)).unwrap())
+    });
+    let t = Instant::now();
+    for _ in 0..200 {
+        black_box(whipple_bicycle::eigenvalues(&bike, black_box(5.0)).unwrap());
+    }
+    println!(
+        "whipple_bicycle: linearization and eigenvalues at one speed {:.1} µs",
+        t.elapsed().as_secs_f64() * 1e6 / 200.0
     );
 }
 

@@ -67,3 +67,45 @@ fn upright_pitch_is_the_steer_axis_tilt() {
         q[4]
     );
 }
+
+#[test]
+fn mass_matrix_is_symmetric_positive_definite_at_the_operating_point() {
+    let p = WhippleBicycle::default();
+    let q = whipple_bicycle::operating_point(&p).unwrap();
+    let mut m = [0.0; 9];
+    let mut f = [0.0; 3];
+    p.mass_matrix_and_forcing(0.0, &q, &[0.0, -5.0 / p.rr, 0.0], &[], &mut m, &mut f)
+        .unwrap();
+    for i in 0..3 {
+        for j in 0..3 {
+            assert!((m[i * 3 + j] - m[j * 3 + i]).abs() < 1e-12 * (1.0 + m[i * 3 + j].abs()));
+        }
+    }
+    // Leading minors positive (Sylvester's criterion).
+    let d1 = m[0];
+    let d2 = m[0] * m[4] - m[1] * m[3];
+    let d3 = m[0] * (m[4] * m[8] - m[5] * m[7]) - m[1] * (m[3] * m[8] - m[5] * m[6])
+        + m[2] * (m[3] * m[7] - m[4] * m[6]);
+    assert!(d1 > 0.0 && d2 > 0.0 && d3 > 0.0, "minors {d1} {d2} {d3}");
+    // Straight-ahead running at constant speed is an equilibrium.
+    assert!(f.iter().all(|x| x.abs() < 1e-10), "{f:?}");
+}
+
+#[test]
+fn lean_steer_eigenvalues_at_5_m_per_s() {
+    // Meijaard et al. (2007), Table 2 (v = 5 m/s): weave −0.775341882195845 ± 4.46486771378823i,
+    // capsize −0.322866429004087, castor −14.0783896927982.
+    let ev = whipple_bicycle::eigenvalues(&WhippleBicycle::default(), 5.0).unwrap();
+    let expected = [
+        (-14.0783896927982, 0.0),
+        (-0.775341882195845, -4.46486771378823),
+        (-0.775341882195845, 4.46486771378823),
+        (-0.322866429004087, 0.0),
+    ];
+    for ((re, im), (er, ei)) in ev.iter().zip(expected) {
+        assert!(
+            (re - er).abs() < 1e-10 && (im - ei).abs() < 1e-10,
+            "({re}, {im}) vs ({er}, {ei})"
+        );
+    }
+}

@@ -326,6 +326,20 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         return Ok(None);
     }
     let dependent: Vec<usize> = (0..n).filter(|i| !model.speeds.contains(i)).collect();
+    for c in &model.holonomic {
+        let involves_dependent = dependent
+            .iter()
+            .any(|&i| model.g.depends_on(c.residual, model.coords[i].1.q));
+        if !involves_dependent {
+            cx.error_spanned_by(
+                &c.at,
+                "this holonomic constraint involves no dependent coordinate: it would restrict the privileged speeds, which must stay independent; leave one of its coordinates out of `speeds(...)`",
+            );
+        }
+    }
+    if cx.has_errors() {
+        return Ok(None);
+    }
     let g = &mut model.g;
     // 2. Structural rank of D' (a matching of rows to dependent columns).
     if let Some(col) = unmatched_column(g, &d_rows, n, m, &dependent) {
