@@ -4,6 +4,8 @@
 
 #[path = "../examples/models/wheel_axle.rs"]
 mod wheel_axle;
+#[path = "../examples/models/chaplygin_sleigh.rs"]
+mod chaplygin;
 
 mod common;
 #[path = "../examples/models/double_pendulum.rs"]
@@ -116,6 +118,42 @@ fn skew_axis_rotation_agrees_with_the_oracle() {
         i3: 0.05,
     };
     let worst = agree(&p, &mut rng, 1000, 3.0);
+    assert!(worst < 1e-10, "largest relative difference {worst:e}");
+}
+
+/// A heavy top: a body pivoted at O, oriented by a body-fixed z-x-y
+/// sequence (three-angle sugar), with its mass centre on its own z axis.
+#[derive(Appell, Clone)]
+#[appell(coordinates(a1, a2, a3), speeds(a1, a2, a3))]
+#[appell(frame(B = N.body_zxy(a1, a2, a3)))]
+#[appell(point(C = O + h * B.z))]
+#[appell(body(top, center = C, frame = B, mass = m, inertia = matrix(i1, i2, i3, i12, 0, i31)))]
+#[appell(gravity(-g * N.z))]
+struct HeavyTop {
+    m: f64,
+    h: f64,
+    g: f64,
+    i1: f64,
+    i2: f64,
+    i3: f64,
+    i12: f64,
+    i31: f64,
+}
+
+#[test]
+fn body_sequence_top_agrees_with_the_oracle() {
+    let mut rng = Rng(26);
+    let p = HeavyTop { m: 0.8, h: 0.15, g: 9.81, i1: 0.004, i2: 0.005, i3: 0.007, i12: 0.0004, i31: -0.0003 };
+    // Away from the sequence's singular middle angle (a2 = ±π/2).
+    let worst = agree(&p, &mut rng, 1000, 1.2);
+    assert!(worst < 1e-10, "largest relative difference {worst:e}");
+}
+
+#[test]
+fn chaplygin_sleigh_example_agrees_with_the_oracle() {
+    let mut rng = Rng(27);
+    let p = chaplygin::ChaplyginSleigh::default();
+    let worst = agree(&p, &mut rng, 1000, 1.2);
     assert!(worst < 1e-10, "largest relative difference {worst:e}");
 }
 
