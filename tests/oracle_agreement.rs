@@ -2,10 +2,10 @@
 //! coordinates, Lagrange multipliers, Jacobians by dual numbers; Wang & Pao
 //! eqs. 69-70) at 1,000 random states per model.
 
-#[path = "../examples/models/wheel_axle.rs"]
-mod wheel_axle;
 #[path = "../examples/models/chaplygin_sleigh.rs"]
 mod chaplygin;
+#[path = "../examples/models/wheel_axle.rs"]
+mod wheel_axle;
 
 mod common;
 #[path = "../examples/models/double_pendulum.rs"]
@@ -143,7 +143,16 @@ struct HeavyTop {
 #[test]
 fn body_sequence_top_agrees_with_the_oracle() {
     let mut rng = Rng(26);
-    let p = HeavyTop { m: 0.8, h: 0.15, g: 9.81, i1: 0.004, i2: 0.005, i3: 0.007, i12: 0.0004, i31: -0.0003 };
+    let p = HeavyTop {
+        m: 0.8,
+        h: 0.15,
+        g: 9.81,
+        i1: 0.004,
+        i2: 0.005,
+        i3: 0.007,
+        i12: 0.0004,
+        i31: -0.0003,
+    };
     // Away from the sequence's singular middle angle (a2 = ±π/2).
     let worst = agree(&p, &mut rng, 1000, 1.2);
     assert!(worst < 1e-10, "largest relative difference {worst:e}");

@@ -41,7 +41,8 @@ pub enum Elimination {
 
 /// The numeric part of the elimination: after the unknowns with safe
 /// pivots are eliminated symbolically, the remaining k dependent rates solve
-/// S X = R (X = the free rows of [B | b]), and their rates S Ẋ = Ṙ − Ṡ X.
+/// S X = R (X = the free rows of [B | b]); for the accelerations,
+/// S w = (Ṙ − Ṡ X) [ẏ; 1] with w = Ẋ [ẏ; 1].
 pub struct NumericElimination {
     /// Number of unknowns solved numerically.
     pub k: usize,
@@ -49,12 +50,12 @@ pub struct NumericElimination {
     pub dp: Vec<Id>,
     /// R (k×(l+1)), row-major.
     pub rhs: Vec<Id>,
-    /// Ṙ − Ṡ X (k×(l+1)), row-major; contains the X symbols.
+    /// (Ṙ − Ṡ X) [ẏ; 1] (k), the right side for w; contains X and ẏ.
     pub rhs_rate: Vec<Id>,
     /// Symbols of X (k×(l+1)).
     pub x: Vec<Symbol>,
-    /// Symbols of Ẋ (k×(l+1)).
-    pub x_rate: Vec<Symbol>,
+    /// Symbols of w = Ẋ [ẏ; 1] (k), the dependent acceleration remainder.
+    pub w: Vec<Symbol>,
 }
 
 /// Per body: velocity pieces and, for rigid bodies, body-frame angular ones.
@@ -474,32 +475,39 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }
     let mut elimination = Elimination::Symbolic;
     if let Some((xs, k, s_mat, s_rhs)) = numeric_part {
-        let mut x_rate = Vec::new();
+        // The accelerations need Ẋ only in the combination w = Ẋ [ẏ; 1]
+        // (the dependent acceleration remainder): every β̄_k is linear in the
+        // column X_k, so Σ_k β̄̇_k ẏ_k + β̄̇ sees Σ_k Ẋ_k ẏ_k + Ẋ_l. The rate
+        // rules therefore give X_fk → 0 (k < l) and X_fl → w_f, and w solves
+        // S w = (Ṙ − Ṡ X) [ẏ; 1]: one right-hand side instead of l + 1.
+        let mut w = Vec::with_capacity(k);
+        for f in 0..k {
+            w.push(g.declare(&format!("__w_{f}"), SymbolKind::Auxiliary)?);
+        }
         for f in 0..k {
             for j in 0..=l {
-                let s = g.declare(&format!("__xd_{f}_{j}"), SymbolKind::Auxiliary)?;
-                x_rate.push(s);
+                let rate = if j == l { g.sym(w[f])? } else { zero };
+                reduced = reduced.with(xs[f * (l + 1) + j], rate);
             }
         }
-        for (s, r) in xs.iter().zip(&x_rate) {
-            let rid = g.sym(*r)?;
-            reduced = reduced.with(*s, rid);
-        }
-        // S X = R  ⇒  S Ẋ = Ṙ − Ṡ X.
         let s_rate = g.time_derivatives(&s_mat, &reduced)?;
-        let rhs_rate_plain = g.time_derivatives(&s_rhs, &reduced)?;
-        let mut rhs_rate = Vec::with_capacity(k * (l + 1));
+        let r_rate = g.time_derivatives(&s_rhs, &reduced)?;
+        let mut rhs_rate = Vec::with_capacity(k);
         for i in 0..k {
+            let mut terms = Vec::new();
             for j in 0..=l {
-                let mut terms = vec![rhs_rate_plain[i * (l + 1) + j]];
+                let mut inner = vec![r_rate[i * (l + 1) + j]];
                 for f in 0..k {
                     let xf = g.sym(xs[f * (l + 1) + j])?;
                     let t = g.mul(s_rate[i * k + f], xf)?;
-                    terms.push(g.neg(t)?);
+                    inner.push(g.neg(t)?);
                 }
-                let sum = g.sum(&terms)?;
-                rhs_rate.push(expanded(g, sum)?);
+                let column = g.sum(&inner)?;
+                let weight = if j == l { one } else { g.sym(speed_rates[j])? };
+                terms.push(g.mul(column, weight)?);
             }
+            let sum = g.sum(&terms)?;
+            rhs_rate.push(expanded(g, sum)?);
         }
         elimination = Elimination::Numeric(NumericElimination {
             k,
@@ -507,7 +515,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             rhs: s_rhs,
             rhs_rate,
             x: xs,
-            x_rate,
+            w,
         });
     }
     // 4. Velocities with ż eliminated: substitute the dependent rates.
@@ -707,7 +715,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 all.union_with(g.dependencies(e));
             }
             ne.x.iter()
-                .chain(&ne.x_rate)
+                .chain(&ne.w)
                 .map(|&s| (s, all.clone()))
                 .collect::<Vec<_>>()
         }

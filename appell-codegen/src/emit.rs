@@ -132,73 +132,68 @@ impl Emitter<'_> {
         let (m, l) = (ne.k, self.d.l);
         let mut s = String::new();
         let mut ops = 0;
-        let mut stage =
-            |s: &mut String, rhs: &[Id], names: &[appell_symbolic::Symbol], tag: &str| {
-                let mut roots: Vec<Id> = ne.dp.clone();
-                roots.extend_from_slice(rhs);
-                let c = code(self.d, &roots, &options(false));
-                ops += c.ops.total() + m * m * m + m * m * (l + 1) * 2;
-                s.push_str("        {\n");
-                s.push_str(
-                    &statements(&c)
-                        .replace("\n        ", "\n            ")
-                        .replacen("        ", "            ", 1),
-                );
-                let rows: Vec<String> = (0..m)
-                    .map(|i| {
-                        format!(
-                            "[{}]",
-                            (0..m)
-                                .map(|j| c.outputs[i * m + j].clone())
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        )
-                    })
-                    .collect();
-                let rrows: Vec<String> = (0..m)
-                    .map(|i| {
-                        format!(
-                            "[{}]",
-                            (0..=l)
-                                .map(|j| c.outputs[m * m + i * (l + 1) + j].clone())
-                                .collect::<Vec<_>>()
-                                .join(", ")
-                        )
-                    })
-                    .collect();
-                let _ = writeln!(
-                    s,
-                    "            let mut __a{tag}: [[__T; {m}]; {m}] = [{}];",
-                    rows.join(", ")
-                );
-                let _ = writeln!(
-                    s,
-                    "            let mut __b{tag}: [[__T; {}]; {m}] = [{}];",
-                    l + 1,
-                    rrows.join(", ")
-                );
-                let _ = writeln!(
-                    s,
-                    "            {P}::lu_solve(&mut __a{tag}, &mut __b{tag})?;"
-                );
-                let _ = writeln!(s, "            __x{tag} = __b{tag};");
-                s.push_str("        }\n");
-                let _ = names;
-            };
+        let mut stage = |s: &mut String, rhs: &[Id], width: usize, tag: &str| {
+            let mut roots: Vec<Id> = ne.dp.clone();
+            roots.extend_from_slice(rhs);
+            let c = code(self.d, &roots, &options(false));
+            ops += c.ops.total() + m * m * m + m * m * width * 2;
+            s.push_str("        {\n");
+            s.push_str(
+                &statements(&c)
+                    .replace("\n        ", "\n            ")
+                    .replacen("        ", "            ", 1),
+            );
+            let rows: Vec<String> = (0..m)
+                .map(|i| {
+                    format!(
+                        "[{}]",
+                        (0..m)
+                            .map(|j| c.outputs[i * m + j].clone())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                })
+                .collect();
+            let rrows: Vec<String> = (0..m)
+                .map(|i| {
+                    format!(
+                        "[{}]",
+                        (0..width)
+                            .map(|j| c.outputs[m * m + i * width + j].clone())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                })
+                .collect();
+            let _ = writeln!(
+                s,
+                "            let mut __a{tag}: [[__T; {m}]; {m}] = [{}];",
+                rows.join(", ")
+            );
+            let _ = writeln!(
+                s,
+                "            let mut __b{tag}: [[__T; {width}]; {m}] = [{}];",
+                rrows.join(", ")
+            );
+            let _ = writeln!(
+                s,
+                "            {P}::lu_solve(&mut __a{tag}, &mut __b{tag})?;"
+            );
+            let _ = writeln!(s, "            __x{tag} = __b{tag};");
+            s.push_str("        }\n");
+        };
         let _ = writeln!(s, "        let __x0: [[__T; {}]; {m}];", l + 1);
-        stage(&mut s, &ne.rhs, &ne.x, "0");
+        stage(&mut s, &ne.rhs, l + 1, "0");
         for i in 0..m {
             for j in 0..=l {
                 let _ = writeln!(s, "        let __x_{i}_{j} = __x0[{i}][{j}];");
             }
         }
         if rates {
-            let _ = writeln!(s, "        let __x1: [[__T; {}]; {m}];", l + 1);
-            stage(&mut s, &ne.rhs_rate, &ne.x_rate, "1");
+            let _ = writeln!(s, "        let __x1: [[__T; 1]; {m}];");
+            stage(&mut s, &ne.rhs_rate, 1, "1");
             for i in 0..m {
-                for j in 0..=l {
-                    let _ = writeln!(s, "        let __xd_{i}_{j} = __x1[{i}][{j}];");
-                }
+                let _ = writeln!(s, "        let __w_{i} = __x1[{i}][0];");
             }
         }
         (s, ops)

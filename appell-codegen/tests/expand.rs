@@ -60,6 +60,9 @@ fn whipple_bicycle_expands() {
     if let Some(i) = out.find("total :") {
         println!("{}", &out[i..i + 20]);
     }
+    if let Some(path) = std::env::var_os("APPELL_WRITE_EXPANSION") {
+        std::fs::write(path, &out).unwrap();
+    }
     assert!(
         !out.contains("compile_error"),
         "{}",
