@@ -48,7 +48,10 @@ pub struct ModelInfo {
     pub parameters: &'static [&'static str],
     /// Generalized coordinates q_r, in declaration order.
     pub coordinates: &'static [&'static str],
-    /// Coordinates whose rates are the privileged speeds ẏ_k, in order.
+    /// The privileged speeds ẏ_k, in order: a coordinate's name when the
+    /// speed is that coordinate's rate (Method II), else the name of a
+    /// quasi-velocity (Method III, defined by
+    /// [`Model::speed_definitions`]).
     pub speeds: &'static [&'static str],
     /// Coordinates whose rates are dependent (solved from the constraints).
     pub dependent: &'static [&'static str],
@@ -131,6 +134,12 @@ pub enum ModelError {
         /// Its value.
         value: f64,
     },
+    /// A privileged speed that is not a coordinate's rate, in a model that
+    /// does not define it (see [`Model::speed_definitions`]).
+    UnknownSpeed {
+        /// The speed's name.
+        name: &'static str,
+    },
     /// An input, a state component or a result is NaN or infinite.
     NonFinite {
         /// Which quantity.
@@ -157,6 +166,10 @@ impl core::fmt::Display for ModelError {
             ModelError::NonPositiveParameter { name, value } => {
                 write!(f, "parameter `{name}` is declared positive but is {value}")
             }
+            ModelError::UnknownSpeed { name } => write!(
+                f,
+                "speed `{name}` is not a coordinate's rate, and the model does not define it"
+            ),
             ModelError::NonFinite { what } => write!(f, "{what} is not finite"),
         }
     }
@@ -254,6 +267,36 @@ pub trait Model {
         holonomic: &mut [T],
         velocity: &mut [T],
     ) -> Result<(), ModelError>;
+
+    /// The definitions of the privileged speeds, u = W(q,t) q̇ + w(q,t):
+    /// `w` is W (l×n row-major), `w0` is w (l). A speed that is a
+    /// coordinate's rate (Method II) has a unit row; a quasi-velocity
+    /// (Method III) has its defining combination. The default serves models
+    /// whose speeds are all named coordinates.
+    fn speed_definitions<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        w: &mut [T],
+        w0: &mut [T],
+    ) -> Result<(), ModelError> {
+        let _ = t;
+        let info = Self::info();
+        let (n, l) = (info.coordinates.len(), info.speeds.len());
+        check_len("q", q, n)?;
+        check_len("w", w, l * n)?;
+        check_len("w0", w0, l)?;
+        for (k, name) in info.speeds.iter().enumerate() {
+            let r = info
+                .coordinate_index(name)
+                .ok_or(ModelError::UnknownSpeed { name })?;
+            for c in 0..n {
+                w[k * n + c] = if c == r { T::one() } else { T::zero() };
+            }
+            w0[k] = T::zero();
+        }
+        Ok(())
+    }
 
     /// Kinetic energy at full coordinates and privileged speeds.
     fn kinetic_energy<T: Scalar>(&self, t: T, q: &[T], u: &[T]) -> Result<T, ModelError>;

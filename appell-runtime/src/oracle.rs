@@ -250,8 +250,7 @@ struct Layout {
     points: usize,
     frames: usize,
     inputs: usize,
-    privileged: Vec<usize>,
-    dependent: Vec<usize>,
+    l: usize,
     retained: Vec<usize>,
 }
 
@@ -271,21 +270,10 @@ impl Layout {
                 )));
             }
         }
-        let mut privileged = Vec::with_capacity(info.speeds.len());
-        for s in info.speeds {
-            let i = index_of(info, s, "speeds")?;
-            if privileged.contains(&i) {
-                return Err(OracleError::InvalidInfo(format!(
-                    "speed `{s}` is listed twice"
-                )));
-            }
-            privileged.push(i);
-        }
-        let dependent: Vec<usize> = (0..n).filter(|i| !privileged.contains(i)).collect();
-        if dependent.len() != info.constraints {
+        let l = info.speeds.len();
+        if info.constraints + l != n {
             return Err(OracleError::InvalidInfo(format!(
-                "{n} coordinates, {} privileged speeds and {} constraint rows: the rows must determine exactly the remaining rates",
-                privileged.len(),
+                "{n} coordinates, {l} privileged speeds and {} constraint rows: the rows and the speeds' definitions must determine exactly the {n} rates",
                 info.constraints
             )));
         }
@@ -301,8 +289,7 @@ impl Layout {
             points: info.force_points,
             frames: info.torques,
             inputs: info.inputs.len(),
-            privileged,
-            dependent,
+            l,
             retained,
         })
     }
@@ -684,7 +671,30 @@ fn accelerations_with<M: Model>(
 ) -> Result<OracleSolution, OracleError> {
     let full = full_dynamics_with(model, lay, t, q, qdot, inputs)?;
     let (qddot, multipliers) = solve_kkt(&full)?;
-    let privileged = lay.privileged.iter().map(|&i| qddot[i]).collect();
+    // u = W q̇ + w  ⇒  u̇ = W q̈ + (Ẇ q̇ + ẇ), the bias by a dual number
+    // along (q̇, 1).
+    let (n, l) = (lay.n, lay.l);
+    let mut w = vec![0.0; l * n];
+    let mut w0 = vec![0.0; l];
+    model.speed_definitions(t, q, &mut w, &mut w0)?;
+    let qd: Vec<Dual64> = q
+        .iter()
+        .zip(qdot)
+        .map(|(&a, &b)| Dual64::new(a, b))
+        .collect();
+    let mut wd = vec![Dual64::from(0.0); l * n];
+    let mut w0d = vec![Dual64::from(0.0); l];
+    model.speed_definitions(Dual64::new(t, 1.0), &qd, &mut wd, &mut w0d)?;
+    let privileged: Vec<f64> = (0..l)
+        .map(|k| {
+            let mut acc = w0d[k].eps;
+            for c in 0..n {
+                acc += w[k * n + c] * qddot[c] + wd[k * n + c].eps * qdot[c];
+            }
+            acc
+        })
+        .collect();
+    finite_all(privileged.iter().copied(), "the privileged accelerations")?;
     Ok(OracleSolution {
         qddot,
         multipliers,
@@ -719,9 +729,9 @@ fn coordinate_rates_with<M: Model>(
     q_full: &[f64],
     u: &[f64],
 ) -> Result<Vec<f64>, OracleError> {
-    let (n, m) = (lay.n, lay.m);
+    let (n, m, l) = (lay.n, lay.m, lay.l);
     check_len("q", q_full, n)?;
-    check_len("u", u, lay.privileged.len())?;
+    check_len("u", u, l)?;
     finite_all([t], "t")?;
     finite_all(q_full.iter().copied(), "q")?;
     finite_all(u.iter().copied(), "u")?;
@@ -729,40 +739,38 @@ fn coordinate_rates_with<M: Model>(
     let mut doff = vec![0.0; m];
     model.constraint_rows(t, q_full, &mut dmat, &mut doff)?;
     finite_all(dmat.iter().chain(&doff).copied(), "the constraint rows")?;
-
-    let mut qdot = vec![0.0; n];
-    for (&i, &v) in lay.privileged.iter().zip(u) {
-        qdot[i] = v;
-    }
-    let mut a = DMatrix::<f64>::zeros(m, m);
-    let mut b = DVector::<f64>::zeros(m);
+    let mut w = vec![0.0; l * n];
+    let mut w0 = vec![0.0; l];
+    model.speed_definitions(t, q_full, &mut w, &mut w0)?;
+    finite_all(w.iter().chain(&w0).copied(), "the speed definitions")?;
+    // [D; W] q̇ = [−d; u − w]
+    let mut a = DMatrix::<f64>::zeros(n, n);
+    let mut b = DVector::<f64>::zeros(n);
     for row in 0..m {
-        for (k, &c) in lay.dependent.iter().enumerate() {
-            a[(row, k)] = dmat[row * n + c];
+        for c in 0..n {
+            a[(row, c)] = dmat[row * n + c];
         }
-        b[row] = -doff[row]
-            - lay
-                .privileged
-                .iter()
-                .map(|&c| dmat[row * n + c] * qdot[c])
-                .sum::<f64>();
+        b[row] = -doff[row];
+    }
+    for k in 0..l {
+        for c in 0..n {
+            a[(m + k, c)] = w[k * n + c];
+        }
+        b[m + k] = u[k] - w0[k];
     }
     let info = M::info();
-    // Measured against all of D: a dependent column can be negligible only
+    // Measured against the whole system: a column can be negligible only
     // relative to the rows it belongs to.
-    let scale = dmat.iter().fold(0.0_f64, |s, x| s.max(x.abs()));
-    let x = lu_solve_checked(a, b, scale, |k, pivot, tolerance| {
+    let scale = dmat.iter().chain(&w).fold(0.0_f64, |s, x| s.max(x.abs()));
+    let qdot = lu_solve_checked(a, b, scale, |k, pivot, tolerance| {
         OracleError::SingularConstraints {
-            coordinate: info.coordinates[lay.dependent[k]],
+            coordinate: info.coordinates[k.min(n - 1)],
             pivot,
             tolerance,
         }
     })?;
-    finite_all(x.iter().copied(), "the dependent rates")?;
-    for (k, &c) in lay.dependent.iter().enumerate() {
-        qdot[c] = x[k];
-    }
-    Ok(qdot)
+    finite_all(qdot.iter().copied(), "the coordinate rates")?;
+    Ok(qdot.iter().copied().collect())
 }
 
 /// The reduced right-hand side in the layout of [`Model::rhs`]'s `dstate`:
@@ -783,7 +791,7 @@ pub fn reduced_rhs<M: Model>(
     let lay = Layout::new(M::info())?;
     let qdot = coordinate_rates_with(model, &lay, t, q_full, u)?;
     let sol = accelerations_with(model, &lay, t, q_full, &qdot, inputs)?;
-    let mut out = Vec::with_capacity(lay.retained.len() + lay.privileged.len());
+    let mut out = Vec::with_capacity(lay.retained.len() + lay.l);
     out.extend(lay.retained.iter().map(|&i| qdot[i]));
     out.extend(sol.privileged);
     Ok(out)
