@@ -148,6 +148,16 @@ pub struct RollsDef {
     pub at: proc_macro2::TokenStream,
 }
 
+/// One privileged speed: a coordinate's name (its rate, Method II) or
+/// `name = expression` (a quasi-velocity linear in the rates, Method III).
+#[derive(Clone, Debug)]
+pub struct SpeedDef {
+    /// The coordinate, or the quasi-velocity's new name.
+    pub name: Ident,
+    /// The definition of a quasi-velocity.
+    pub definition: Option<Expr>,
+}
+
 /// The whole model as written.
 #[derive(Clone, Debug)]
 pub struct ModelAst {
@@ -158,7 +168,7 @@ pub struct ModelAst {
     /// `coordinates(...)`.
     pub coordinates: Vec<Ident>,
     /// `speeds(...)` and its tokens (for errors).
-    pub speeds: Option<(Vec<Ident>, proc_macro2::TokenStream)>,
+    pub speeds: Option<(Vec<SpeedDef>, proc_macro2::TokenStream)>,
     /// `inputs(...)`.
     pub inputs: Vec<Ident>,
     /// `positive(...)`: parameters known to be positive.

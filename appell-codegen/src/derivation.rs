@@ -98,6 +98,10 @@ pub struct Derivation {
     pub qdot: Vec<Id>,
     /// D q̇ + d, with q̇ the coordinate rate symbols.
     pub velocity_residuals: Vec<Id>,
+    /// W (l×n) of the speeds' definitions u = W q̇ + w.
+    pub speed_w: Vec<Id>,
+    /// w (l).
+    pub speed_w0: Vec<Id>,
     /// Symbols ÿ_k.
     pub accels: Vec<Symbol>,
     /// M (l×l), row-major, symmetric.
@@ -144,6 +148,8 @@ struct Parts {
     elimination: Elimination,
     qdot: Vec<Id>,
     velocity_residuals: Vec<Id>,
+    speed_w: Vec<Id>,
+    speed_w0: Vec<Id>,
     accels: Vec<Symbol>,
     mass: Vec<Id>,
     forcing: Vec<Id>,
@@ -169,6 +175,8 @@ impl Parts {
             elimination: self.elimination,
             qdot: self.qdot,
             velocity_residuals: self.velocity_residuals,
+            speed_w: self.speed_w,
+            speed_w0: self.speed_w0,
             accels: self.accels,
             mass: self.mass,
             forcing: self.forcing,
@@ -307,7 +315,73 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         return Ok(None);
     }
     let m = d0.len();
-    let l = model.speeds.len();
+    let l = model.speed_specs.len();
+    let quasi = model.speed_specs.iter().any(|s| s.definition.is_some());
+    // The speeds' definitions u = W q̇ + w: unit rows for coordinate rates
+    // (Method II), the defining combination for quasi-velocities (Method III).
+    let (zero, one) = (model.g.int(0)?, model.g.int(1)?);
+    let mut speed_w = Vec::with_capacity(l * n);
+    let mut speed_w0 = Vec::with_capacity(l);
+    for spec in &model.speed_specs {
+        match (spec.coordinate, spec.definition) {
+            (Some(r), _) => {
+                speed_w.extend((0..n).map(|c| if c == r { one } else { zero }));
+                speed_w0.push(zero);
+            }
+            (None, Some(def)) => {
+                let bad: Vec<String> = model
+                    .g
+                    .dependencies(def)
+                    .iter()
+                    .filter(|s| {
+                        matches!(
+                            model.g.symbol_kind(*s),
+                            SymbolKind::Input | SymbolKind::Acceleration(_) | SymbolKind::Auxiliary
+                        )
+                    })
+                    .map(|s| model.g.symbol_name(s).to_string())
+                    .collect();
+                if !bad.is_empty() {
+                    cx.error_spanned_by(
+                        &model.speeds_at,
+                        format!(
+                            "the quasi-velocity `{}` cannot depend on {}",
+                            spec.name,
+                            bad.join(", ")
+                        ),
+                    );
+                    continue;
+                }
+                match model.g.linear_coefficients(def, &rates) {
+                    Ok(form) => {
+                        if form.coefficients.iter().all(|c| model.g.is_zero(*c)) {
+                            cx.error_spanned_by(
+                                &model.speeds_at,
+                                format!(
+                                    "the quasi-velocity `{}` involves no coordinate rate",
+                                    spec.name
+                                ),
+                            );
+                            continue;
+                        }
+                        speed_w.extend(form.coefficients);
+                        speed_w0.push(form.remainder);
+                    }
+                    Err(SymbolicError::NonLinear { symbol, .. }) => {
+                        cx.error_spanned_by(
+                            &model.speeds_at,
+                            format!("the quasi-velocity `{}` must be linear in the coordinate rates (Method III, eq. 56), and it is not linear in `{symbol}`", spec.name),
+                        );
+                    }
+                    Err(e) => cx.error_spanned_by(&model.speeds_at, e),
+                }
+            }
+            (None, None) => unreachable!("a speed is a coordinate or a definition"),
+        }
+    }
+    if cx.has_errors() {
+        return Ok(None);
+    }
     if let Some(row) = dependent_row(&model.g, &d_rows, n, m) {
         cx.error_spanned_by(
             &row_sources[row],
@@ -326,7 +400,25 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         );
         return Ok(None);
     }
-    let dependent: Vec<usize> = (0..n).filter(|i| !model.speeds.contains(i)).collect();
+    if quasi {
+        let mut full = d_rows.clone();
+        full.extend(&speed_w);
+        if let Some(row) = dependent_row(&model.g, &full, n, n) {
+            let name = &model.speed_specs[row.saturating_sub(m).min(l - 1)].name;
+            cx.error_spanned_by(
+                &model.speeds_at,
+                format!("the speeds' definitions are not invertible: with the constraints they do not determine the coordinate rates ([D; W] is singular; `{name}` depends on the others)"),
+            );
+            return Ok(None);
+        }
+    }
+    // Unknowns: the dependent rates (Method II), or every rate when some
+    // speed is a quasi-velocity (Method III, [D; W] q̇ = [−d; u − w]).
+    let dependent: Vec<usize> = if quasi {
+        (0..n).collect()
+    } else {
+        (0..n).filter(|i| !model.speeds.contains(i)).collect()
+    };
     for c in &model.holonomic {
         let involves_dependent = dependent
             .iter()
@@ -342,8 +434,33 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         return Ok(None);
     }
     let g = &mut model.g;
-    // 2. Structural rank of D' (a matching of rows to dependent columns).
-    if let Some(col) = unmatched_column(g, &d_rows, n, m, &dependent) {
+    let k_unknowns = dependent.len();
+    let mut dp = Vec::with_capacity(k_unknowns * k_unknowns);
+    let mut rhs = Vec::with_capacity(k_unknowns * (l + 1));
+    if quasi {
+        dp.extend(d_rows.iter().copied());
+        dp.extend(speed_w.iter().copied());
+        for r in 0..m {
+            rhs.extend((0..l).map(|_| zero));
+            rhs.push(g.neg(d0[r])?);
+        }
+        for k in 0..l {
+            rhs.extend((0..l).map(|j| if j == k { one } else { zero }));
+            rhs.push(g.neg(speed_w0[k])?);
+        }
+    } else {
+        for r in 0..m {
+            for &c in &dependent {
+                dp.push(d_rows[r * n + c]);
+            }
+            for &k in &model.speeds {
+                rhs.push(g.neg(d_rows[r * n + k])?);
+            }
+            rhs.push(g.neg(d0[r])?);
+        }
+    }
+    // 2. Structural rank of the system (a matching of rows to unknowns).
+    if let Some(col) = unmatched_column(g, &dp, k_unknowns) {
         let name = model.coords[dependent[col]].0.to_string();
         cx.error_spanned_by(
             &model.speeds_at,
@@ -351,96 +468,86 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         );
         return Ok(None);
     }
-    let mut dp = Vec::with_capacity(m * m);
-    let mut rhs = Vec::with_capacity(m * (l + 1));
-    for r in 0..m {
-        for &c in &dependent {
-            dp.push(d_rows[r * n + c]);
-        }
-        for &k in &model.speeds {
-            rhs.push(g.neg(d_rows[r * n + k])?);
-        }
-        rhs.push(g.neg(d0[r])?);
-    }
     let mut assume = Assumptions::new();
     for p in &model.params {
         if p.positive {
             assume = assume.positive(p.symbol);
         }
     }
-    let dp_m = SymMatrix::from_rows(m, m, dp.clone())?;
-    let rhs_m = SymMatrix::from_rows(m, l + 1, rhs.clone())?;
+    let dp_m = SymMatrix::from_rows(k_unknowns, k_unknowns, dp.clone())?;
+    let rhs_m = SymMatrix::from_rows(k_unknowns, l + 1, rhs.clone())?;
     // Unknowns with safe pivots are eliminated symbolically; the rest (the
     // Schur complement S x_f = R_s) is solved numerically at run time, the
     // free unknowns standing as auxiliary symbols X_f in the expressions.
     #[allow(clippy::type_complexity)] // (aux symbols, S, R_s) of the numeric part
-    let (x_entries, numeric_part): (Vec<Id>, Option<(Vec<Symbol>, usize, Vec<Id>, Vec<Id>)>) = if m
-        == 0
-    {
-        (Vec::new(), None)
-    } else {
-        match g.eliminate(&dp_m, &rhs_m, &assume) {
-            Ok(part) => {
-                let k = part.free_cols.len();
-                let zero = g.int(0)?;
-                let mut x_entries = vec![zero; m * (l + 1)];
-                let mut syms = Vec::new();
-                let mut ids = Vec::new();
-                for f in 0..k {
-                    for j in 0..=l {
-                        let s = g.declare(&format!("__x_{f}_{j}"), SymbolKind::Auxiliary)?;
-                        ids.push(g.sym(s)?);
-                        syms.push(s);
-                    }
-                }
-                for (f, &col) in part.free_cols.iter().enumerate() {
-                    for j in 0..=l {
-                        x_entries[col * (l + 1) + j] = ids[f * (l + 1) + j];
-                    }
-                }
-                for (i, &col) in part.pivot_cols.iter().enumerate() {
-                    for j in 0..=l {
-                        let mut terms = vec![part.pivot_rhs[(i, j)]];
-                        for f in 0..k {
-                            let t = g.mul(part.pivot_free[(i, f)], ids[f * (l + 1) + j])?;
-                            terms.push(g.neg(t)?);
+    let (x_entries, numeric_part): (Vec<Id>, Option<(Vec<Symbol>, usize, Vec<Id>, Vec<Id>)>) =
+        if k_unknowns == 0 {
+            (Vec::new(), None)
+        } else {
+            match g.eliminate(&dp_m, &rhs_m, &assume) {
+                Ok(part) => {
+                    let k = part.free_cols.len();
+                    let zero = g.int(0)?;
+                    let mut x_entries = vec![zero; k_unknowns * (l + 1)];
+                    let mut syms = Vec::new();
+                    let mut ids = Vec::new();
+                    for f in 0..k {
+                        for j in 0..=l {
+                            let s = g.declare(&format!("__x_{f}_{j}"), SymbolKind::Auxiliary)?;
+                            ids.push(g.sym(s)?);
+                            syms.push(s);
                         }
-                        let sum = g.sum(&terms)?;
-                        x_entries[col * (l + 1) + j] = expanded(g, sum)?;
+                    }
+                    for (f, &col) in part.free_cols.iter().enumerate() {
+                        for j in 0..=l {
+                            x_entries[col * (l + 1) + j] = ids[f * (l + 1) + j];
+                        }
+                    }
+                    for (i, &col) in part.pivot_cols.iter().enumerate() {
+                        for j in 0..=l {
+                            let mut terms = vec![part.pivot_rhs[(i, j)]];
+                            for f in 0..k {
+                                let t = g.mul(part.pivot_free[(i, f)], ids[f * (l + 1) + j])?;
+                                terms.push(g.neg(t)?);
+                            }
+                            let sum = g.sum(&terms)?;
+                            x_entries[col * (l + 1) + j] = expanded(g, sum)?;
+                        }
+                    }
+                    if k == 0 {
+                        (x_entries, None)
+                    } else {
+                        (
+                            x_entries,
+                            Some((
+                                syms,
+                                k,
+                                part.s.entries().to_vec(),
+                                part.s_rhs.entries().to_vec(),
+                            )),
+                        )
                     }
                 }
-                if k == 0 {
-                    (x_entries, None)
-                } else {
-                    (
-                        x_entries,
-                        Some((
-                            syms,
-                            k,
-                            part.s.entries().to_vec(),
-                            part.s_rhs.entries().to_vec(),
-                        )),
-                    )
-                }
-            }
-            Err(SymbolicError::StructurallySingular { column }) => {
-                let name = model.coords[dependent[column]].0.to_string();
-                cx.error_spanned_by(
+                Err(SymbolicError::StructurallySingular { column }) => {
+                    let name = model.coords[dependent[column]].0.to_string();
+                    cx.error_spanned_by(
                     &model.speeds_at,
                     format!("with these privileged speeds the constraints cannot determine the rate of `{name}` (D' is singular after elimination); choose other speeds"),
                 );
-                return Ok(None);
+                    return Ok(None);
+                }
+                Err(e) => return Err(e),
             }
-            Err(e) => return Err(e),
-        }
-    };
+        };
     // 3. C and c.
     let zero = g.int(0)?;
     let one = g.int(1)?;
     let mut c = vec![zero; n * l];
     let mut c0 = vec![zero; n];
-    for (k, &s) in model.speeds.iter().enumerate() {
-        c[s * l + k] = one;
+    if !quasi {
+        for (k, &s) in model.speeds.iter().enumerate() {
+            c[s * l + k] = one;
+        }
     }
     for (i, &r) in dependent.iter().enumerate() {
         for k in 0..l {
@@ -448,16 +555,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
         c0[r] = x_entries[i * (l + 1) + l];
     }
-    let speed_rates: Vec<Symbol> = model
-        .speeds
-        .iter()
-        .map(|&i| model.coords[i].1.rate)
-        .collect();
-    let accels: Vec<Symbol> = model
-        .speeds
-        .iter()
-        .map(|&i| model.coords[i].1.accel)
-        .collect();
+    let speed_rates: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
+    let accels: Vec<Symbol> = model.speed_specs.iter().map(|s| s.accel).collect();
     // q̇_r = Σ C_rk ẏ_k + c_r, as expressions.
     let mut qdot = Vec::with_capacity(n);
     for r in 0..n {
@@ -472,6 +571,10 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let mut reduced = RateRules::coordinates();
     for (r, (_, coord)) in model.coords.iter().enumerate() {
         reduced = reduced.with(coord.q, qdot[r]);
+    }
+    for spec in model.speed_specs.iter().filter(|s| s.definition.is_some()) {
+        let a = g.sym(spec.accel)?;
+        reduced = reduced.with(spec.symbol, a);
     }
     let mut elimination = Elimination::Symbolic;
     if let Some((xs, k, s_mat, s_rhs)) = numeric_part {
@@ -780,6 +883,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         elimination,
         qdot,
         velocity_residuals,
+        speed_w,
+        speed_w0,
         accels,
         mass,
         forcing,
@@ -979,28 +1084,22 @@ fn dependent_row(g: &appell_symbolic::Graph, d: &[Id], n: usize, m: usize) -> Op
     first_dependent
 }
 
-/// A column of D' (dependent rate) that no row can be matched to, by
+/// A column (unknown rate) of the square system that no row can be matched to, by
 /// augmenting paths over the non-zero pattern.
-fn unmatched_column(
-    g: &appell_symbolic::Graph,
-    d: &[Id],
-    n: usize,
-    m: usize,
-    dependent: &[usize],
-) -> Option<usize> {
-    let nonzero = |r: usize, c: usize| !g.is_zero(d[r * n + dependent[c]]);
-    let mut row_of_col: Vec<Option<usize>> = vec![None; m];
+fn unmatched_column(g: &appell_symbolic::Graph, a: &[Id], size: usize) -> Option<usize> {
+    let nonzero = |r: usize, c: usize| !g.is_zero(a[r * size + c]);
+    let mut row_of_col: Vec<Option<usize>> = vec![None; size];
     fn augment(
         r: usize,
         seen: &mut [bool],
         row_of_col: &mut [Option<usize>],
-        m: usize,
+        size: usize,
         nonzero: &dyn Fn(usize, usize) -> bool,
     ) -> bool {
-        for c in 0..m {
+        for c in 0..size {
             if nonzero(r, c) && !seen[c] {
                 seen[c] = true;
-                if row_of_col[c].is_none_or(|r2| augment(r2, seen, row_of_col, m, nonzero)) {
+                if row_of_col[c].is_none_or(|r2| augment(r2, seen, row_of_col, size, nonzero)) {
                     row_of_col[c] = Some(r);
                     return true;
                 }
@@ -1008,9 +1107,9 @@ fn unmatched_column(
         }
         false
     }
-    for r in 0..m {
-        let mut seen = vec![false; m];
-        augment(r, &mut seen, &mut row_of_col, m, &nonzero);
+    for r in 0..size {
+        let mut seen = vec![false; size];
+        augment(r, &mut seen, &mut row_of_col, size, &nonzero);
     }
     row_of_col.iter().position(|x| x.is_none())
 }
@@ -1042,11 +1141,16 @@ fn equations_text(d: &Derivation) -> String {
     );
     let speeds: Vec<String> = d
         .model
-        .speeds
+        .speed_specs
         .iter()
-        .map(|&i| format!("{}_dot", name(i)))
+        .map(|sp| g.symbol_name(sp.symbol).to_string())
         .collect();
     let _ = writeln!(s, "privileged speeds: {}", speeds.join(", "));
+    for (k, sp) in d.model.speed_specs.iter().enumerate() {
+        if let Some(def) = sp.definition {
+            let _ = writeln!(s, "  {} = {} (quasi-velocity)", speeds[k], show(def));
+        }
+    }
     if !d.dependent.is_empty() {
         let how = match d.elimination {
             Elimination::Symbolic => "solved symbolically",
@@ -1090,9 +1194,9 @@ fn equations_text(d: &Derivation) -> String {
     let _ = writeln!(s, "reduced state: ({})", state.join(", "));
     let accels: Vec<String> = d
         .model
-        .speeds
+        .speed_specs
         .iter()
-        .map(|&i| format!("{}_ddot", name(i)))
+        .map(|sp| g.symbol_name(sp.accel).to_string())
         .collect();
     let _ = writeln!(
         s,

@@ -105,8 +105,12 @@ impl Emitter<'_> {
 
     fn bind_u(&self, slice: &str) -> String {
         let mut s = String::new();
-        for (k, &i) in self.d.model.speeds.iter().enumerate() {
-            let _ = writeln!(s, "        let {}_dot = {slice}[{k}];", self.coord(i));
+        for (k, spec) in self.d.model.speed_specs.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "        let {} = {slice}[{k}];",
+                self.d.model.g.symbol_name(spec.symbol)
+            );
         }
         s
     }
@@ -347,7 +351,7 @@ impl Emitter<'_> {
             name = model.name.to_string(),
             params = list(model.params.iter().map(|p| p.ident.to_string()).collect()),
             all = coords(&(0..d.n).collect::<Vec<_>>()),
-            speeds = coords(&model.speeds),
+            speeds = list(model.speed_specs.iter().map(|sp| sp.name.clone()).collect()),
             dependent = coords(&d.dependent),
             cyclic = coords(&d.cyclic),
             ignorable = coords(&d.ignorable),
@@ -456,11 +460,11 @@ impl Emitter<'_> {
         for (k, &r) in d.retained.iter().enumerate() {
             let _ = writeln!(bind_state, "        let {} = __state[{k}];", self.coord(r));
         }
-        for (k, &i) in model.speeds.iter().enumerate() {
+        for (k, spec) in model.speed_specs.iter().enumerate() {
             let _ = writeln!(
                 bind_state,
-                "        let {}_dot = __state[{}];",
-                self.coord(i),
+                "        let {} = __state[{}];",
+                g.symbol_name(spec.symbol),
                 d.retained.len() + k
             );
         }
@@ -507,6 +511,9 @@ impl Emitter<'_> {
         let ct = code(d, &ct_roots, &options(false));
         let cr = code(d, qdot, &options(false));
         let ke = code(d, &[d.kinetic], &options(false));
+        let mut sd_roots = d.speed_w.clone();
+        sd_roots.extend(&d.speed_w0);
+        let sd = code(d, &sd_roots, &options(false));
 
         // --- constraint residuals: holonomic f(q,t), rows D q̇ + d ---
         let mut res_roots = d.holonomic.clone();
@@ -654,6 +661,9 @@ const _: () = {{
     fn constraint_residuals<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_q}{chk_qdot_in}{chk_hol}{chk_vel}{params_t}{bind_q}{bind_qdot}{res_body}{res_out}        {P}::Ok(())
     }}
+    fn speed_definitions<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_w}{chk_w0}{params_t}{bind_q}{sd_body}{sd_out}        {P}::Ok(())
+    }}
     fn kinetic_energy<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{
 {chk_q}{chk_u}{pos}{params_t}{bind_q}{bind_u}{elim_pos}{ke_body}        {P}::Ok({ke_out})
     }}
@@ -689,6 +699,19 @@ const _: () = {{
             chk_qdot_in = self.check("__qdot", n),
             chk_hol = self.check("__holonomic", d.holonomic.len()),
             chk_vel = self.check("__velocity", m),
+            chk_w = self.check("__w", l * n),
+            chk_w0 = self.check("__w0", l),
+            sd_body = statements(&sd),
+            sd_out = {
+                let mut s = String::new();
+                for i in 0..l * n {
+                    let _ = writeln!(s, "        __w[{i}] = {};", sd.outputs[i]);
+                }
+                for i in 0..l {
+                    let _ = writeln!(s, "        __w0[{i}] = {};", sd.outputs[l * n + i]);
+                }
+                s
+            },
             chk_masses = self.check("__masses", nb),
             chk_inertias = self.check("__inertias", nb),
             chk_positions = self.check("__positions", nb),

@@ -87,6 +87,20 @@ pub struct Rolling {
     pub at: proc_macro2::TokenStream,
 }
 
+/// One privileged speed ẏ_k.
+pub struct SpeedSpec {
+    /// Its name (the coordinate's for a coordinate rate).
+    pub name: String,
+    /// The symbol standing for ẏ_k.
+    pub symbol: Symbol,
+    /// The symbol standing for ÿ_k.
+    pub accel: Symbol,
+    /// The coordinate whose rate it is (Method II).
+    pub coordinate: Option<usize>,
+    /// Its definition, linear in the rates (Method III).
+    pub definition: Option<Id>,
+}
+
 /// A constraint residual with its source span.
 pub struct Constraint {
     /// `lhs - rhs`.
@@ -105,8 +119,11 @@ pub struct Model {
     pub params: Vec<Param>,
     /// Coordinates in declaration order.
     pub coords: Vec<(Ident, Coordinate)>,
-    /// Indices (into `coords`) of the privileged speeds, in order.
+    /// Indices (into `coords`) of the coordinates whose rates are privileged
+    /// speeds (Method II).
     pub speeds: Vec<usize>,
+    /// All privileged speeds, in order.
+    pub speed_specs: Vec<SpeedSpec>,
     /// The tokens of `speeds(...)`, for errors.
     pub speeds_at: proc_macro2::TokenStream,
     /// Inputs.
@@ -304,7 +321,8 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             at: r.at.clone(),
         });
     }
-    let (speeds, speeds_at) = b.speeds(ast);
+    let (speed_specs, speeds_at) = b.speeds(ast);
+    let speeds: Vec<usize> = speed_specs.iter().filter_map(|s| s.coordinate).collect();
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
             ast.name.span(),
@@ -320,6 +338,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         params: b.params,
         coords: b.coords,
         speeds,
+        speed_specs,
         speeds_at,
         inputs: b.inputs,
         time: b.time,
@@ -416,25 +435,64 @@ impl Builder<'_> {
         }
     }
 
-    fn speeds(&mut self, ast: &ModelAst) -> (Vec<usize>, proc_macro2::TokenStream) {
+    fn speeds(&mut self, ast: &ModelAst) -> (Vec<SpeedSpec>, proc_macro2::TokenStream) {
         let Some((list, at)) = &ast.speeds else {
             self.cx.error_at(ast.name.span(), "the model declares no `speeds(...)`: name the coordinates whose rates are independent");
             let name = &ast.name;
             return (Vec::new(), quote::quote!(#name));
         };
-        let mut out = Vec::new();
+        let mut out: Vec<SpeedSpec> = Vec::new();
         for s in list {
-            match self.coords.iter().position(|(c, _)| c == s) {
-                Some(i) if out.contains(&i) => self
-                    .cx
-                    .error_spanned_by(s, format!("duplicate speed `{s}`")),
-                Some(i) => out.push(i),
-                None => {
-                    let h = hint(
-                        &s.to_string(),
-                        self.coords.iter().map(|(c, _)| c.to_string()),
-                    );
-                    self.cx.error_spanned_by(s, format!("`{s}` is not a coordinate; speeds name the coordinates whose rates are independent{h}"));
+            let name = s.name.to_string();
+            if out.iter().any(|o| o.name == name) {
+                self.cx
+                    .error_spanned_by(&s.name, format!("duplicate speed `{name}`"));
+                continue;
+            }
+            match &s.definition {
+                None => match self.coords.iter().position(|(c, _)| *c == s.name) {
+                    Some(i) => {
+                        let c = self.coords[i].1;
+                        out.push(SpeedSpec {
+                            name,
+                            symbol: c.rate,
+                            accel: c.accel,
+                            coordinate: Some(i),
+                            definition: None,
+                        });
+                    }
+                    None => {
+                        let h = hint(&name, self.coords.iter().map(|(c, _)| c.to_string()));
+                        self.cx.error_spanned_by(
+                            &s.name,
+                            format!("`{name}` is not a coordinate; a speed is a coordinate's name, or `name = expression` for a quasi-velocity{h}"),
+                        );
+                    }
+                },
+                Some(def) => {
+                    if self.all_names().contains(&name) {
+                        self.cx.error_spanned_by(&s.name, format!("the quasi-velocity `{name}` needs a new name; `{name}` is already used"));
+                        continue;
+                    }
+                    let Some(e) = self.scalar(def) else { continue };
+                    let (Ok(symbol), Ok(accel)) = (
+                        self.g.declare(&name, SymbolKind::Auxiliary),
+                        self.g
+                            .declare(&format!("{name}_dot"), SymbolKind::Auxiliary),
+                    ) else {
+                        self.cx.error_spanned_by(
+                            &s.name,
+                            format!("the quasi-velocity `{name}` clashes with another name"),
+                        );
+                        continue;
+                    };
+                    out.push(SpeedSpec {
+                        name,
+                        symbol,
+                        accel,
+                        coordinate: None,
+                        definition: Some(e),
+                    });
                 }
             }
         }
@@ -929,6 +987,39 @@ impl Builder<'_> {
                 };
                 Ok(Some(Val::Scalar(self.g.powi(x, n)?)))
             }
+            "omega" | "velocity" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                let Expr::Name(target) = &args[0] else {
+                    let what = if name == "omega" {
+                        "a frame"
+                    } else {
+                        "a point"
+                    };
+                    self.cx
+                        .error_at(args[0].span(), format!("`{name}` takes the name of {what}"));
+                    return Ok(None);
+                };
+                if name == "omega" {
+                    let Some(fi) = self.frame_named(target) else {
+                        return Ok(None);
+                    };
+                    Ok(Some(Val::Vector(self.frames[fi].omega)))
+                } else {
+                    let Some(p) = self.point_named(target) else {
+                        return Ok(None);
+                    };
+                    let rules = RateRules::coordinates();
+                    let v = [
+                        self.g.time_derivative(p[0], &rules)?,
+                        self.g.time_derivative(p[1], &rules)?,
+                        self.g.time_derivative(p[2], &rules)?,
+                    ];
+                    Ok(Some(Val::Vector(v)))
+                }
+            }
             "dot" | "cross" => {
                 if !arity(2) {
                     wrong(self.cx, 2);
@@ -974,7 +1065,7 @@ impl Builder<'_> {
             _ => {
                 const FUNCS: &[&str] = &[
                     "dt", "sin", "cos", "tan", "exp", "ln", "sqrt", "abs", "atan2", "powi", "dot",
-                    "cross", "norm", "unit",
+                    "cross", "norm", "unit", "omega", "velocity",
                 ];
                 let h = hint(&name, FUNCS.iter().map(|s| s.to_string()));
                 self.cx

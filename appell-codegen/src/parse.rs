@@ -131,7 +131,17 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
             "inputs" => ast.inputs.extend(ident_list(tokens)?),
             "positive" => ast.positive.extend(ident_list(tokens)?),
             "speeds" => {
-                let list = ident_list(tokens)?;
+                let list =
+                    Parser::parse2(Punctuated::<SpeedItem, Token![,]>::parse_terminated, tokens)?;
+                let list: Vec<SpeedDef> = list
+                    .into_iter()
+                    .map(|i| {
+                        Ok(SpeedDef {
+                            name: i.name,
+                            definition: i.definition.as_ref().map(convert).transpose()?,
+                        })
+                    })
+                    .collect::<syn::Result<_>>()?;
                 if ast.speeds.is_some() {
                     cx.error_spanned_by(&item.all, "`speeds` is given twice");
                 }
@@ -192,6 +202,25 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
     })();
     if let Err(e) = result {
         cx.syn_error(e);
+    }
+}
+
+/// `name` or `name = expression` inside `speeds(...)`.
+struct SpeedItem {
+    name: Ident,
+    definition: Option<syn::Expr>,
+}
+
+impl syn::parse::Parse for SpeedItem {
+    fn parse(input: ParseStream) -> syn::Result<SpeedItem> {
+        let name: Ident = input.parse()?;
+        let definition = if input.peek(Token![=]) {
+            input.parse::<Token![=]>()?;
+            Some(input.parse()?)
+        } else {
+            None
+        };
+        Ok(SpeedItem { name, definition })
     }
 }
 
