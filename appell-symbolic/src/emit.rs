@@ -264,55 +264,128 @@ impl Lowering<'_> {
         }
     }
 
+    /// `constant + Σ k·Π bᵉ`, with common factors taken out greedily
+    /// (`a·x + a·y + z → a·(x + y) + z`): the state-dependent factor shared by
+    /// the most terms first, so each is multiplied once.
+    fn sum(&mut self, constant: Number, mut terms: Vec<(Number, Vec<(Id, i32)>)>) -> u32 {
+        if terms.len() >= 2 {
+            // The factor (not parameter-only: those are hoisted anyway) that
+            // the most terms contain; ties go to the smallest id.
+            let mut counts: BTreeMap<Id, usize> = BTreeMap::new();
+            for (_, factors) in &terms {
+                for &(b, e) in factors {
+                    if e > 0 && !self.graph.is_parameter_only(b) {
+                        *counts.entry(b).or_insert(0) += 1;
+                    }
+                }
+            }
+            let best = counts
+                .iter()
+                .filter(|(_, &c)| c >= 2)
+                .max_by_key(|(id, &c)| (c, std::cmp::Reverse(**id)))
+                .map(|(id, _)| *id);
+            if let Some(f) = best {
+                let (with, without): (Vec<_>, Vec<_>) = terms
+                    .drain(..)
+                    .partition(|(_, fs)| fs.iter().any(|&(b, e)| b == f && e > 0));
+                let reduced: Vec<(Number, Vec<(Id, i32)>)> = with
+                    .into_iter()
+                    .map(|(k, fs)| {
+                        let fs = fs
+                            .into_iter()
+                            .filter_map(|(b, e)| match (b == f, e - 1) {
+                                (true, 0) => None,
+                                (true, r) => Some((b, r)),
+                                _ => Some((b, e)),
+                            })
+                            .collect();
+                        (k, fs)
+                    })
+                    .collect();
+                let inner = self.sum(Number::ZERO, reduced);
+                let base = self.memo[&f];
+                let grouped = self.push(Inst::Mul(inner, base));
+                if without.is_empty() && constant.is_zero() {
+                    return grouped;
+                }
+                let rest = self.sum(constant, without);
+                return self.push(Inst::Add(grouped, rest));
+            }
+        }
+        let mut pos = Vec::new();
+        let mut neg = Vec::new();
+        let mut ordered: Vec<(bool, usize, Number, Vec<(Id, i32)>)> = terms
+            .into_iter()
+            .enumerate()
+            .map(|(i, (k, fs))| {
+                (
+                    !fs.iter().all(|&(b, _)| self.graph.is_parameter_only(b)),
+                    i,
+                    k,
+                    fs,
+                )
+            })
+            .collect();
+        ordered.sort_by_key(|t| (t.0, t.1));
+        for (_, _, k, factors) in ordered {
+            // A coefficient joins the term's parameter-only factors (sign
+            // included, so the term is simply added); without such factors
+            // the sign becomes a subtraction.
+            let has_param = factors
+                .iter()
+                .any(|&(f, _)| self.graph.is_parameter_only(f));
+            if factors.is_empty() {
+                let c = self.constant(k.abs());
+                if k.is_negative() {
+                    neg.push(c)
+                } else {
+                    pos.push(c)
+                }
+            } else if has_param || !k.is_negative() {
+                pos.push(self.product(k, &factors));
+            } else {
+                neg.push(self.product(k.abs(), &factors));
+            }
+        }
+        if !constant.is_zero() {
+            let c = self.constant(constant.abs());
+            if constant.is_negative() {
+                neg.push(c)
+            } else {
+                pos.push(c)
+            }
+        }
+        let start = match self.chain(&pos, Inst::Add) {
+            Some(v) => v,
+            None => match neg.is_empty() {
+                true => return self.constant(Number::ZERO),
+                false => {
+                    let first = neg.remove(0);
+                    self.push(Inst::Neg(first))
+                }
+            },
+        };
+        neg.iter()
+            .fold(start, |acc, &x| self.push(Inst::Sub(acc, x)))
+    }
+
     fn lower_node(&mut self, id: Id) -> u32 {
         let node = self.graph.node(id);
         match node {
             Node::Num(n) => self.constant(*n),
             Node::Sym(s) => self.push(Inst::Symbol(*s)),
             Node::Add { constant, terms } => {
-                let mut pos = Vec::new();
-                let mut neg = Vec::new();
-                let mut ordered: Vec<(bool, Id, Number)> = terms
+                let terms: Vec<(Number, Vec<(Id, i32)>)> = terms
                     .iter()
-                    .map(|&(b, k)| (!self.graph.is_parameter_only(b), b, k))
+                    .map(|&(b, k)| {
+                        let factors = match self.graph.node(b) {
+                            Node::Mul { factors, .. } => factors.to_vec(),
+                            _ => vec![(b, 1)],
+                        };
+                        (k, factors)
+                    })
                     .collect();
-                ordered.sort_by_key(|t| (t.0, t.1));
-                for (_, b, k) in ordered {
-                    let factors: Vec<(Id, i32)> = match self.graph.node(b) {
-                        Node::Mul { factors, .. } => factors.to_vec(),
-                        _ => vec![(b, 1)],
-                    };
-                    // A coefficient joins the term's parameter-only factors
-                    // (sign included, so the term is simply added); without
-                    // such factors the sign becomes a subtraction.
-                    let has_param = factors
-                        .iter()
-                        .any(|&(f, _)| self.graph.is_parameter_only(f));
-                    if has_param {
-                        pos.push(self.product(k, &factors));
-                    } else if k.is_negative() {
-                        neg.push(self.product(k.abs(), &factors));
-                    } else {
-                        pos.push(self.product(k, &factors));
-                    }
-                }
-                if !constant.is_zero() {
-                    let c = self.constant(constant.abs());
-                    if constant.is_negative() {
-                        neg.push(c)
-                    } else {
-                        pos.push(c)
-                    }
-                }
-                let start = match self.chain(&pos, Inst::Add) {
-                    Some(v) => v,
-                    None => {
-                        let first = neg.remove(0);
-                        self.push(Inst::Neg(first))
-                    }
-                };
-                neg.iter()
-                    .fold(start, |acc, &x| self.push(Inst::Sub(acc, x)))
+                self.sum(*constant, terms)
             }
             Node::Mul { coeff, factors } => {
                 let factors = factors.to_vec();
