@@ -314,7 +314,8 @@ impl Lowering<'_> {
         }
         let mut pos = Vec::new();
         let mut neg = Vec::new();
-        let mut ordered: Vec<(bool, usize, Number, Vec<(Id, i32)>)> = terms
+        type Ordered = (bool, usize, Number, Vec<(Id, i32)>);
+        let mut ordered: Vec<Ordered> = terms
             .into_iter()
             .enumerate()
             .map(|(i, (k, fs))| {
