@@ -404,6 +404,65 @@ impl Lowering<'_> {
     }
 }
 
+/// Divisions by a denominator that several divisions share become one
+/// reciprocal and multiplications (`a/d, b/d → r = 1/d; a·r, b·r`): a
+/// division costs several multiplications.
+fn share_reciprocals(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+    let mut uses = vec![0usize; insts.len()];
+    for inst in &insts {
+        if let Inst::Div(_, d) = inst {
+            uses[*d as usize] += 1;
+        }
+    }
+    if uses.iter().all(|&u| u < 2) {
+        return (insts, outputs);
+    }
+    let mut out: Vec<Inst> = Vec::with_capacity(insts.len() + 8);
+    let mut map = vec![0u32; insts.len()];
+    let mut recip: BTreeMap<u32, u32> = BTreeMap::new();
+    let mut one: Option<u32> = None;
+    for (i, inst) in insts.into_iter().enumerate() {
+        let r = |x: u32| map[x as usize];
+        let new = match inst {
+            Inst::Div(a, d) if uses[d as usize] >= 2 => {
+                let nd = r(d);
+                let rec = match recip.get(&nd) {
+                    Some(&x) => x,
+                    None => {
+                        let o = match one {
+                            Some(o) => o,
+                            None => {
+                                out.push(Inst::Const(Number::ONE));
+                                let o = (out.len() - 1) as u32;
+                                one = Some(o);
+                                o
+                            }
+                        };
+                        out.push(Inst::Div(o, nd));
+                        let x = (out.len() - 1) as u32;
+                        recip.insert(nd, x);
+                        x
+                    }
+                };
+                Inst::Mul(r(a), rec)
+            }
+            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
+            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
+            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
+            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
+            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+            Inst::Neg(a) => Inst::Neg(r(a)),
+            Inst::Powi(a, e) => Inst::Powi(r(a), e),
+            Inst::Call(f, a) => Inst::Call(f, r(a)),
+            leaf => leaf,
+        };
+        out.push(new);
+        map[i] = (out.len() - 1) as u32;
+    }
+    let outputs = outputs.iter().map(|&o| map[o as usize]).collect();
+    (out, outputs)
+}
+
 impl Program {
     /// Lowers the expressions `roots` of `graph`.
     pub fn lower(graph: &Graph, roots: &[Id]) -> Program {
@@ -418,6 +477,8 @@ impl Program {
             l.memo.insert(id, i);
         }
         let outputs: Vec<u32> = roots.iter().map(|r| l.memo[r]).collect();
+        let (insts, outputs) = share_reciprocals(l.insts, outputs);
+        l.insts = insts;
         // Keep only instructions the outputs need (lowering may have built
         // intermediate forms that ended up unused), renumbered in order.
         let mut needed = vec![false; l.insts.len()];
