@@ -158,6 +158,17 @@ pub struct SpeedDef {
     pub definition: Option<Expr>,
 }
 
+/// `scene(name, effects(a, b), outputs(quadrature(x1, y1)))`.
+#[derive(Clone, Debug)]
+pub struct SceneDef {
+    /// The scene's name.
+    pub name: Ident,
+    /// The effects kept.
+    pub effects: Vec<Ident>,
+    /// Outputs: a kind and its arguments.
+    pub outputs: Vec<(Ident, Vec<Ident>)>,
+}
+
 /// The whole model as written.
 #[derive(Clone, Debug)]
 pub struct ModelAst {
@@ -191,4 +202,8 @@ pub struct ModelAst {
     pub gravity: Option<Expr>,
     /// `rolls(body, contact = P)`.
     pub rolls: Vec<RollsDef>,
+    /// `scene(name, effects(...), outputs(...))`.
+    pub scenes: Vec<SceneDef>,
+    /// The struct's visibility (scene types get the same).
+    pub vis: syn::Visibility,
 }

@@ -841,7 +841,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             .map(|(i, _)| i)
             .collect()
     };
-    let mut retained: BTreeSet<usize> = BTreeSet::new();
+    let mut retained: BTreeSet<usize> = model.quadrature.iter().copied().collect();
     for &e in mass.iter().chain(&forcing) {
         retained.extend(coord_of(&deps_of(g, e)));
     }

@@ -52,6 +52,14 @@ fn statements(c: &RustCode) -> String {
 
 struct Emitter<'a> {
     d: &'a Derivation,
+    /// The type the implementation is for.
+    type_name: String,
+    /// How the parameters are reached (`self`, or `self.0` for a scene).
+    this: String,
+    /// The name of the `ModelInfo` static.
+    info_ident: String,
+    /// The scene infos the full model lists (empty for a scene).
+    scene_infos: String,
 }
 
 impl Emitter<'_> {
@@ -66,10 +74,11 @@ impl Emitter<'_> {
             if scalar {
                 let _ = writeln!(
                     s,
-                    "        let {f}: __T = <__T as {P}::Scalar>::from_f64(self.{f});"
+                    "        let {f}: __T = <__T as {P}::Scalar>::from_f64({this}.{f});",
+                    this = self.this
                 );
             } else {
-                let _ = writeln!(s, "        let {f}: f64 = self.{f};");
+                let _ = writeln!(s, "        let {f}: f64 = {this}.{f};", this = self.this);
             }
         }
         s
@@ -81,7 +90,8 @@ impl Emitter<'_> {
             let f = &p.ident;
             let _ = writeln!(
                 s,
-                "        if !(self.{f} > 0.0) {{ return {P}::Err({P}::ModelError::NonPositiveParameter {{ name: \"{f}\", value: self.{f} }}); }}"
+                "        if !({this}.{f} > 0.0) {{ return {P}::Err({P}::ModelError::NonPositiveParameter {{ name: \"{f}\", value: {this}.{f} }}); }}",
+                this = self.this
             );
         }
         s
@@ -348,7 +358,7 @@ impl Emitter<'_> {
             rhs_ops: {P}::OpCounts {{ add: {add}, mul: {mul}, div: {div}, calls: {calls}, total: {total} }},
             equations: {text:?},
         }}",
-            name = model.name.to_string(),
+            name = model.info_name,
             params = list(model.params.iter().map(|p| p.ident.to_string()).collect()),
             all = coords(&(0..d.n).collect::<Vec<_>>()),
             speeds = list(model.speed_specs.iter().map(|sp| sp.name.clone()).collect()),
@@ -377,7 +387,6 @@ impl Emitter<'_> {
         let d = self.d;
         let model = &d.model;
         let (n, m, l) = (d.n, d.m, d.l);
-        let name = &model.name;
         let ni = model.inputs.len();
         let np = model.params.len();
         let ns = d.retained.len() + l;
@@ -609,9 +618,14 @@ impl Emitter<'_> {
             let f = &p.ident;
             let _ = writeln!(
                 set_param,
-                "            \"{f}\" => {{ self.{f} = __value; true }}"
+                "            \"{f}\" => {{ {this}.{f} = __value; true }}",
+                this = self.this
             );
-            let _ = writeln!(get_param, "        __out[{k}] = self.{f};");
+            let _ = writeln!(
+                get_param,
+                "        __out[{k}] = {this}.{f};",
+                this = self.this
+            );
         }
         let params_t = self.params_as(true);
         let params_f = self.params_as(false);
@@ -622,17 +636,18 @@ impl Emitter<'_> {
             .join(" && ");
         let finite = if ns == 0 { "true".to_string() } else { finite };
 
+        let info_ident = &self.info_ident;
+        let name = &self.type_name;
+        let scene_infos = &self.scene_infos;
         format!(
             r#"
-const _: () = {{
-    #[allow(unused_imports)]
-    use {P}::Scalar as _;
-    static __INFO: {P}::ModelInfo = {info};
+    static {info_ident}: {P}::ModelInfo = {info};
     #[automatically_derived]
     #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
     impl {P}::Model for {name} {{
     type Prepared<__T: {P}::Scalar> = [__T; {h}];
-    fn info() -> &'static {P}::ModelInfo {{ &__INFO }}
+    fn info() -> &'static {P}::ModelInfo {{ &{info_ident} }}
+    fn scene_infos() -> &'static [&'static {P}::ModelInfo] {{ {scene_infos} }}
     fn parameter_values(&self, __out: &mut [f64]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_out}{get_param}        {P}::Ok(())
     }}
@@ -683,7 +698,6 @@ const _: () = {{
 {chk_q}{chk_qdot_in}{chk_inputs}{chk_forces}{chk_torques}{params_t}{bind_q}{bind_qdot}{bind_inputs}{loads_body}{loads_forces}{loads_torques}        {P}::Ok(())
     }}
     }}
-}};
 "#,
             chk_out = self.check("__out", np),
             chk_state = self.check("__state", ns),
@@ -797,9 +811,55 @@ const _: () = {{
     }
 }
 
-/// The `Model` implementation for a derived model.
-pub fn emit(d: &Derivation) -> TokenStream {
-    let text = Emitter { d }.emit();
+/// The `Model` implementations: the full model's, and one per scene on a
+/// generated newtype (`{Model}{Scene}(pub Model)`), all in one `const _`
+/// block; the scene types are declared beside the struct.
+pub fn emit(
+    full: &Derivation,
+    scenes: &[(syn::Ident, Derivation)],
+    vis: &syn::Visibility,
+) -> TokenStream {
+    let base = full.model.name.to_string();
+    let scene_type = |name: &syn::Ident| format!("{base}{}", camel(&name.to_string()));
+    let scene_refs: Vec<String> = scenes.iter().map(|(n, _)| format!("&__INFO_{n}")).collect();
+    let mut body = format!(
+        "    static __SCENES: [&{P}::ModelInfo; {}] = [{}];\n",
+        scenes.len(),
+        scene_refs.join(", ")
+    );
+    body.push_str(
+        &Emitter {
+            d: full,
+            type_name: base.clone(),
+            this: "self".into(),
+            info_ident: "__INFO".into(),
+            scene_infos: "&__SCENES".into(),
+        }
+        .emit(),
+    );
+    let mut decls = String::new();
+    let vis = quote::quote!(#vis).to_string();
+    for (name, d) in scenes {
+        let ty = scene_type(name);
+        let effects = d.model.effects.join(", ");
+        let _ = writeln!(
+            decls,
+            "/// Scene `{name}` of [`{base}`]: the reduced equations with the effects {effects} only (generated by `#[derive(Appell)]`).\n{vis} struct {ty}(pub {base});"
+        );
+        body.push_str(
+            &Emitter {
+                d,
+                type_name: ty,
+                this: "self.0".into(),
+                info_ident: format!("__INFO_{name}"),
+                scene_infos: "&[]".into(),
+            }
+            .emit(),
+        );
+    }
+    let text = format!(
+        "{decls}\nconst _: () = {{\n    #[allow(unused_imports)]\n    use {P}::Scalar as _;\n{body}\n}};\n"
+    );
     match TokenStream::from_str(&text) {
         Ok(t) => t,
         Err(e) => {
@@ -807,6 +867,20 @@ pub fn emit(d: &Derivation) -> TokenStream {
             quote::quote!(compile_error!(#msg);)
         }
     }
+}
+
+/// `track_check` → `TrackCheck`.
+fn camel(s: &str) -> String {
+    s.split('_')
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let mut c = p.chars();
+            match c.next() {
+                Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+                None => String::new(),
+            }
+        })
+        .collect()
 }
 
 /// A stub implementation emitted beside errors, so the user sees only the

@@ -35,8 +35,17 @@ pub fn expand(input: &syn::DeriveInput) -> TokenStream {
     } else {
         model::build(&cx, &ast)
     };
+    // One derivation per scene (its effects' loads only), then the full one.
+    let mut scene_derivations = Vec::new();
+    if let Some(m) = &model {
+        for sc in &m.scenes {
+            if let Some(d) = derivation::derive(&cx, model::scene_model(m, sc)) {
+                scene_derivations.push((sc.name.clone(), d));
+            }
+        }
+    }
     let derived = model.and_then(|m| derivation::derive(&cx, m));
-    let tokens = derived.map(|d| emit::emit(&d));
+    let tokens = derived.map(|d| emit::emit(&d, &scene_derivations, &ast.vis));
     match cx.check() {
         Ok(()) => tokens.expect("no errors means a derivation"),
         Err(err) => {

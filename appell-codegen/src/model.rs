@@ -21,6 +21,7 @@ pub type Vec3 = [Id; 3];
 pub type Mat3 = [[Id; 3]; 3];
 
 /// A parameter (struct field).
+#[derive(Clone)]
 pub struct Param {
     /// The field.
     pub ident: Ident,
@@ -31,6 +32,7 @@ pub struct Param {
 }
 
 /// A frame: rotation (columns = unit vectors in N) and angular velocity in N.
+#[derive(Clone)]
 pub struct Frame {
     /// Its name.
     pub name: String,
@@ -41,6 +43,7 @@ pub struct Frame {
 }
 
 /// A named point and its position in N.
+#[derive(Clone)]
 pub struct Point {
     /// Its name.
     pub name: String,
@@ -49,6 +52,7 @@ pub struct Point {
 }
 
 /// A body or particle.
+#[derive(Clone)]
 pub struct Body {
     /// Its name.
     pub name: String,
@@ -63,6 +67,7 @@ pub struct Body {
 }
 
 /// A force at a point or a torque on a frame.
+#[derive(Clone)]
 pub struct Load {
     /// Application point's position (forces).
     pub point: Vec3,
@@ -76,6 +81,7 @@ pub struct Load {
 
 /// `rolls(...)`: the material point of a body at a contact point has zero
 /// velocity.
+#[derive(Clone)]
 pub struct Rolling {
     /// Index of the body in [`Model::bodies`].
     pub body: usize,
@@ -87,7 +93,21 @@ pub struct Rolling {
     pub at: proc_macro2::TokenStream,
 }
 
+/// `scene(name, effects(...), outputs(...))`: a specialised rhs with the
+/// chosen effects' loads only, and the requested outputs.
+#[derive(Clone)]
+pub struct Scene {
+    /// The scene's name.
+    pub name: Ident,
+    /// The effects it keeps.
+    pub effects: Vec<String>,
+    /// Coordinates integrated by quadrature beside the reduced state
+    /// (`outputs(quadrature(x1, y1))`).
+    pub quadrature: Vec<usize>,
+}
+
 /// One privileged speed ẏ_k.
+#[derive(Clone)]
 pub struct SpeedSpec {
     /// Its name (the coordinate's for a coordinate rate).
     pub name: String,
@@ -102,6 +122,7 @@ pub struct SpeedSpec {
 }
 
 /// A constraint residual with its source span.
+#[derive(Clone)]
 pub struct Constraint {
     /// `lhs - rhs`.
     pub residual: Id,
@@ -110,6 +131,7 @@ pub struct Constraint {
 }
 
 /// The resolved model.
+#[derive(Clone)]
 pub struct Model {
     /// The expression graph everything lives in.
     pub g: Graph,
@@ -148,6 +170,13 @@ pub struct Model {
     pub torques: Vec<Load>,
     /// Effect names in order of first use.
     pub effects: Vec<String>,
+    /// Declared scenes.
+    pub scenes: Vec<Scene>,
+    /// Coordinates forced into the reduced state (a scene's quadrature
+    /// outputs); empty for the full model.
+    pub quadrature: Vec<usize>,
+    /// The name the generated `ModelInfo` carries.
+    pub info_name: String,
 }
 
 #[derive(Clone, Copy)]
@@ -323,6 +352,59 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
     }
     let (speed_specs, speeds_at) = b.speeds(ast);
     let speeds: Vec<usize> = speed_specs.iter().filter_map(|s| s.coordinate).collect();
+    let mut scenes = Vec::new();
+    for sc in &ast.scenes {
+        let mut ok = true;
+        for e in &sc.effects {
+            if !effects.contains(&e.to_string()) {
+                let h = hint(&e.to_string(), effects.iter().cloned());
+                cx.error_spanned_by(
+                    e,
+                    format!(
+                        "scene `{}` names the effect `{e}`, which no load declares{h}",
+                        sc.name
+                    ),
+                );
+                ok = false;
+            }
+        }
+        let mut quadrature = Vec::new();
+        for (kind, args) in &sc.outputs {
+            if kind == "quadrature" {
+                for a in args {
+                    match b.coords.iter().position(|(c, _)| c == a) {
+                        Some(i) => quadrature.push(i),
+                        None => {
+                            let h =
+                                hint(&a.to_string(), b.coords.iter().map(|(c, _)| c.to_string()));
+                            cx.error_spanned_by(
+                                a,
+                                format!("`quadrature` takes coordinates, and `{a}` is not one{h}"),
+                            );
+                            ok = false;
+                        }
+                    }
+                }
+            } else {
+                cx.error_spanned_by(
+                    kind,
+                    format!("unknown scene output `{kind}`; available: quadrature(coordinates...)"),
+                );
+                ok = false;
+            }
+        }
+        if scenes.iter().any(|s: &Scene| s.name == sc.name) {
+            cx.error_spanned_by(&sc.name, format!("duplicate scene `{}`", sc.name));
+            ok = false;
+        }
+        if ok {
+            scenes.push(Scene {
+                name: sc.name.clone(),
+                effects: sc.effects.iter().map(|e| e.to_string()).collect(),
+                quadrature,
+            });
+        }
+    }
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
             ast.name.span(),
@@ -351,7 +433,23 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         forces,
         torques,
         effects,
+        scenes,
+        quadrature: Vec::new(),
+        info_name: ast.name.to_string(),
     })
+}
+
+/// The model of one scene: loads of the scene's effects only, its
+/// quadrature coordinates kept in the state.
+pub fn scene_model(full: &Model, scene: &Scene) -> Model {
+    let mut m = full.clone();
+    m.forces.retain(|f| scene.effects.contains(&f.effect));
+    m.torques.retain(|t| scene.effects.contains(&t.effect));
+    m.effects.retain(|e| scene.effects.contains(e));
+    m.quadrature = scene.quadrature.clone();
+    m.info_name = format!("{}::{}", full.name, scene.name);
+    m.scenes = Vec::new();
+    m
 }
 
 const RESERVED: &[&str] = &["N", "O", "t"];

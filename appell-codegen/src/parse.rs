@@ -28,6 +28,8 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
         torques: Vec::new(),
         gravity: None,
         rolls: Vec::new(),
+        scenes: Vec::new(),
+        vis: input.vis.clone(),
     };
     match &input.data {
         syn::Data::Struct(s) => match &s.fields {
@@ -120,6 +122,7 @@ const ITEMS: &[&str] = &[
     "torque",
     "gravity",
     "rolls",
+    "scene",
 ];
 
 fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
@@ -174,6 +177,7 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
             }
             "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
             "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
+            "scene" => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
             "rolls" => {
                 let at = item.all.clone();
                 ast.rolls.push(Parser::parse2(
@@ -292,6 +296,42 @@ fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
         name,
         parent,
         rotations,
+    })
+}
+
+fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
+    let name: Ident = s.parse()?;
+    let mut effects = Vec::new();
+    let mut outputs = Vec::new();
+    while !s.is_empty() {
+        s.parse::<Token![,]>()?;
+        if s.is_empty() {
+            break;
+        }
+        let item: Item = s.parse()?;
+        match item.name.to_string().as_str() {
+            "effects" => effects.extend(ident_list(item.content)?),
+            "outputs" => {
+                let list = Parser::parse2(
+                    Punctuated::<Item, Token![,]>::parse_terminated,
+                    item.content,
+                )?;
+                for o in list {
+                    outputs.push((o.name.clone(), ident_list(o.content)?));
+                }
+            }
+            other => return Err(syn::Error::new(
+                item.name.span(),
+                format!(
+                    "unknown scene part `{other}`; a scene has `effects(...)` and `outputs(...)`"
+                ),
+            )),
+        }
+    }
+    Ok(SceneDef {
+        name,
+        effects,
+        outputs,
     })
 }
 

@@ -206,6 +206,12 @@ pub trait Model {
     /// Names, sizes and the derived equations.
     fn info() -> &'static ModelInfo;
 
+    /// The `ModelInfo` of each declared scene (`scene(...)` on the struct),
+    /// whose generated types implement this trait too.
+    fn scene_infos() -> &'static [&'static ModelInfo] {
+        &[]
+    }
+
     /// The parameter values, in [`ModelInfo::parameters`] order.
     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError>;
 

@@ -8,6 +8,10 @@ use appell::Appell;
 /// on a plane inclined by `alpha`; `mass` (M in the paper) at each wheel
 /// centre, rims of mass `rim` (m') with inertia m'a²/2 about a diameter and
 /// m'a² about the axle; gravity `g`. Wheel 2 sits at +l along the axle.
+///
+/// Scenes: `WheelAxleCoasting` (gravity only), `WheelAxleDriven` (the drive
+/// torque only: on level ground the heading drops out of the state) and
+/// `WheelAxleTrack` (everything, plus the track of wheel 1 by quadrature).
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(coordinates(x1, y1, psi1, x2, y2, psi2, phi))]
 #[appell(speeds(phi, psi1))]
@@ -27,6 +31,12 @@ use appell::Appell;
 #[appell(force(C1, mass * g * sin(alpha) * N.x, effect = gravity),
          force(C2, mass * g * sin(alpha) * N.x, effect = gravity))]
 #[appell(inputs(tau), torque(W1, tau * A.y, effect = motor))]
+// Scenes name the same effects; clippy's duplicated_attributes lint reads
+// the repeated names inside `#[appell(...)]` as duplicate attributes.
+#[allow(clippy::duplicated_attributes)]
+#[appell(scene(coasting, effects(gravity)))]
+#[appell(scene(driven, effects(motor)))]
+#[appell(scene(track, effects(gravity, motor), outputs(quadrature(x1, y1))))]
 pub struct WheelAxle {
     /// Wheel radius a [m].
     pub a: f64,

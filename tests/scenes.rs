@@ -1,0 +1,151 @@
+//! Scenes: specialised rhs with only the chosen effects, and quadrature
+//! outputs, compared with the full model.
+
+mod common;
+#[path = "../examples/models/wheel_axle.rs"]
+mod wheel_axle;
+
+use appell::Model;
+use common::{close, Rng};
+use wheel_axle::{WheelAxle, WheelAxleCoasting, WheelAxleDriven, WheelAxleTrack};
+
+#[test]
+fn scenes_are_listed_with_their_states_and_costs() {
+    let scenes = WheelAxle::scene_infos();
+    let names: Vec<&str> = scenes.iter().map(|s| s.name).collect();
+    assert_eq!(
+        names,
+        [
+            "WheelAxle::coasting",
+            "WheelAxle::driven",
+            "WheelAxle::track"
+        ]
+    );
+    for s in scenes {
+        println!(
+            "{}: effects {:?}, state {:?} + speeds, {} ops",
+            s.name, s.effects, s.retained, s.rhs_ops.total
+        );
+    }
+    assert_eq!(WheelAxleCoasting::info().effects, &["gravity"]);
+    // Without gravity nothing depends on the heading: it drops out.
+    assert_eq!(WheelAxleDriven::info().retained, &[] as &[&str]);
+    assert_eq!(WheelAxleDriven::info().state_len(), 2);
+    // The track scene integrates wheel 1's position (and the heading its
+    // rates need) beside the speeds.
+    assert_eq!(WheelAxleTrack::info().retained, &["x1", "y1", "phi"]);
+    assert!(WheelAxleCoasting::info().rhs_ops.total < WheelAxle::info().rhs_ops.total);
+}
+
+#[test]
+fn each_scene_equals_the_full_model_with_the_other_effects_switched_off() {
+    let mut rng = Rng(61);
+    for _ in 0..1000 {
+        let p = WheelAxle {
+            a: rng.uniform(0.1, 1.0),
+            l: rng.uniform(0.2, 2.0),
+            mass: rng.uniform(0.5, 5.0),
+            rim: rng.uniform(0.1, 2.0),
+            g: 9.81,
+            alpha: rng.uniform(-0.5, 0.5),
+        };
+        let (phi, w, s) = (
+            rng.uniform(-3.0, 3.0),
+            rng.uniform(-3.0, 3.0),
+            rng.uniform(-3.0, 3.0),
+        );
+        let tau = rng.uniform(-2.0, 2.0);
+        // Coasting = full model with no drive torque.
+        let mut full = [0.0; 3];
+        p.rhs(&p.prepare::<f64>(), 0.0, &[phi, w, s], &[0.0], &mut full)
+            .unwrap();
+        let coasting = WheelAxleCoasting(p.clone());
+        let mut d = [0.0; 3];
+        coasting
+            .rhs(
+                &coasting.prepare::<f64>(),
+                0.0,
+                &[phi, w, s],
+                &[tau],
+                &mut d,
+            )
+            .unwrap();
+        for k in 0..3 {
+            assert!(
+                close(d[k], full[k], 1e-12),
+                "coasting {k}: {} vs {}",
+                d[k],
+                full[k]
+            );
+        }
+        // Driven = full model with gravity off (g = 0); its state has no heading.
+        let level = WheelAxle {
+            g: 0.0,
+            ..p.clone()
+        };
+        level
+            .rhs(
+                &level.prepare::<f64>(),
+                0.0,
+                &[phi, w, s],
+                &[tau],
+                &mut full,
+            )
+            .unwrap();
+        let driven = WheelAxleDriven(p.clone());
+        let mut d2 = [0.0; 2];
+        driven
+            .rhs(&driven.prepare::<f64>(), 0.0, &[w, s], &[tau], &mut d2)
+            .unwrap();
+        assert!(close(d2[0], full[1], 1e-12) && close(d2[1], full[2], 1e-12));
+    }
+}
+
+#[test]
+fn quadrature_output_follows_the_full_system() {
+    // Integrate the track scene (x1, y1, phi, speeds) and, separately, the
+    // full reduced state with x1, y1 by quadrature of coordinate_rates.
+    let p = WheelAxle::default();
+    let track = WheelAxleTrack(p.clone());
+    let tp = track.prepare::<f64>();
+    let fp = p.prepare::<f64>();
+    let h = 1e-3;
+    let tau = [0.3];
+    let mut s = [0.0, 0.0, 0.4, 0.2, 1.0];
+    let mut full = [0.4, 0.2, 1.0];
+    let mut xy = [0.0, 0.0];
+    for step in 0..2000 {
+        let t = step as f64 * h;
+        s = appell::integrate::rk4_step(&track, &tp, t, h, &s, &tau).unwrap();
+        // The same RK4 on (x1, y1, phi, speeds) assembled from the full model.
+        let rate = |x: &[f64; 5]| -> [f64; 5] {
+            let mut d = [0.0; 3];
+            p.rhs(&fp, 0.0, &[x[2], x[3], x[4]], &tau, &mut d).unwrap();
+            let mut q = [0.0; 7];
+            q[6] = x[2];
+            let mut qd = [0.0; 7];
+            p.coordinate_rates(0.0, &q, &[x[3], x[4]], &mut qd).unwrap();
+            [qd[0], qd[1], d[0], d[1], d[2]]
+        };
+        let x = [xy[0], xy[1], full[0], full[1], full[2]];
+        let k1 = rate(&x);
+        let add = |a: &[f64; 5], b: &[f64; 5], c: f64| -> [f64; 5] {
+            std::array::from_fn(|i| a[i] + c * b[i])
+        };
+        let k2 = rate(&add(&x, &k1, h / 2.0));
+        let k3 = rate(&add(&x, &k2, h / 2.0));
+        let k4 = rate(&add(&x, &k3, h));
+        let next: [f64; 5] =
+            std::array::from_fn(|i| x[i] + h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]));
+        xy = [next[0], next[1]];
+        full = [next[2], next[3], next[4]];
+    }
+    println!("track after 2 s: x1 = {:.9}, y1 = {:.9}", s[0], s[1]);
+    assert!(
+        close(s[0], xy[0], 1e-12) && close(s[1], xy[1], 1e-12),
+        "{:?} vs {:?}",
+        &s[..2],
+        xy
+    );
+    assert!(close(s[2], full[0], 1e-12));
+}
