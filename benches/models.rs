@@ -130,7 +130,56 @@ fn bench_model<M: Model>(
     );
 }
 
+/// ns per rhs call and op count of a scene, for the per-scene table.
+fn scene_line<M: Model>(label: &str, model: &M) {
+    let info = M::info();
+    let inputs = vec![0.1; info.inputs.len()];
+    let prepared = model.prepare::<f64>();
+    let set = states::<M>(64);
+    let mut d = vec![0.0; info.state_len()];
+    for (s, _, _) in &set {
+        let _ = model.rhs(&prepared, 0.0, s, &inputs, &mut d);
+    }
+    let reps = 2000;
+    let t = Instant::now();
+    for _ in 0..reps {
+        for (s, _, _) in &set {
+            let _ = model.rhs(&prepared, 0.0, black_box(s), &inputs, &mut d);
+        }
+    }
+    let ns = t.elapsed().as_secs_f64() * 1e9 / (reps * set.len()) as f64;
+    println!(
+        "{label}: state {}, {} ops, rhs {ns:.1} ns",
+        info.state_len(),
+        info.rhs_ops.total
+    );
+}
+
 fn bench(c: &mut Criterion) {
+    let axle = wheel_axle::WheelAxle::default();
+    scene_line("scene wheel_axle (all effects)", &axle);
+    scene_line(
+        "scene wheel_axle::coasting",
+        &wheel_axle::WheelAxleCoasting(axle.clone()),
+    );
+    scene_line(
+        "scene wheel_axle::driven",
+        &wheel_axle::WheelAxleDriven(axle.clone()),
+    );
+    scene_line(
+        "scene wheel_axle::track",
+        &wheel_axle::WheelAxleTrack(axle.clone()),
+    );
+    let bike = whipple_bicycle::WhippleBicycle::default();
+    scene_line("scene whipple_bicycle (all effects)", &bike);
+    scene_line(
+        "scene whipple_bicycle::coasting",
+        &whipple_bicycle::WhippleBicycleCoasting(bike.clone()),
+    );
+    scene_line(
+        "scene whipple_bicycle::ridden",
+        &whipple_bicycle::WhippleBicycleRidden(bike.clone()),
+    );
     bench_model(
         c,
         "wheel_axle",
@@ -166,7 +215,6 @@ fn bench(c: &mut Criterion) {
         include_str!("../examples/models/n_link_pendulum.rs"),
         "Pendulum8",
     );
-    let bike = whipple_bicycle::WhippleBicycle::default();
     bench_model(
         c,
         "whipple_bicycle",

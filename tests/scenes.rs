@@ -149,3 +149,49 @@ fn quadrature_output_follows_the_full_system() {
     );
     assert!(close(s[2], full[0], 1e-12));
 }
+
+#[test]
+fn command_line_lists_scenes_and_evaluates_one() {
+    let args = |v: &[&str]| -> Vec<String> { v.iter().map(|s| s.to_string()).collect() };
+    let mut out = Vec::new();
+    appell::cli::run_with(
+        WheelAxle::default(),
+        &args(&["wheel_axle", "info"]),
+        &mut &b""[..],
+        &mut out,
+        |_| Ok(()),
+    )
+    .unwrap();
+    let info: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(info["scenes"][1]["name"], "WheelAxle::driven");
+    assert_eq!(info["scenes"][1]["state_len"], 2);
+    let line = br#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}, "inputs": {"tau": 0.5}}"#;
+    let mut out = Vec::new();
+    appell::cli::run_with(
+        WheelAxle::default(),
+        &args(&["wheel_axle", "eval", "--scene", "driven"]),
+        &mut &line[..],
+        &mut out,
+        |_| Ok(()),
+    )
+    .unwrap();
+    let v: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    // Level ground: the heading does not enter, the torque turns the axle.
+    let p = WheelAxle::default();
+    let driven = WheelAxleDriven(p.clone());
+    let mut d = [0.0; 2];
+    driven
+        .rhs(&driven.prepare::<f64>(), 0.0, &[0.1, 2.0], &[0.5], &mut d)
+        .unwrap();
+    assert_eq!(v["udot"]["phi"].as_f64().unwrap(), d[0]);
+    assert_eq!(v["udot"]["psi1"].as_f64().unwrap(), d[1]);
+    let mut out = Vec::new();
+    let err = appell::cli::run_with(
+        WheelAxle::default(),
+        &args(&["wheel_axle", "eval", "--scene", "flying"]),
+        &mut &line[..],
+        &mut out,
+        |_| Ok(()),
+    );
+    assert!(matches!(err, Err(appell::cli::CliError::Usage(_))));
+}

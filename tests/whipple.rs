@@ -33,8 +33,9 @@ fn agrees_with_the_oracle() {
         let u = [next(-2.0, 2.0), next(-20.0, 0.0), next(-2.0, 2.0)];
         let state = [q[3], q[4], q[6], u[0], u[1], u[2]];
         let mut d = [0.0; 6];
-        p.rhs(&prepared, 0.0, &state, &[], &mut d).unwrap();
-        let o = appell::oracle::reduced_rhs(&p, 0.0, &q, &u, &[]).unwrap();
+        let steer = [next(-5.0, 5.0)];
+        p.rhs(&prepared, 0.0, &state, &steer, &mut d).unwrap();
+        let o = appell::oracle::reduced_rhs(&p, 0.0, &q, &u, &steer).unwrap();
         for (a, b) in d.iter().zip(&o) {
             worst = worst.max((a - b).abs() / (1.0 + a.abs().max(b.abs())));
         }
@@ -74,7 +75,7 @@ fn mass_matrix_is_symmetric_positive_definite_at_the_operating_point() {
     let q = whipple_bicycle::operating_point(&p).unwrap();
     let mut m = [0.0; 9];
     let mut f = [0.0; 3];
-    p.mass_matrix_and_forcing(0.0, &q, &[0.0, -5.0 / p.rr, 0.0], &[], &mut m, &mut f)
+    p.mass_matrix_and_forcing(0.0, &q, &[0.0, -5.0 / p.rr, 0.0], &[0.0], &mut m, &mut f)
         .unwrap();
     for i in 0..3 {
         for j in 0..3 {
@@ -108,4 +109,38 @@ fn lean_steer_eigenvalues_at_5_m_per_s() {
             "({re}, {im}) vs ({er}, {ei})"
         );
     }
+}
+
+#[test]
+fn coasting_scene_is_the_bicycle_without_its_rider() {
+    use whipple_bicycle::{WhippleBicycleCoasting, WhippleBicycleRidden};
+    let p = WhippleBicycle::default();
+    let full = p.prepare::<f64>();
+    let coasting = WhippleBicycleCoasting(p.clone());
+    let cp = coasting.prepare::<f64>();
+    let ridden = WhippleBicycleRidden(p.clone());
+    let rp = ridden.prepare::<f64>();
+    let state = [0.1, std::f64::consts::PI / 10.0, -0.2, 0.3, -15.0, 0.4];
+    let (mut a, mut b, mut c) = ([0.0; 6], [0.0; 6], [0.0; 6]);
+    p.rhs(&full, 0.0, &state, &[0.0], &mut a).unwrap();
+    coasting.rhs(&cp, 0.0, &state, &[2.0], &mut b).unwrap();
+    ridden.rhs(&rp, 0.0, &state, &[0.0], &mut c).unwrap();
+    for k in 0..6 {
+        assert!(
+            (a[k] - b[k]).abs() <= 1e-12 * (1.0 + a[k].abs()),
+            "{k}: {} vs {}",
+            a[k],
+            b[k]
+        );
+        assert!((a[k] - c[k]).abs() <= 1e-12 * (1.0 + a[k].abs()));
+    }
+    println!(
+        "bicycle ops: full {}, coasting {}, ridden {}",
+        WhippleBicycle::info().rhs_ops.total,
+        WhippleBicycleCoasting::info().rhs_ops.total,
+        WhippleBicycleRidden::info().rhs_ops.total
+    );
+    assert!(
+        WhippleBicycleCoasting::info().rhs_ops.total < WhippleBicycleRidden::info().rhs_ops.total
+    );
 }

@@ -320,12 +320,14 @@ fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
                     outputs.push((o.name.clone(), ident_list(o.content)?));
                 }
             }
-            other => return Err(syn::Error::new(
-                item.name.span(),
-                format!(
+            other => {
+                return Err(syn::Error::new(
+                    item.name.span(),
+                    format!(
                     "unknown scene part `{other}`; a scene has `effects(...)` and `outputs(...)`"
                 ),
-            )),
+                ))
+            }
         }
     }
     Ok(SceneDef {

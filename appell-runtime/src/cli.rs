@@ -274,6 +274,12 @@ pub fn run_with<M: Model>(
     let info = M::info();
     let program = args.first().map(String::as_str).unwrap_or(info.name);
     let rest = args.get(1..).unwrap_or(&[]);
+    if let [command, flag, name] = rest {
+        if command == "eval" && flag == "--scene" {
+            let mut evaluator = Evaluator::with_scene(model, name)?;
+            return eval_stream(&mut evaluator, stdin, stdout);
+        }
+    }
     let command = match rest {
         [] => return default_action(&model).map_err(CliError::Action),
         [command] => command.as_str(),
@@ -410,8 +416,21 @@ pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
         .map(|b| json!({ "name": b.name, "rigid": b.rigid }))
         .collect();
     let ops = info.rhs_ops;
+    let scenes: Vec<Value> = M::scene_infos()
+        .iter()
+        .map(|s| {
+            json!({
+                "name": s.name,
+                "effects": s.effects,
+                "retained": s.retained,
+                "state_len": s.state_len(),
+                "rhs_ops": s.rhs_ops.total,
+            })
+        })
+        .collect();
     Ok(json!({
         "name": info.name,
+        "scenes": scenes,
         "parameters": parameters,
         "coordinates": info.coordinates,
         "speeds": info.speeds,
@@ -452,6 +471,7 @@ fn finite_or_null(x: f64) -> Value {
 pub struct Evaluator<M: Model> {
     model: M,
     defaults: Vec<f64>,
+    scene: Option<usize>,
 }
 
 impl<M: Model> Evaluator<M> {
@@ -459,7 +479,34 @@ impl<M: Model> Evaluator<M> {
     pub fn new(model: M) -> Result<Self, ModelError> {
         let mut defaults = vec![0.0; M::info().parameters.len()];
         model.parameter_values(&mut defaults)?;
-        Ok(Evaluator { model, defaults })
+        Ok(Evaluator {
+            model,
+            defaults,
+            scene: None,
+        })
+    }
+
+    /// An evaluator of the scene named `name` (as in `info`'s `scenes`: the
+    /// part after `::`, or the whole name).
+    pub fn with_scene(model: M, name: &str) -> Result<Self, CliError> {
+        let scenes = M::scene_infos();
+        let index = scenes
+            .iter()
+            .position(|s| s.name == name || s.name.rsplit("::").next() == Some(name))
+            .ok_or_else(|| {
+                let names: Vec<&str> = scenes.iter().map(|s| s.name).collect();
+                CliError::Usage(format!(
+                    "unknown scene `{name}`; the model's scenes: {}\n",
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                ))
+            })?;
+        let mut e = Evaluator::new(model)?;
+        e.scene = Some(index);
+        Ok(e)
     }
 
     /// The model (with the parameters of the last evaluated line).
@@ -477,7 +524,12 @@ impl<M: Model> Evaluator<M> {
     }
 
     fn try_eval(&mut self, line: &str) -> Result<Value, String> {
-        let info = M::info();
+        // A scene has the model's coordinates, speeds and parameters but its
+        // own reduced state.
+        let info = match self.scene {
+            Some(i) => M::scene_infos()[i],
+            None => M::info(),
+        };
         let value: Value =
             serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
         let Value::Object(obj) = value else {
@@ -531,11 +583,15 @@ impl<M: Model> Evaluator<M> {
             state.push(q[i]);
         }
         state.extend_from_slice(&u);
-        let prepared = self.model.prepare::<f64>();
         let mut dstate = vec![0.0; info.state_len()];
-        self.model
-            .rhs(&prepared, t, &state, &inputs, &mut dstate)
-            .map_err(|e| e.to_string())?;
+        match self.scene {
+            Some(i) => self.model.scene_rhs(i, t, &state, &inputs, &mut dstate),
+            None => {
+                let prepared = self.model.prepare::<f64>();
+                self.model.rhs(&prepared, t, &state, &inputs, &mut dstate)
+            }
+        }
+        .map_err(|e| e.to_string())?;
         let mut qdot = vec![0.0; info.coordinates.len()];
         self.model
             .coordinate_rates(t, &q, &u, &mut qdot)

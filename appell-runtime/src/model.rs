@@ -134,6 +134,11 @@ pub enum ModelError {
         /// Its value.
         value: f64,
     },
+    /// A scene index past the model's scenes.
+    UnknownScene {
+        /// The index asked for.
+        index: usize,
+    },
     /// A privileged speed that is not a coordinate's rate, in a model that
     /// does not define it (see [`Model::speed_definitions`]).
     UnknownSpeed {
@@ -166,6 +171,7 @@ impl core::fmt::Display for ModelError {
             ModelError::NonPositiveParameter { name, value } => {
                 write!(f, "parameter `{name}` is declared positive but is {value}")
             }
+            ModelError::UnknownScene { index } => write!(f, "the model has no scene {index}"),
             ModelError::UnknownSpeed { name } => write!(
                 f,
                 "speed `{name}` is not a coordinate's rate, and the model does not define it"
@@ -210,6 +216,21 @@ pub trait Model {
     /// whose generated types implement this trait too.
     fn scene_infos() -> &'static [&'static ModelInfo] {
         &[]
+    }
+
+    /// The reduced rhs of scene `scene` (an index into
+    /// [`Model::scene_infos`]) in `f64`, for tools that pick a scene by name
+    /// at run time (the command line); simulations use the scene's own type.
+    fn scene_rhs(
+        &self,
+        scene: usize,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError> {
+        let _ = (t, state, inputs, dstate);
+        Err(ModelError::UnknownScene { index: scene })
     }
 
     /// The parameter values, in [`ModelInfo::parameters`] order.

@@ -9,7 +9,9 @@ use appell::Appell;
 /// slip on flat ground, z down. Coordinates: rear contact (q1, q2), yaw q3,
 /// roll q4, pitch q5, rear wheel angle q6, steer q7, front wheel angle q8.
 /// Privileged speeds: roll, rear wheel and steer rates; forward speed
-/// v = −rr·q6'.
+/// v = −rr·q6'. Input: the rider's steer torque (effect `rider`). Scenes:
+/// `WhippleBicycleCoasting` (gravity only, no input terms) and
+/// `WhippleBicycleRidden` (gravity and steer torque).
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(coordinates(q1, q2, q3, q4, q5, q6, q7, q8), speeds(q4, q6, q7))]
 #[appell(positive(rf, rr))]
@@ -29,6 +31,15 @@ use appell::Appell;
 #[appell(rolls(rear_wheel, contact = P, along = [A.x, A.y]))]
 #[appell(rolls(front_wheel, contact = Q, along = [A.x, A.y]))]
 #[appell(gravity(g * N.z))]
+// The rider's steer torque acts on the front frame about the steer axis, and
+// back on the rear frame.
+#[appell(inputs(steer_torque))]
+#[appell(torque(E, steer_torque * C.z, effect = rider), torque(C, -steer_torque * C.z, effect = rider))]
+// Scenes share effect names, which clippy's duplicated_attributes lint reads
+// as duplicate attributes.
+#[allow(clippy::duplicated_attributes)]
+#[appell(scene(coasting, effects(gravity)))]
+#[appell(scene(ridden, effects(gravity, rider)))]
 pub struct WhippleBicycle {
     /// Front wheel radius [m].
     pub rf: f64,
@@ -139,7 +150,7 @@ pub fn lean_steer(
 ) -> Result<appell::linearize::Linearization, appell::linearize::LinearizeError> {
     let q = operating_point(p)?;
     let u = [0.0, -v / p.rr, 0.0];
-    appell::linearize::minimal_linearization(p, 0.0, &q, &u, &[], &["q6"])
+    appell::linearize::minimal_linearization(p, 0.0, &q, &u, &[0.0], &["q6"])
 }
 
 /// Eigenvalues (re, im) of the lean and steer dynamics at speed `v`.
