@@ -32,6 +32,7 @@ use crate::ctxt::Ctxt;
 use crate::model::{cross, dot, Mat3, Model, Vec3};
 
 /// How the dependent speeds are obtained.
+#[derive(Clone)]
 pub enum Elimination {
     /// B and b are expressions.
     Symbolic,
@@ -43,6 +44,7 @@ pub enum Elimination {
 /// pivots are eliminated symbolically, the remaining k dependent rates solve
 /// S X = R (X = the free rows of [B | b]); for the accelerations,
 /// S w = (Ṙ − Ṡ X) [ẏ; 1] with w = Ẋ [ẏ; 1].
+#[derive(Clone)]
 pub struct NumericElimination {
     /// Number of unknowns solved numerically.
     pub k: usize,
@@ -118,6 +120,14 @@ pub struct Derivation {
     pub ignorable: Vec<usize>,
     /// Readable equations.
     pub text: String,
+    /// M before the ignorable coordinates were fixed (for scenes).
+    pub raw_mass: Vec<Id>,
+    /// The elimination before the ignorable coordinates were fixed.
+    pub raw_elimination: Elimination,
+    /// The inertial part of f, per speed (for scenes).
+    pub inertial_terms: Vec<Vec<Id>>,
+    /// Each load's part of f, per speed, with its effect (for scenes).
+    pub load_terms: Vec<(String, Vec<Id>)>,
 }
 
 /// Runs the derivation; errors go to `cx`.
@@ -157,6 +167,10 @@ struct Parts {
     retained: Vec<usize>,
     cyclic: Vec<usize>,
     ignorable: Vec<usize>,
+    raw_mass: Vec<Id>,
+    raw_elimination: Elimination,
+    inertial_terms: Vec<Vec<Id>>,
+    load_terms: Vec<(String, Vec<Id>)>,
 }
 
 impl Parts {
@@ -185,6 +199,10 @@ impl Parts {
             cyclic: self.cyclic,
             ignorable: self.ignorable,
             text: String::new(),
+            raw_mass: self.raw_mass,
+            raw_elimination: self.raw_elimination,
+            inertial_terms: self.inertial_terms,
+            load_terms: self.load_terms,
         };
         d.text = equations_text(&d);
         d
@@ -732,15 +750,26 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             }
         }
     }
+    // Loads are kept apart (per effect) so scenes can pick them.
+    let inertial_terms = forcing_terms.clone();
+    let mut load_terms: Vec<(String, Vec<Id>)> = Vec::new();
     for (fi, f) in model.forces.iter().enumerate() {
+        let per_k: Vec<Id> = (0..l)
+            .map(|k| dot(g, f.vector, force_beta[fi][k]))
+            .collect::<Result<_, _>>()?;
         for k in 0..l {
-            forcing_terms[k].push(dot(g, f.vector, force_beta[fi][k])?);
+            forcing_terms[k].push(per_k[k]);
         }
+        load_terms.push((f.effect.clone(), per_k));
     }
     for (ti, t) in model.torques.iter().enumerate() {
+        let per_k: Vec<Id> = (0..l)
+            .map(|k| dot(g, t.vector, torque_gamma[ti][k]))
+            .collect::<Result<_, _>>()?;
         for k in 0..l {
-            forcing_terms[k].push(dot(g, t.vector, torque_gamma[ti][k])?);
+            forcing_terms[k].push(per_k[k]);
         }
+        load_terms.push((t.effect.clone(), per_k));
     }
     for k in 0..l {
         for j in k..l {
@@ -769,98 +798,19 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let ke = g.sum(&ke_terms)?;
     let kinetic = g.scale(ke, Number::ratio(1, 2).expect("1/2"))?;
     let kinetic = expanded(g, kinetic)?;
-    // 7. Retained and ignorable coordinates. First, coordinates that occur
-    // in the equations but on which they do not depend (an axisymmetric
-    // wheel's angle, a bicycle's heading after the elimination) are found
-    // numerically at pseudo-random points and set to zero in M, f and the
-    // numeric elimination, so they drop out of the reduced state.
-    {
-        let mut core: Vec<Id> = mass.iter().chain(&forcing).copied().collect();
-        if let Elimination::Numeric(ne) = &elimination {
-            core.extend(ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate));
-        }
-        let mut deps = SymbolSet::new();
-        for &e in &core {
-            deps.union_with(g.dependencies(e));
-        }
-        let tape = appell_symbolic::Tape::new(g, &core);
-        let independent: Vec<Symbol> = model
-            .coords
-            .iter()
-            .map(|(_, c)| c.q)
-            .filter(|&q| deps.contains(q) && numerically_independent(g, &tape, q))
-            .collect();
-        if !independent.is_empty() {
-            let mut fix = Substitution::new();
-            for &q in &independent {
-                fix.insert(q, zero);
-            }
-            for e in mass.iter_mut().chain(forcing.iter_mut()) {
-                *e = fix.apply(g, *e)?;
-            }
-            if let Elimination::Numeric(ne) = &mut elimination {
-                for e in ne
-                    .dp
-                    .iter_mut()
-                    .chain(ne.rhs.iter_mut())
-                    .chain(ne.rhs_rate.iter_mut())
-                {
-                    *e = fix.apply(g, *e)?;
-                }
-            }
-        }
-    }
-    let aux_deps = match &elimination {
-        Elimination::Symbolic => Vec::new(),
-        Elimination::Numeric(ne) => {
-            let mut all = SymbolSet::new();
-            for &e in ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate) {
-                all.union_with(g.dependencies(e));
-            }
-            ne.x.iter()
-                .chain(&ne.w)
-                .map(|&s| (s, all.clone()))
-                .collect::<Vec<_>>()
-        }
-    };
-    let deps_of = |g: &appell_symbolic::Graph, e: Id| -> SymbolSet {
-        let mut set = g.dependencies(e).clone();
-        for (s, d) in &aux_deps {
-            if set.contains(*s) {
-                set.union_with(d);
-            }
-        }
-        set
-    };
-    let coord_of = |set: &SymbolSet| -> BTreeSet<usize> {
-        model
-            .coords
-            .iter()
-            .enumerate()
-            .filter(|(_, (_, c))| set.contains(c.q))
-            .map(|(i, _)| i)
-            .collect()
-    };
-    let mut retained: BTreeSet<usize> = model.quadrature.iter().copied().collect();
-    for &e in mass.iter().chain(&forcing) {
-        retained.extend(coord_of(&deps_of(g, e)));
-    }
-    loop {
-        let before = retained.len();
-        for r in retained.clone() {
-            retained.extend(coord_of(&deps_of(g, qdot[r])));
-        }
-        if retained.len() == before {
-            break;
-        }
-    }
-    let retained: Vec<usize> = retained.into_iter().collect();
-    let ignorable: Vec<usize> = (0..n).filter(|i| !retained.contains(i)).collect();
-    let cyclic: Vec<usize> = ignorable
-        .iter()
-        .copied()
-        .filter(|i| dependent.contains(i))
-        .collect();
+    // 7. Retained and ignorable coordinates.
+    let raw_mass = mass.clone();
+    let raw_elimination = elimination.clone();
+    let (retained, ignorable, cyclic) = reduce_state(
+        g,
+        &model.coords,
+        &model.quadrature,
+        &mut mass,
+        &mut forcing,
+        &mut elimination,
+        &qdot,
+        &dependent,
+    )?;
     let mut velocity_residuals = Vec::with_capacity(m);
     for i in 0..m {
         let mut terms = vec![d0[i]];
@@ -892,7 +842,197 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         retained,
         cyclic,
         ignorable,
+        raw_mass,
+        raw_elimination,
+        inertial_terms,
+        load_terms,
     }))
+}
+
+/// The retained, ignorable and cyclic coordinates. First, coordinates that
+/// occur in the equations but on which they do not depend (an axisymmetric
+/// wheel's angle, a bicycle's heading after the elimination) are found
+/// numerically at pseudo-random points and set to zero in M, f and the
+/// numeric elimination, so they drop out of the reduced state; then the
+/// coordinates M and f need, and those the kept coordinates' rates need.
+#[allow(clippy::type_complexity)] // (retained, ignorable, cyclic)
+fn reduce_state(
+    g: &mut appell_symbolic::Graph,
+    coords: &[(syn::Ident, appell_symbolic::Coordinate)],
+    quadrature: &[usize],
+    mass: &mut [Id],
+    forcing: &mut [Id],
+    elimination: &mut Elimination,
+    qdot: &[Id],
+    dependent: &[usize],
+) -> Result<(Vec<usize>, Vec<usize>, Vec<usize>), SymbolicError> {
+    let n = coords.len();
+    let zero = g.int(0)?;
+    {
+        let mut core: Vec<Id> = mass.iter().chain(forcing.iter()).copied().collect();
+        if let Elimination::Numeric(ne) = &*elimination {
+            core.extend(ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate));
+        }
+        let mut deps = SymbolSet::new();
+        for &e in &core {
+            deps.union_with(g.dependencies(e));
+        }
+        let tape = appell_symbolic::Tape::new(g, &core);
+        let independent: Vec<Symbol> = coords
+            .iter()
+            .map(|(_, c)| c.q)
+            .filter(|&q| deps.contains(q) && numerically_independent(g, &tape, q))
+            .collect();
+        if !independent.is_empty() {
+            let mut fix = Substitution::new();
+            for &q in &independent {
+                fix.insert(q, zero);
+            }
+            for e in mass.iter_mut().chain(forcing.iter_mut()) {
+                *e = fix.apply(g, *e)?;
+            }
+            if let Elimination::Numeric(ne) = elimination {
+                for e in ne
+                    .dp
+                    .iter_mut()
+                    .chain(ne.rhs.iter_mut())
+                    .chain(ne.rhs_rate.iter_mut())
+                {
+                    *e = fix.apply(g, *e)?;
+                }
+            }
+        }
+    }
+    let aux_deps = match &*elimination {
+        Elimination::Symbolic => Vec::new(),
+        Elimination::Numeric(ne) => {
+            let mut all = SymbolSet::new();
+            for &e in ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate) {
+                all.union_with(g.dependencies(e));
+            }
+            ne.x.iter()
+                .chain(&ne.w)
+                .map(|&s| (s, all.clone()))
+                .collect::<Vec<_>>()
+        }
+    };
+    let deps_of = |g: &appell_symbolic::Graph, e: Id| -> SymbolSet {
+        let mut set = g.dependencies(e).clone();
+        for (s, d) in &aux_deps {
+            if set.contains(*s) {
+                set.union_with(d);
+            }
+        }
+        set
+    };
+    let coord_of = |set: &SymbolSet| -> BTreeSet<usize> {
+        coords
+            .iter()
+            .enumerate()
+            .filter(|(_, (_, c))| set.contains(c.q))
+            .map(|(i, _)| i)
+            .collect()
+    };
+    let mut retained: BTreeSet<usize> = quadrature.iter().copied().collect();
+    for &e in mass.iter().chain(forcing.iter()) {
+        retained.extend(coord_of(&deps_of(g, e)));
+    }
+    loop {
+        let before = retained.len();
+        for r in retained.clone() {
+            retained.extend(coord_of(&deps_of(g, qdot[r])));
+        }
+        if retained.len() == before {
+            break;
+        }
+    }
+    let retained: Vec<usize> = retained.into_iter().collect();
+    let ignorable: Vec<usize> = (0..n).filter(|i| !retained.contains(i)).collect();
+    let cyclic: Vec<usize> = ignorable
+        .iter()
+        .copied()
+        .filter(|i| dependent.contains(i))
+        .collect();
+    Ok((retained, ignorable, cyclic))
+}
+
+/// A scene of a derived model: its loads only, its quadrature outputs kept
+/// in the state. Reuses the full derivation (kinematics, M, elimination); only
+/// the forcing and the reduced state are derived again.
+pub fn derive_scene(
+    cx: &Ctxt,
+    full: &Derivation,
+    scene: &crate::model::Scene,
+) -> Option<Derivation> {
+    let r: Result<Derivation, SymbolicError> = (|| {
+        let mut model = crate::model::scene_model(&full.model, scene);
+        let g = &mut model.g;
+        let l = full.l;
+        let mut mass = full.raw_mass.clone();
+        let mut forcing = Vec::with_capacity(l);
+        for k in 0..l {
+            let mut terms = full.inertial_terms[k].clone();
+            for (effect, per_k) in &full.load_terms {
+                if scene.effects.contains(effect) {
+                    terms.push(per_k[k]);
+                }
+            }
+            let sum = g.sum(&terms)?;
+            forcing.push(expanded(g, sum)?);
+        }
+        let mut elimination = full.raw_elimination.clone();
+        let (retained, ignorable, cyclic) = reduce_state(
+            g,
+            &model.coords,
+            &model.quadrature,
+            &mut mass,
+            &mut forcing,
+            &mut elimination,
+            &full.qdot,
+            &full.dependent,
+        )?;
+        let mut d = Derivation {
+            model,
+            n: full.n,
+            m: full.m,
+            l,
+            dependent: full.dependent.clone(),
+            d_rows: full.d_rows.clone(),
+            d0: full.d0.clone(),
+            holonomic: full.holonomic.clone(),
+            c: full.c.clone(),
+            c0: full.c0.clone(),
+            elimination,
+            qdot: full.qdot.clone(),
+            velocity_residuals: full.velocity_residuals.clone(),
+            speed_w: full.speed_w.clone(),
+            speed_w0: full.speed_w0.clone(),
+            accels: full.accels.clone(),
+            mass,
+            forcing,
+            kinetic: full.kinetic,
+            retained,
+            cyclic,
+            ignorable,
+            text: String::new(),
+            raw_mass: full.raw_mass.clone(),
+            raw_elimination: full.raw_elimination.clone(),
+            inertial_terms: full.inertial_terms.clone(),
+            load_terms: Vec::new(),
+        };
+        d.text = equations_text(&d);
+        Ok(d)
+    })();
+    match r {
+        Ok(d) => Some(d),
+        Err(e) => {
+            cx.error_spanned_by(
+                &scene.name,
+                format!("deriving scene `{}` failed: {e}", scene.name),
+            );
+            None
+        }
+    }
 }
 
 /// Multiplies out products of sums when that makes the expression no

@@ -35,16 +35,17 @@ pub fn expand(input: &syn::DeriveInput) -> TokenStream {
     } else {
         model::build(&cx, &ast)
     };
-    // One derivation per scene (its effects' loads only), then the full one.
+    // The full derivation, then each scene from it (its effects' loads only:
+    // kinematics, M and the elimination are shared).
+    let derived = model.and_then(|m| derivation::derive(&cx, m));
     let mut scene_derivations = Vec::new();
-    if let Some(m) = &model {
-        for sc in &m.scenes {
-            if let Some(d) = derivation::derive(&cx, model::scene_model(m, sc)) {
+    if let Some(full) = &derived {
+        for sc in &full.model.scenes {
+            if let Some(d) = derivation::derive_scene(&cx, full, sc) {
                 scene_derivations.push((sc.name.clone(), d));
             }
         }
     }
-    let derived = model.and_then(|m| derivation::derive(&cx, m));
     let tokens = derived.map(|d| emit::emit(&d, &scene_derivations, &ast.vis));
     match cx.check() {
         Ok(()) => tokens.expect("no errors means a derivation"),
