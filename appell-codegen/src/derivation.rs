@@ -855,7 +855,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
 /// numerically at pseudo-random points and set to zero in M, f and the
 /// numeric elimination, so they drop out of the reduced state; then the
 /// coordinates M and f need, and those the kept coordinates' rates need.
-#[allow(clippy::type_complexity)] // (retained, ignorable, cyclic)
+#[allow(clippy::type_complexity, clippy::too_many_arguments)] // (retained, ignorable, cyclic); the derivation pieces it reads and rewrites
 fn reduce_state(
     g: &mut appell_symbolic::Graph,
     coords: &[(syn::Ident, appell_symbolic::Coordinate)],
