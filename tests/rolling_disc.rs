@@ -92,3 +92,12 @@ fn agrees_with_the_oracle() {
     }
     println!("rolling disc vs oracle: largest relative difference {worst:.2e}");
 }
+
+#[test]
+fn potential_energy_is_the_gravity_potential() {
+    let p = RollingDisc::default();
+    let q = [0.3, 0.7, -1.1, 0.2, 0.4];
+    let v = p.potential_energy(0.0, &q).unwrap();
+    // V = m g z of the centre, z = r cos(lean) (N.z up, gravity −g N.z).
+    assert!(close(v, p.m * p.g * p.r * q[1].cos(), 1e-15), "{v}");
+}

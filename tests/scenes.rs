@@ -195,3 +195,25 @@ fn command_line_lists_scenes_and_evaluates_one() {
     );
     assert!(matches!(err, Err(appell::cli::CliError::Usage(_))));
 }
+
+#[test]
+fn energy_of_the_coasting_scene_is_conserved_on_the_slope() {
+    // Gravity only: T + V is constant along the motion (V = −M g sin α (x1 + x2)).
+    let p = WheelAxle::default();
+    let scene = WheelAxleTrack(p.clone());
+    let prepared = scene.prepare::<f64>();
+    // State (x1, y1, phi, phi_dot, psi1_dot) with no drive torque; x2, y2 follow
+    // from the geometry of the axle (wheel 2 at +l along it).
+    let energy = |s: &[f64; 5]| {
+        let phi = s[2];
+        let x2 = s[0] - p.l * phi.sin();
+        let q = [s[0], s[1], 0.0, x2, s[1] + p.l * phi.cos(), 0.0, phi];
+        p.kinetic_energy(0.0, &q, &s[3..]).unwrap() + p.potential_energy(0.0, &q).unwrap()
+    };
+    let s0 = [0.0, 0.0, 0.5, 0.3, 1.0];
+    let e0 = energy(&s0);
+    let s = appell::integrate::rk4(&scene, &prepared, 0.0, &s0, 1e-4, 20_000, &[0.0]).unwrap();
+    let drift = ((energy(&s) - e0) / e0.abs().max(1.0)).abs();
+    println!("wheel-axle on the slope: energy drift over 2 s {drift:.2e}");
+    assert!(drift < 1e-9, "{drift:e}");
+}

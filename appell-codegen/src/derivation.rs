@@ -112,6 +112,8 @@ pub struct Derivation {
     pub forcing: Vec<Id>,
     /// Kinetic energy.
     pub kinetic: Id,
+    /// Potential energy of the gravity effect's loads.
+    pub potential: Id,
     /// Coordinates kept in the reduced state.
     pub retained: Vec<usize>,
     /// Cyclic (dependent, absent) coordinates.
@@ -164,6 +166,7 @@ struct Parts {
     mass: Vec<Id>,
     forcing: Vec<Id>,
     kinetic: Id,
+    potential: Id,
     retained: Vec<usize>,
     cyclic: Vec<usize>,
     ignorable: Vec<usize>,
@@ -195,6 +198,7 @@ impl Parts {
             mass: self.mass,
             forcing: self.forcing,
             kinetic: self.kinetic,
+            potential: self.potential,
             retained: self.retained,
             cyclic: self.cyclic,
             ignorable: self.ignorable,
@@ -798,6 +802,14 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let ke = g.sum(&ke_terms)?;
     let kinetic = g.scale(ke, Number::ratio(1, 2).expect("1/2"))?;
     let kinetic = expanded(g, kinetic)?;
+    // V = −Σ F·r over the gravity effect's (constant) forces.
+    let mut v_terms = Vec::new();
+    for f in model.forces.iter().filter(|f| f.effect == "gravity") {
+        let w = dot(g, f.vector, f.point)?;
+        v_terms.push(g.neg(w)?);
+    }
+    let potential = g.sum(&v_terms)?;
+    let potential = expanded(g, potential)?;
     // 7. Retained and ignorable coordinates.
     let raw_mass = mass.clone();
     let raw_elimination = elimination.clone();
@@ -839,6 +851,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         mass,
         forcing,
         kinetic,
+        potential,
         retained,
         cyclic,
         ignorable,
@@ -981,6 +994,11 @@ pub fn derive_scene(
             forcing.push(expanded(g, sum)?);
         }
         let mut elimination = full.raw_elimination.clone();
+        let potential = if scene.effects.iter().any(|e| e == "gravity") {
+            full.potential
+        } else {
+            g.int(0)?
+        };
         let (retained, ignorable, cyclic) = reduce_state(
             g,
             &model.coords,
@@ -1011,6 +1029,7 @@ pub fn derive_scene(
             mass,
             forcing,
             kinetic: full.kinetic,
+            potential,
             retained,
             cyclic,
             ignorable,

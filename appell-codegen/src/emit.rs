@@ -522,6 +522,7 @@ impl Emitter<'_> {
         let ct = code(d, &ct_roots, &options(false));
         let cr = code(d, qdot, &options(false));
         let ke = code(d, &[d.kinetic], &options(false));
+        let pe = code(d, &[d.potential], &options(false));
         let mut sd_roots = d.speed_w.clone();
         sd_roots.extend(&d.speed_w0);
         let sd = code(d, &sd_roots, &options(false));
@@ -683,6 +684,9 @@ impl Emitter<'_> {
     fn speed_definitions<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_q}{chk_w}{chk_w0}{params_t}{bind_q}{sd_body}{sd_out}        {P}::Ok(())
     }}
+    fn potential_energy<__T: {P}::Scalar>(&self, t: __T, __q: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{
+{chk_q}{params_t}{bind_q}{pe_body}        {P}::Ok({pe_out})
+    }}
     fn kinetic_energy<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{
 {chk_q}{chk_u}{pos}{params_t}{bind_q}{bind_u}{elim_pos}{ke_body}        {P}::Ok({ke_out})
     }}
@@ -791,6 +795,8 @@ impl Emitter<'_> {
                 s
             },
             ke_body = statements(&ke),
+            pe_body = statements(&pe),
+            pe_out = pe.outputs[0],
             ke_out = ke.outputs[0],
             mp_body = statements(&mp),
             poses_body = statements(&poses),

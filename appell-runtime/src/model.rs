@@ -325,6 +325,13 @@ pub trait Model {
         Ok(())
     }
 
+    /// The potential energy of the `gravity` effect's loads (constant forces
+    /// F at points r: V = −Σ F·r), zero for a model that has none.
+    fn potential_energy<T: Scalar>(&self, t: T, q: &[T]) -> Result<T, ModelError> {
+        let _ = (t, q);
+        Ok(T::zero())
+    }
+
     /// Kinetic energy at full coordinates and privileged speeds.
     fn kinetic_energy<T: Scalar>(&self, t: T, q: &[T], u: &[T]) -> Result<T, ModelError>;
 
