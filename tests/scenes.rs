@@ -217,3 +217,19 @@ fn energy_of_the_coasting_scene_is_conserved_on_the_slope() {
     println!("wheel-axle on the slope: energy drift over 2 s {drift:.2e}");
     assert!(drift < 1e-9, "{drift:e}");
 }
+
+#[test]
+fn input_power_is_torque_times_wheel_rate() {
+    // The drive torque τ on wheel 1 about the axle: P = τ ψ̇1.
+    let p = WheelAxle::default();
+    let q = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7];
+    let power = p.input_power(0.0, &q, &[0.8, -1.3], &[0.25]).unwrap();
+    assert!(close(power, 0.25 * -1.3, 1e-15), "{power}");
+    // The coasting scene has no input loads.
+    assert_eq!(
+        WheelAxleCoasting(p)
+            .input_power(0.0, &q, &[0.8, -1.3], &[0.25])
+            .unwrap(),
+        0.0
+    );
+}

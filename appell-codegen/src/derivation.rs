@@ -114,6 +114,8 @@ pub struct Derivation {
     pub kinetic: Id,
     /// Potential energy of the gravity effect's loads.
     pub potential: Id,
+    /// Power of the loads that depend on inputs.
+    pub input_power: Id,
     /// Coordinates kept in the reduced state.
     pub retained: Vec<usize>,
     /// Cyclic (dependent, absent) coordinates.
@@ -130,6 +132,8 @@ pub struct Derivation {
     pub inertial_terms: Vec<Vec<Id>>,
     /// Each load's part of f, per speed, with its effect (for scenes).
     pub load_terms: Vec<(String, Vec<Id>)>,
+    /// The power of each input-dependent load, with its effect (for scenes).
+    pub power_terms: Vec<(String, Id)>,
 }
 
 /// Runs the derivation; errors go to `cx`.
@@ -167,6 +171,7 @@ struct Parts {
     forcing: Vec<Id>,
     kinetic: Id,
     potential: Id,
+    input_power: Id,
     retained: Vec<usize>,
     cyclic: Vec<usize>,
     ignorable: Vec<usize>,
@@ -174,6 +179,7 @@ struct Parts {
     raw_elimination: Elimination,
     inertial_terms: Vec<Vec<Id>>,
     load_terms: Vec<(String, Vec<Id>)>,
+    power_terms: Vec<(String, Id)>,
 }
 
 impl Parts {
@@ -199,6 +205,7 @@ impl Parts {
             forcing: self.forcing,
             kinetic: self.kinetic,
             potential: self.potential,
+            input_power: self.input_power,
             retained: self.retained,
             cyclic: self.cyclic,
             ignorable: self.ignorable,
@@ -207,6 +214,7 @@ impl Parts {
             raw_elimination: self.raw_elimination,
             inertial_terms: self.inertial_terms,
             load_terms: self.load_terms,
+            power_terms: self.power_terms,
         };
         d.text = equations_text(&d);
         d
@@ -689,13 +697,19 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         beta_rem.push((beta, beta0, gamma_n));
     }
     let mut force_beta = Vec::new();
+    let mut force_beta0 = Vec::new();
     for f in &model.forces {
-        force_beta.push(vel(g, &mut sub, f.point)?.0);
+        let (beta, beta0) = vel(g, &mut sub, f.point)?;
+        force_beta.push(beta);
+        force_beta0.push(beta0);
     }
     let mut torque_gamma = Vec::new();
+    let mut torque_gamma0 = Vec::new();
     for t in &model.torques {
         let omega = model.frames[t.frame].omega;
-        torque_gamma.push(split_omega(g, omega, &mut sub, &speed_rates)?.0);
+        let (gamma, gamma0) = split_omega(g, omega, &mut sub, &speed_rates)?;
+        torque_gamma.push(gamma);
+        torque_gamma0.push(gamma0);
     }
     // 5. Acceleration remainders: Σ_k (d/dt β̄_k) ẏ_k + d/dt β̄.
     let remainder =
@@ -810,6 +824,28 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }
     let potential = g.sum(&v_terms)?;
     let potential = expanded(g, potential)?;
+    // Power of the loads that depend on an input: F·v_P + L·ω.
+    let inputs_set = SymbolSet::from_symbols(model.inputs.iter().map(|(_, s)| *s));
+    let mut p_terms = Vec::new();
+    let mut power_terms: Vec<(String, Id)> = Vec::new();
+    for (fi, f) in model.forces.iter().enumerate() {
+        if f.vector.iter().any(|&c| g.depends_on_any(c, &inputs_set)) {
+            let v = combine(g, &force_beta[fi], force_beta0[fi], &speed_rates)?;
+            let p = dot(g, f.vector, v)?;
+            p_terms.push(p);
+            power_terms.push((f.effect.clone(), p));
+        }
+    }
+    for (ti, t) in model.torques.iter().enumerate() {
+        if t.vector.iter().any(|&c| g.depends_on_any(c, &inputs_set)) {
+            let w = combine(g, &torque_gamma[ti], torque_gamma0[ti], &speed_rates)?;
+            let p = dot(g, t.vector, w)?;
+            p_terms.push(p);
+            power_terms.push((t.effect.clone(), p));
+        }
+    }
+    let input_power = g.sum(&p_terms)?;
+    let input_power = expanded(g, input_power)?;
     // 7. Retained and ignorable coordinates.
     let raw_mass = mass.clone();
     let raw_elimination = elimination.clone();
@@ -852,6 +888,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         forcing,
         kinetic,
         potential,
+        input_power,
         retained,
         cyclic,
         ignorable,
@@ -859,6 +896,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         raw_elimination,
         inertial_terms,
         load_terms,
+        power_terms,
     }))
 }
 
@@ -999,6 +1037,14 @@ pub fn derive_scene(
         } else {
             g.int(0)?
         };
+        let scene_power: Vec<Id> = full
+            .power_terms
+            .iter()
+            .filter(|(e, _)| scene.effects.contains(e))
+            .map(|(_, p)| *p)
+            .collect();
+        let input_power = g.sum(&scene_power)?;
+        let input_power = expanded(g, input_power)?;
         let (retained, ignorable, cyclic) = reduce_state(
             g,
             &model.coords,
@@ -1030,6 +1076,7 @@ pub fn derive_scene(
             forcing,
             kinetic: full.kinetic,
             potential,
+            input_power,
             retained,
             cyclic,
             ignorable,
@@ -1038,6 +1085,7 @@ pub fn derive_scene(
             raw_elimination: full.raw_elimination.clone(),
             inertial_terms: full.inertial_terms.clone(),
             load_terms: Vec::new(),
+            power_terms: Vec::new(),
         };
         d.text = equations_text(&d);
         Ok(d)

@@ -523,6 +523,7 @@ impl Emitter<'_> {
         let cr = code(d, qdot, &options(false));
         let ke = code(d, &[d.kinetic], &options(false));
         let pe = code(d, &[d.potential], &options(false));
+        let ip = code(d, &[d.input_power], &options(false));
         let mut sd_roots = d.speed_w.clone();
         sd_roots.extend(&d.speed_w0);
         let sd = code(d, &sd_roots, &options(false));
@@ -684,6 +685,9 @@ impl Emitter<'_> {
     fn speed_definitions<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_q}{chk_w}{chk_w0}{params_t}{bind_q}{sd_body}{sd_out}        {P}::Ok(())
     }}
+    fn input_power<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{
+{chk_q}{chk_u}{chk_inputs}{params_t}{bind_q}{bind_u}{bind_inputs}{elim_pos}{ip_body}        {P}::Ok({ip_out})
+    }}
     fn potential_energy<__T: {P}::Scalar>(&self, t: __T, __q: &[__T]) -> {P}::Result<__T, {P}::ModelError> {{
 {chk_q}{params_t}{bind_q}{pe_body}        {P}::Ok({pe_out})
     }}
@@ -796,6 +800,8 @@ impl Emitter<'_> {
             },
             ke_body = statements(&ke),
             pe_body = statements(&pe),
+            ip_body = statements(&ip),
+            ip_out = ip.outputs[0],
             pe_out = pe.outputs[0],
             ke_out = ke.outputs[0],
             mp_body = statements(&mp),

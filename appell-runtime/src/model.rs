@@ -332,6 +332,19 @@ pub trait Model {
         Ok(T::zero())
     }
 
+    /// The power of the loads that depend on the inputs (Σ F·v + L·ω over
+    /// them), for controllers; zero for a model without inputs.
+    fn input_power<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        u: &[T],
+        inputs: &[T],
+    ) -> Result<T, ModelError> {
+        let _ = (t, q, u, inputs);
+        Ok(T::zero())
+    }
+
     /// Kinetic energy at full coordinates and privileged speeds.
     fn kinetic_energy<T: Scalar>(&self, t: T, q: &[T], u: &[T]) -> Result<T, ModelError>;
 
