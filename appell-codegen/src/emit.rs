@@ -921,9 +921,21 @@ fn camel(s: &str) -> String {
 
 /// A stub implementation emitted beside errors, so the user sees only the
 /// real ones (thiserror's fallback).
-pub fn stub(name: &syn::Ident) -> TokenStream {
-    let text = format!(
-        r#"
+pub fn stub(name: &syn::Ident, scenes: &[syn::Ident], vis: &syn::Visibility) -> TokenStream {
+    // The scene types are declared too, so code using them sees only the
+    // real errors.
+    let vis = quote::quote!(#vis).to_string();
+    let mut decls = String::new();
+    for sc in scenes {
+        let _ = writeln!(
+            decls,
+            "#[allow(dead_code)]\n{vis} struct {name}{}(pub {name});",
+            camel(&sc.to_string())
+        );
+    }
+    let text = decls
+        + &format!(
+            r#"
 const _: () = {{
     static __INFO: {P}::ModelInfo = {P}::ModelInfo {{
         name: "{name}", parameters: &[], coordinates: &[], speeds: &[], dependent: &[], cyclic: &[],
@@ -952,6 +964,6 @@ const _: () = {{
     }}
 }};
 "#
-    );
+        );
     TokenStream::from_str(&text).unwrap_or_default()
 }

@@ -51,7 +51,8 @@ pub fn expand(input: &syn::DeriveInput) -> TokenStream {
         Ok(()) => tokens.expect("no errors means a derivation"),
         Err(err) => {
             let mut out = err.to_compile_error();
-            out.extend(emit::stub(&input.ident));
+            let scenes: Vec<syn::Ident> = ast.scenes.iter().map(|s| s.name.clone()).collect();
+            out.extend(emit::stub(&input.ident, &scenes, &ast.vis));
             out
         }
     }
