@@ -20,3 +20,28 @@ impl Rng {
 pub fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * (1.0 + a.abs().max(b.abs()))
 }
+
+/// The textbook accelerations of a planar double pendulum (point masses,
+/// absolute angles from the downward vertical): state (θ1, θ2, ω1, ω2).
+pub fn double_pendulum_accelerations(
+    m1: f64,
+    m2: f64,
+    l1: f64,
+    l2: f64,
+    g: f64,
+    s: [f64; 4],
+) -> (f64, f64) {
+    let (t1, t2, w1, w2) = (s[0], s[1], s[2], s[3]);
+    let den = 2.0 * m1 + m2 - m2 * (2.0 * t1 - 2.0 * t2).cos();
+    let a1 = (-g * (2.0 * m1 + m2) * t1.sin()
+        - m2 * g * (t1 - 2.0 * t2).sin()
+        - 2.0 * (t1 - t2).sin() * m2 * (w2 * w2 * l2 + w1 * w1 * l1 * (t1 - t2).cos()))
+        / (l1 * den);
+    let a2 = 2.0
+        * (t1 - t2).sin()
+        * (w1 * w1 * l1 * (m1 + m2)
+            + g * (m1 + m2) * t1.cos()
+            + w2 * w2 * l2 * m2 * (t1 - t2).cos())
+        / (l2 * den);
+    (a1, a2)
+}
