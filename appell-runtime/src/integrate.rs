@@ -10,12 +10,148 @@
 //! coordinates then privileged speeds, see [`Model::rhs`]); [`rk4_step_fn`]
 //! is the same step for any right-hand side given as a closure.
 //!
+//! [`heun_step_fn`] and [`midpoint_step_fn`] (with the model versions
+//! [`heun_step`] and [`midpoint_step`]) are second-order steps of the same
+//! shape. [`Dopri5`] is an adaptive Dormand–Prince 5(4) integrator with
+//! error control, dense output and event location, also without allocation.
+//!
 //! Every step checks that the new state is finite (its real part, for dual
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
 //! otherwise, so a blow-up never goes unnoticed as NaN.
 
 use crate::model::{Model, ModelError};
 use crate::scalar::Scalar;
+
+mod dopri5;
+pub use dopri5::{Dopri5, EventFn, IntegrateError, Solution, Stats};
+
+/// One step of Heun's method (the explicit trapezoidal rule, order 2) of
+/// `dx/dt = f(t, x)` of size `h` from `(t, x)`: an Euler predictor
+/// `x̃ = x + h f(t, x)`, then `x + h/2 (f(t, x) + f(t + h, x̃))`.
+///
+/// Two evaluations of `f`; its errors are passed on, and the new state is
+/// checked to be finite ([`ModelError::NonFinite`] `{ what: "state" }`).
+///
+/// ```
+/// use appell_runtime::integrate::heun_step_fn;
+/// use appell_runtime::ModelError;
+///
+/// // dx/dt = x: one step of 0.1 has a local error of about h³/6.
+/// let mut f = |_t: f64, x: &[f64; 1], dx: &mut [f64; 1]| -> Result<(), ModelError> {
+///     dx[0] = x[0];
+///     Ok(())
+/// };
+/// let x1 = heun_step_fn(&mut f, 0.0, 0.1, &[1.0]).unwrap();
+/// assert_eq!(x1[0], 1.105); // 1 + h + h²/2
+/// assert!((x1[0] - 0.1_f64.exp()).abs() < 2e-4);
+/// ```
+pub fn heun_step_fn<T, F, const S: usize>(
+    f: &mut F,
+    t: T,
+    h: T,
+    state: &[T; S],
+) -> Result<[T; S], ModelError>
+where
+    T: Scalar,
+    F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
+{
+    let half_h = h * T::from_f64(0.5);
+    let mut k1 = [T::zero(); S];
+    f(t, state, &mut k1)?;
+    let mut x = *state;
+    for i in 0..S {
+        x[i] = state[i] + h * k1[i];
+    }
+    let mut k2 = [T::zero(); S];
+    f(t + h, &x, &mut k2)?;
+    let mut out = *state;
+    for i in 0..S {
+        out[i] = state[i] + half_h * (k1[i] + k2[i]);
+    }
+    finite_state(out)
+}
+
+/// One step of the explicit midpoint method (order 2) of `dx/dt = f(t, x)`
+/// of size `h` from `(t, x)`: `x + h f(t + h/2, x + h/2 f(t, x))`.
+///
+/// Two evaluations of `f`; errors as for [`heun_step_fn`].
+///
+/// ```
+/// use appell_runtime::integrate::midpoint_step_fn;
+/// use appell_runtime::ModelError;
+///
+/// // dx/dt = t: the midpoint rule integrates a linear rate exactly.
+/// let mut f = |t: f64, _x: &[f64; 1], dx: &mut [f64; 1]| -> Result<(), ModelError> {
+///     dx[0] = t;
+///     Ok(())
+/// };
+/// let x1 = midpoint_step_fn(&mut f, 1.0, 0.5, &[0.0]).unwrap();
+/// assert!((x1[0] - (1.5_f64 * 1.5 - 1.0) / 2.0).abs() < 1e-15);
+/// ```
+pub fn midpoint_step_fn<T, F, const S: usize>(
+    f: &mut F,
+    t: T,
+    h: T,
+    state: &[T; S],
+) -> Result<[T; S], ModelError>
+where
+    T: Scalar,
+    F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
+{
+    let half_h = h * T::from_f64(0.5);
+    let mut k1 = [T::zero(); S];
+    f(t, state, &mut k1)?;
+    let mut x = *state;
+    for i in 0..S {
+        x[i] = state[i] + half_h * k1[i];
+    }
+    let mut k2 = [T::zero(); S];
+    f(t + half_h, &x, &mut k2)?;
+    let mut out = *state;
+    for i in 0..S {
+        out[i] = state[i] + h * k2[i];
+    }
+    finite_state(out)
+}
+
+/// The state, or [`ModelError::NonFinite`] `{ what: "state" }`.
+fn finite_state<T: Scalar, const S: usize>(x: [T; S]) -> Result<[T; S], ModelError> {
+    if x.iter().all(|v| v.re().is_finite()) {
+        Ok(x)
+    } else {
+        Err(ModelError::NonFinite { what: "state" })
+    }
+}
+
+/// One step of Heun's method ([`heun_step_fn`]) of the model's reduced
+/// equations; arguments and errors as for [`rk4_step`].
+pub fn heun_step<M: Model, T: Scalar, const S: usize>(
+    model: &M,
+    prepared: &M::Prepared<T>,
+    t: T,
+    h: T,
+    state: &[T; S],
+    inputs: &[T],
+) -> Result<[T; S], ModelError> {
+    check_state_len::<M>(S)?;
+    let mut f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(prepared, t, x, inputs, dx);
+    heun_step_fn(&mut f, t, h, state)
+}
+
+/// One step of the explicit midpoint method ([`midpoint_step_fn`]) of the
+/// model's reduced equations; arguments and errors as for [`rk4_step`].
+pub fn midpoint_step<M: Model, T: Scalar, const S: usize>(
+    model: &M,
+    prepared: &M::Prepared<T>,
+    t: T,
+    h: T,
+    state: &[T; S],
+    inputs: &[T],
+) -> Result<[T; S], ModelError> {
+    check_state_len::<M>(S)?;
+    let mut f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(prepared, t, x, inputs, dx);
+    midpoint_step_fn(&mut f, t, h, state)
+}
 
 /// One classical RK4 step of `dx/dt = f(t, x)` of size `h` from `(t, x)`.
 ///
