@@ -24,6 +24,10 @@ use crate::scalar::Scalar;
 
 mod dopri5;
 pub use dopri5::{Dopri5, EventFn, IntegrateError, Solution, Stats};
+#[cfg(feature = "std")]
+mod implicit;
+#[cfg(feature = "std")]
+pub use implicit::*;
 
 /// One step of Heun's method (the explicit trapezoidal rule, order 2) of
 /// `dx/dt = f(t, x)` of size `h` from `(t, x)`: an Euler predictor

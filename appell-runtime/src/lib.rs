@@ -13,6 +13,8 @@
 #![warn(missing_docs)]
 
 #[cfg(feature = "std")]
+pub mod accuracy;
+#[cfg(feature = "std")]
 pub mod cli;
 pub mod integrate;
 pub mod linalg;

@@ -1,0 +1,373 @@
+//! What accuracy costs: work–precision sweeps of the integrators over a
+//! derived model, against a reference solution computed far more
+//! accurately.
+//!
+//! [`sweep`] runs each [`Method`] at each of its settings (a step count for
+//! the fixed-step methods, a tolerance for the adaptive one), measures the
+//! error at the final time and the largest error at evenly spaced
+//! checkpoints, and the wall time (median of repeated runs). [`reference`]
+//! computes the reference with Dormand–Prince at a tight tolerance and
+//! checks it against a second run ten times looser (the difference bounds
+//! the reference's own error).
+
+use std::time::Instant;
+
+use crate::integrate::{heun_step, midpoint_step, rk4_step, Dopri5, IntegrateError};
+use crate::model::Model;
+
+/// An integrator and its setting.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Method {
+    /// Classical RK4 with this many fixed steps.
+    Rk4(usize),
+    /// Heun (explicit trapezoid) with this many fixed steps.
+    Heun(usize),
+    /// Explicit midpoint with this many fixed steps.
+    Midpoint(usize),
+    /// Dormand–Prince 5(4) with this relative tolerance (absolute = relative
+    /// × 1e-2).
+    Dopri5(f64),
+}
+
+impl Method {
+    /// The method's name.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Method::Rk4(_) => "rk4",
+            Method::Heun(_) => "heun",
+            Method::Midpoint(_) => "midpoint",
+            Method::Dopri5(_) => "dopri5",
+        }
+    }
+
+    /// The setting as a number (steps, or tolerance).
+    pub fn setting(&self) -> f64 {
+        match *self {
+            Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => n as f64,
+            Method::Dopri5(tol) => tol,
+        }
+    }
+}
+
+/// One point of a work–precision chart.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Point {
+    /// The method.
+    pub method: Method,
+    /// Largest relative error (per component, relative to 1 + |reference|)
+    /// at the final time.
+    pub error_final: f64,
+    /// The same, largest over the checkpoints.
+    pub error_max: f64,
+    /// Median wall time of one integration [s].
+    pub seconds: f64,
+    /// Right-hand-side evaluations of one integration.
+    pub rhs_calls: u64,
+}
+
+/// An initial-value problem on a derived model: from `x0` at t = 0 to
+/// `t_end`, errors measured at `checkpoints` evenly spaced times.
+#[derive(Clone, Copy, Debug)]
+pub struct Problem<'a, M: Model, const S: usize> {
+    /// The model.
+    pub model: &'a M,
+    /// The initial reduced state.
+    pub x0: [f64; S],
+    /// The horizon [s].
+    pub t_end: f64,
+    /// Constant inputs.
+    pub inputs: &'a [f64],
+    /// How many evenly spaced checkpoints the errors are measured at.
+    pub checkpoints: usize,
+}
+
+impl<M: Model, const S: usize> Problem<'_, M, S> {
+    /// The reference states at the checkpoints `t_end · k / checkpoints`
+    /// (k = 1..=checkpoints), by Dormand–Prince at rtol 1e-14, and an
+    /// estimate of their error (the largest relative difference from a run at
+    /// rtol 1e-13).
+    #[allow(clippy::type_complexity)] // (states at the checkpoints, error estimate)
+    pub fn reference(&self) -> Result<(Vec<[f64; S]>, f64), IntegrateError> {
+        let tight = integrate(self, Method::Dopri5(1e-14))?.0;
+        let loose = integrate(self, Method::Dopri5(1e-13))?.0;
+        let estimate = tight
+            .iter()
+            .zip(&loose)
+            .map(|(a, b)| relative_error(a, b))
+            .fold(0.0, f64::max);
+        Ok((tight, estimate))
+    }
+
+    /// Runs every method against `reference`; the wall time is the median
+    /// of `repeats` runs; `progress(done, total)` is called before each
+    /// method. Methods that fail (a step size underflow, say) are skipped,
+    /// so a sweep returns what it could measure.
+    pub fn sweep(
+        &self,
+        reference: &[[f64; S]],
+        methods: &[Method],
+        repeats: usize,
+        mut progress: impl FnMut(usize, usize),
+    ) -> Vec<Point> {
+        let mut points = Vec::with_capacity(methods.len());
+        for (i, &method) in methods.iter().enumerate() {
+            progress(i, methods.len());
+            let Ok((states, rhs_calls)) = integrate(self, method) else {
+                continue;
+            };
+            let mut times = Vec::with_capacity(repeats.max(1));
+            for _ in 0..repeats.max(1) {
+                let start = Instant::now();
+                let r = integrate(self, method);
+                times.push(start.elapsed().as_secs_f64());
+                std::hint::black_box(r.ok());
+            }
+            times.sort_by(f64::total_cmp);
+            let errors: Vec<f64> = states
+                .iter()
+                .zip(reference)
+                .map(|(x, r)| relative_error(x, r))
+                .collect();
+            points.push(Point {
+                method,
+                error_final: *errors.last().unwrap_or(&f64::NAN),
+                error_max: errors.iter().copied().fold(0.0, f64::max),
+                seconds: times[times.len() / 2],
+                rhs_calls,
+            });
+        }
+        progress(methods.len(), methods.len());
+        points
+    }
+}
+
+fn relative_error<const S: usize>(x: &[f64; S], reference: &[f64; S]) -> f64 {
+    x.iter()
+        .zip(reference)
+        .map(|(a, b)| (a - b).abs() / (1.0 + b.abs()))
+        .fold(0.0, f64::max)
+}
+
+/// One integration with `method`: the states at the checkpoints and the
+/// number of rhs calls.
+fn integrate<M: Model, const S: usize>(
+    pb: &Problem<'_, M, S>,
+    method: Method,
+) -> Result<(Vec<[f64; S]>, u64), IntegrateError> {
+    let (model, inputs, checkpoints, t_end) =
+        (pb.model, pb.inputs, pb.checkpoints.max(1), pb.t_end);
+    match method {
+        Method::Dopri5(tol) => {
+            let mut out: Vec<(f64, [f64; S])> = (1..=checkpoints)
+                .map(|k| (t_end * k as f64 / checkpoints as f64, [0.0; S]))
+                .collect();
+            let sol = Dopri5::new()
+                .rtol(tol)
+                .atol(tol * 1e-2)
+                .max_steps(10_000_000)
+                .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?;
+            Ok((
+                out.into_iter().map(|(_, x)| x).collect(),
+                sol.stats.rhs_calls as u64,
+            ))
+        }
+        Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => {
+            let prepared = model.prepare::<f64>();
+            // Round the step count up to a multiple of the checkpoints.
+            let per = n.div_ceil(checkpoints).max(1);
+            let steps = per * checkpoints;
+            let h = t_end / steps as f64;
+            let stages = match method {
+                Method::Rk4(_) => 4,
+                _ => 2,
+            };
+            let mut x = pb.x0;
+            let mut out = Vec::with_capacity(checkpoints);
+            for k in 0..steps {
+                let t = k as f64 * h;
+                x = match method {
+                    Method::Rk4(_) => rk4_step(model, &prepared, t, h, &x, inputs)?,
+                    Method::Heun(_) => heun_step(model, &prepared, t, h, &x, inputs)?,
+                    _ => midpoint_step(model, &prepared, t, h, &x, inputs)?,
+                };
+                if (k + 1) % per == 0 {
+                    out.push(x);
+                }
+            }
+            Ok((out, (steps * stages) as u64))
+        }
+    }
+}
+
+/// The methods of a standard sweep: RK4, Heun and midpoint at step counts
+/// doubling from `min_steps` (`levels` of them), Dormand–Prince at
+/// tolerances from 1e-3 down by factors of 10 (`levels + 2` of them, to
+/// 1e-12 for 8 levels).
+pub fn standard_methods(min_steps: usize, levels: usize) -> Vec<Method> {
+    let mut v = Vec::new();
+    for k in 0..levels {
+        let n = min_steps << k;
+        v.push(Method::Rk4(n));
+        v.push(Method::Heun(n));
+        v.push(Method::Midpoint(n));
+    }
+    for k in 0..levels + 2 {
+        v.push(Method::Dopri5(10f64.powi(-3 - k as i32)));
+    }
+    v
+}
+
+/// A log–log chart (error against time) as a self-contained SVG document,
+/// one polyline per method name; `title` on top.
+pub fn svg_chart(title: &str, points: &[Point]) -> String {
+    let (w, h, left, bottom, top, right) = (720.0, 480.0, 80.0, 60.0, 40.0, 150.0);
+    let pts: Vec<&Point> = points
+        .iter()
+        .filter(|p| p.error_final > 0.0 && p.seconds > 0.0 && p.error_final.is_finite())
+        .collect();
+    let lx = |p: &Point| p.seconds.log10();
+    let ly = |p: &Point| p.error_final.max(1e-17).log10();
+    let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
+    for p in &pts {
+        x0 = x0.min(lx(p).floor());
+        x1 = x1.max(lx(p).ceil());
+        y0 = y0.min(ly(p).floor());
+        y1 = y1.max(ly(p).ceil());
+    }
+    if pts.is_empty() {
+        (x0, x1, y0, y1) = (-6.0, 0.0, -16.0, 0.0);
+    }
+    if x1 <= x0 {
+        x1 = x0 + 1.0;
+    }
+    if y1 <= y0 {
+        y1 = y0 + 1.0;
+    }
+    let sx = |v: f64| left + (v - x0) / (x1 - x0) * (w - left - right);
+    let sy = |v: f64| h - bottom - (v - y0) / (y1 - y0) * (h - bottom - top);
+    let mut s = format!(
+        "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{w}\" height=\"{h}\" font-family=\"sans-serif\" font-size=\"12\">\n\
+         <rect width=\"{w}\" height=\"{h}\" fill=\"white\"/>\n\
+         <text x=\"{}\" y=\"24\" text-anchor=\"middle\" font-size=\"15\">{}</text>\n",
+        w / 2.0,
+        escape(title)
+    );
+    for d in (x0 as i32)..=(x1 as i32) {
+        let x = sx(d as f64);
+        s += &format!(
+            "<line x1=\"{x}\" y1=\"{}\" x2=\"{x}\" y2=\"{}\" stroke=\"#ddd\"/><text x=\"{x}\" y=\"{}\" text-anchor=\"middle\">1e{d}</text>\n",
+            sy(y0),
+            sy(y1),
+            sy(y0) + 18.0
+        );
+    }
+    for d in (y0 as i32)..=(y1 as i32) {
+        let y = sy(d as f64);
+        s += &format!(
+            "<line x1=\"{}\" y1=\"{y}\" x2=\"{}\" y2=\"{y}\" stroke=\"#ddd\"/><text x=\"{}\" y=\"{}\" text-anchor=\"end\">1e{d}</text>\n",
+            sx(x0),
+            sx(x1),
+            sx(x0) - 6.0,
+            y + 4.0
+        );
+    }
+    s += &format!(
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">wall time per integration [s]</text>\n\
+         <text x=\"18\" y=\"{}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {})\">relative error at the final time</text>\n",
+        (sx(x0) + sx(x1)) / 2.0,
+        h - 12.0,
+        (sy(y0) + sy(y1)) / 2.0,
+        (sy(y0) + sy(y1)) / 2.0
+    );
+    let colors = [
+        "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
+    ];
+    let mut names: Vec<&str> = pts.iter().map(|p| p.method.name()).collect();
+    names.dedup();
+    let mut seen: Vec<&str> = Vec::new();
+    for n in names {
+        if !seen.contains(&n) {
+            seen.push(n);
+        }
+    }
+    for (k, name) in seen.iter().enumerate() {
+        let color = colors[k % colors.len()];
+        let mut line: Vec<&&Point> = pts.iter().filter(|p| p.method.name() == *name).collect();
+        line.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+        let path: Vec<String> = line
+            .iter()
+            .map(|p| format!("{:.2},{:.2}", sx(lx(p)), sy(ly(p))))
+            .collect();
+        s += &format!(
+            "<polyline fill=\"none\" stroke=\"{color}\" stroke-width=\"2\" points=\"{}\"/>\n",
+            path.join(" ")
+        );
+        for p in &line {
+            s += &format!(
+                "<circle cx=\"{:.2}\" cy=\"{:.2}\" r=\"3\" fill=\"{color}\"/>\n",
+                sx(lx(p)),
+                sy(ly(p))
+            );
+        }
+        let ly_legend = top + 20.0 + 20.0 * k as f64;
+        s += &format!(
+            "<line x1=\"{}\" y1=\"{ly_legend}\" x2=\"{}\" y2=\"{ly_legend}\" stroke=\"{color}\" stroke-width=\"2\"/><text x=\"{}\" y=\"{}\">{name}</text>\n",
+            w - right + 15.0,
+            w - right + 40.0,
+            w - right + 46.0,
+            ly_legend + 4.0
+        );
+    }
+    s += "</svg>\n";
+    s
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+/// The points as CSV: `method,setting,error_final,error_max,seconds,rhs_calls`.
+pub fn csv(points: &[Point]) -> String {
+    let mut s = String::from("method,setting,error_final,error_max,seconds,rhs_calls\n");
+    for p in points {
+        s += &format!(
+            "{},{:e},{:e},{:e},{:e},{}\n",
+            p.method.name(),
+            p.method.setting(),
+            p.error_final,
+            p.error_max,
+            p.seconds,
+            p.rhs_calls
+        );
+    }
+    s
+}
+
+/// For each method, the least time that reached a relative error at or below
+/// each target (`None` where no setting did).
+pub fn time_to_reach(points: &[Point], targets: &[f64]) -> Vec<(&'static str, Vec<Option<f64>>)> {
+    let mut names: Vec<&'static str> = Vec::new();
+    for p in points {
+        if !names.contains(&p.method.name()) {
+            names.push(p.method.name());
+        }
+    }
+    names
+        .into_iter()
+        .map(|n| {
+            let times = targets
+                .iter()
+                .map(|&target| {
+                    points
+                        .iter()
+                        .filter(|p| p.method.name() == n && p.error_max <= target)
+                        .map(|p| p.seconds)
+                        .min_by(f64::total_cmp)
+                })
+                .collect();
+            (n, times)
+        })
+        .collect()
+}
