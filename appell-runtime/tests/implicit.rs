@@ -1,0 +1,626 @@
+//! The adaptive TR-BDF2 integrator: accuracy and work on stiff problems
+//! against Dormand–Prince, observed order, Jacobians by dual numbers, and
+//! typed errors. The models are hand-written `impl Model`s whose only
+//! meaningful methods are `info`, `prepare` and `rhs`.
+
+use appell_runtime::integrate::{Dopri5, IntegrateError, TrBdf2, TrBdf2Stats};
+use appell_runtime::{check_len, Model, ModelError, ModelInfo, OpCounts, Scalar};
+
+fn unused() -> Result<(), ModelError> {
+    Err(ModelError::NonFinite { what: "unused" })
+}
+
+const fn info(
+    name: &'static str,
+    retained: &'static [&'static str],
+    speeds: &'static [&'static str],
+    inputs: &'static [&'static str],
+) -> ModelInfo {
+    ModelInfo {
+        name,
+        parameters: &[],
+        coordinates: retained,
+        speeds,
+        dependent: &[],
+        cyclic: &[],
+        ignorable: &[],
+        retained,
+        inputs,
+        effects: &[],
+        holonomic: 0,
+        constraints: 0,
+        bodies: &[],
+        force_points: 0,
+        torques: 0,
+        symbolic_elimination: true,
+        rhs_ops: OpCounts {
+            add: 0,
+            mul: 0,
+            div: 0,
+            calls: 0,
+            total: 0,
+        },
+        equations: "",
+    }
+}
+
+/// Everything of `Model` except `Prepared`, `info`, `prepare` and `rhs`.
+macro_rules! rest_of_model {
+    () => {
+        fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> {
+            unused()
+        }
+        fn set_parameter(&mut self, _: &str, _: f64) -> bool {
+            false
+        }
+        fn mass_matrix_and_forcing<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &[T],
+            _: &[T],
+            _: &mut [T],
+            _: &mut [T],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn speed_transform<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &mut [T],
+            _: &mut [T],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn coordinate_rates<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &[T],
+            _: &mut [T],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn constraint_residuals<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &[T],
+            _: &mut [T],
+            _: &mut [T],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> {
+            unused().map(|_| T::zero())
+        }
+        fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> {
+            unused()
+        }
+        fn body_poses<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &mut [[T; 3]],
+            _: &mut [[T; 9]],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn constraint_rows<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &mut [T],
+            _: &mut [T],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn load_geometry<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &mut [[T; 3]],
+            _: &mut [[T; 9]],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+        fn load_values<T: Scalar>(
+            &self,
+            _: T,
+            _: &[T],
+            _: &[T],
+            _: &[T],
+            _: &mut [[T; 3]],
+            _: &mut [[T; 3]],
+        ) -> Result<(), ModelError> {
+            unused()
+        }
+    };
+}
+
+// ---------------------------------------------------------------------------
+// x' = −λ (x − a cos t), with the amplitude a an input.
+
+struct StiffLinear {
+    lambda: f64,
+}
+
+static STIFF_INFO: ModelInfo = info("StiffLinear", &["x"], &[], &["a"]);
+
+impl Model for StiffLinear {
+    type Prepared<T: Scalar> = T;
+    fn info() -> &'static ModelInfo {
+        &STIFF_INFO
+    }
+    fn prepare<T: Scalar>(&self) -> T {
+        T::from_f64(self.lambda)
+    }
+    fn rhs<T: Scalar>(
+        &self,
+        lambda: &T,
+        t: T,
+        state: &[T],
+        inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        check_len("state", state, 1)?;
+        check_len("inputs", inputs, 1)?;
+        check_len("dstate", dstate, 1)?;
+        dstate[0] = -(*lambda * (state[0] - inputs[0] * t.cos()));
+        Ok(())
+    }
+    rest_of_model!();
+}
+
+/// The exact solution of `StiffLinear` with x(0) = 0, a = 1.
+fn stiff_exact(lambda: f64, t: f64) -> f64 {
+    let l2 = lambda * lambda;
+    lambda * (lambda * t.cos() + t.sin()) / (l2 + 1.0) - (-lambda * t).exp() * l2 / (l2 + 1.0)
+}
+
+// ---------------------------------------------------------------------------
+// Van der Pol: x'' = μ (1 − x²) x' − x.
+
+struct VanDerPol {
+    mu: f64,
+}
+
+static VDP_INFO: ModelInfo = info("VanDerPol", &["x"], &["x"], &[]);
+
+impl Model for VanDerPol {
+    type Prepared<T: Scalar> = T;
+    fn info() -> &'static ModelInfo {
+        &VDP_INFO
+    }
+    fn prepare<T: Scalar>(&self) -> T {
+        T::from_f64(self.mu)
+    }
+    fn rhs<T: Scalar>(
+        &self,
+        mu: &T,
+        _t: T,
+        state: &[T],
+        inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        check_len("state", state, 2)?;
+        check_len("inputs", inputs, 0)?;
+        check_len("dstate", dstate, 2)?;
+        let (x, v) = (state[0], state[1]);
+        dstate[0] = v;
+        dstate[1] = *mu * (T::one() - x * x) * v - x;
+        Ok(())
+    }
+    rest_of_model!();
+}
+
+// ---------------------------------------------------------------------------
+// A smooth nonlinear non-stiff problem with a closed form: the pendulum-free
+// x' = y, y' = −x (harmonic oscillator) and z' = −z² (z = 1/(1 + t)).
+
+struct Smooth;
+
+static SMOOTH_INFO: ModelInfo = info("Smooth", &["x", "z"], &["x"], &[]);
+
+impl Model for Smooth {
+    type Prepared<T: Scalar> = ();
+    fn info() -> &'static ModelInfo {
+        &SMOOTH_INFO
+    }
+    fn prepare<T: Scalar>(&self) {}
+    fn rhs<T: Scalar>(
+        &self,
+        _: &(),
+        _t: T,
+        state: &[T],
+        _inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        check_len("state", state, 3)?;
+        check_len("dstate", dstate, 3)?;
+        dstate[0] = state[2];
+        dstate[1] = -(state[1] * state[1]);
+        dstate[2] = -state[0];
+        Ok(())
+    }
+    rest_of_model!();
+}
+
+fn smooth_exact(t: f64) -> [f64; 3] {
+    [t.cos(), 1.0 / (1.0 + t), -t.sin()]
+}
+
+fn max_err(a: &[f64], b: &[f64]) -> f64 {
+    a.iter()
+        .zip(b)
+        .map(|(x, y)| (x - y).abs())
+        .fold(0.0, f64::max)
+}
+
+// ---------------------------------------------------------------------------
+// Models that fail: x' = x² (blows up at t = 1 from x(0) = 1), and one whose
+// rhs reports a singular configuration past x = 0.5.
+
+struct BlowUp;
+
+static BLOWUP_INFO: ModelInfo = info("BlowUp", &["x"], &[], &[]);
+
+impl Model for BlowUp {
+    type Prepared<T: Scalar> = ();
+    fn info() -> &'static ModelInfo {
+        &BLOWUP_INFO
+    }
+    fn prepare<T: Scalar>(&self) {}
+    fn rhs<T: Scalar>(
+        &self,
+        _: &(),
+        _t: T,
+        state: &[T],
+        _inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        check_len("state", state, 1)?;
+        dstate[0] = state[0] * state[0];
+        Ok(())
+    }
+    rest_of_model!();
+}
+
+struct Singular;
+
+static SINGULAR_INFO: ModelInfo = info("Singular", &["x"], &[], &[]);
+
+impl Model for Singular {
+    type Prepared<T: Scalar> = ();
+    fn info() -> &'static ModelInfo {
+        &SINGULAR_INFO
+    }
+    fn prepare<T: Scalar>(&self) {}
+    fn rhs<T: Scalar>(
+        &self,
+        _: &(),
+        _t: T,
+        state: &[T],
+        _inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        check_len("state", state, 1)?;
+        if state[0].re() > 0.5 {
+            return Err(ModelError::SingularMassMatrix {
+                index: 0,
+                pivot: 0.0,
+            });
+        }
+        dstate[0] = T::one();
+        Ok(())
+    }
+    rest_of_model!();
+}
+
+// ---------------------------------------------------------------------------
+
+const LAMBDA: f64 = 1000.0;
+
+fn dopri5_stiff(tol: f64) -> (f64, appell_runtime::integrate::Stats) {
+    let model = StiffLinear { lambda: LAMBDA };
+    let sol = Dopri5::new()
+        .rtol(tol)
+        .atol(tol)
+        .solve_model(&model, &[1.0], 0.0, &[0.0], 5.0)
+        .unwrap();
+    ((sol.x[0] - stiff_exact(LAMBDA, 5.0)).abs(), sol.stats)
+}
+
+fn trbdf2_stiff(tol: f64) -> (f64, TrBdf2Stats) {
+    let model = StiffLinear { lambda: LAMBDA };
+    let sol = TrBdf2::new()
+        .rtol(tol)
+        .atol(tol)
+        .solve_model(&model, 0.0, &[0.0], 5.0, &[1.0])
+        .unwrap();
+    assert_eq!(sol.t, 5.0);
+    ((sol.x[0] - stiff_exact(LAMBDA, 5.0)).abs(), sol.stats)
+}
+
+#[test]
+fn stiff_linear_is_accurate_with_far_fewer_steps_than_dopri5() {
+    for tol in [1e-4, 1e-6, 1e-8] {
+        let (e_imp, s_imp) = trbdf2_stiff(tol);
+        let (e_exp, s_exp) = dopri5_stiff(tol);
+        println!(
+            "tol {tol:e}: TR-BDF2 error {e_imp:.2e} {s_imp:?}\n            Dopri5  error {e_exp:.2e} {s_exp:?}"
+        );
+        assert!(e_imp <= 10.0 * tol, "tol {tol}: error {e_imp}");
+        // Linear problem: one Jacobian for the whole run.
+        assert_eq!(s_imp.jacobians, 1, "{s_imp:?}");
+        assert_eq!(s_imp.jacobian_rhs_calls, 1);
+        assert_eq!(s_imp.newton_failures, 0, "{s_imp:?}");
+        // Dopri5 is held at its stability limit (≈ 3.3/λ) everywhere.
+        assert!(s_exp.accepted > 1400, "{s_exp:?}");
+        let factor = if tol >= 1e-6 { 10 } else { 3 };
+        assert!(
+            factor * (s_imp.accepted + s_imp.rejected) < s_exp.accepted + s_exp.rejected,
+            "tol {tol}: {s_imp:?} vs {s_exp:?}"
+        );
+        assert!(factor * s_imp.rhs_calls < s_exp.rhs_calls);
+    }
+}
+
+#[test]
+fn user_jacobian_gives_the_same_trajectory_as_dual_numbers() {
+    let f = |t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+        dx[0] = -(LAMBDA * (x[0] - t.cos()));
+        Ok(())
+    };
+    let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+        j[0] = -LAMBDA;
+        Ok(())
+    };
+    let solver = TrBdf2::new().rtol(1e-6).atol(1e-6);
+    let a = solver.solve(f, jac, 0.0, &[0.0], 5.0).unwrap();
+    let b = solver
+        .solve_model(&StiffLinear { lambda: LAMBDA }, 0.0, &[0.0], 5.0, &[1.0])
+        .unwrap();
+    assert_eq!(a.x, b.x);
+    assert_eq!(a.stats.accepted, b.stats.accepted);
+    assert_eq!(a.stats.jacobian_rhs_calls, 0);
+    assert_eq!(b.stats.jacobian_rhs_calls, 1);
+}
+
+#[test]
+fn inputs_reach_the_model() {
+    // a = 2: the solution doubles.
+    let sol = TrBdf2::new()
+        .rtol(1e-8)
+        .atol(1e-8)
+        .solve_model(&StiffLinear { lambda: LAMBDA }, 0.0, &[0.0], 2.0, &[2.0])
+        .unwrap();
+    assert!((sol.x[0] - 2.0 * stiff_exact(LAMBDA, 2.0)).abs() < 1e-6);
+}
+
+#[test]
+fn fixed_steps_converge_with_order_two() {
+    let t_end = 2.0;
+    let errs: Vec<f64> = [20, 40, 80, 160]
+        .iter()
+        .map(|&n| {
+            let h = t_end / n as f64;
+            let sol = TrBdf2::new()
+                .rtol(1e-10)
+                .atol(1e-10)
+                .adaptive(false)
+                .h_init(Some(h))
+                .solve_model(&Smooth, 0.0, &[1.0, 1.0, 0.0], t_end, &[])
+                .unwrap();
+            assert_eq!(sol.stats.accepted, n, "{:?}", sol.stats);
+            assert_eq!(sol.stats.rejected, 0);
+            max_err(&sol.x, &smooth_exact(t_end))
+        })
+        .collect();
+    let orders: Vec<f64> = errs.windows(2).map(|w| (w[0] / w[1]).log2()).collect();
+    println!("fixed-step errors {errs:?}, observed orders {orders:?}");
+    for p in &orders {
+        assert!((p - 2.0).abs() < 0.15, "order {p}");
+    }
+}
+
+#[test]
+fn tolerance_sweep_shows_order_two_in_steps() {
+    // With local error ∝ tol, global error ∝ N^−2 for N steps.
+    let runs: Vec<(f64, usize)> = [1e-5, 1e-7, 1e-9, 1e-11]
+        .iter()
+        .map(|&tol| {
+            let sol = TrBdf2::new()
+                .rtol(tol)
+                .atol(tol)
+                .solve_model(&Smooth, 0.0, &[1.0, 1.0, 0.0], 10.0, &[])
+                .unwrap();
+            (max_err(&sol.x, &smooth_exact(10.0)), sol.stats.accepted)
+        })
+        .collect();
+    println!("tolerance sweep (error, steps): {runs:?}");
+    let (e0, n0) = runs[0];
+    let (e1, n1) = runs[runs.len() - 1];
+    let p = (e0 / e1).ln() / (n1 as f64 / n0 as f64).ln();
+    println!("observed order over the sweep: {p}");
+    assert!((p - 2.0).abs() < 0.35, "order {p}");
+    // The error follows the tolerance (proportionality tol^(2/3)).
+    for w in runs.windows(2) {
+        assert!(w[1].0 < w[0].0);
+    }
+}
+
+#[test]
+fn van_der_pol_mu_1000_completes_with_modest_work() {
+    let model = VanDerPol { mu: 1000.0 };
+    let t_end = 2000.0;
+    let sol = TrBdf2::new()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .solve_model(&model, 0.0, &[2.0, 0.0], t_end, &[])
+        .unwrap();
+    println!(
+        "van der Pol μ = 1000 to t = {t_end}: x = {:?}, {:?}",
+        sol.x, sol.stats
+    );
+    assert_eq!(sol.t, t_end);
+    let s = sol.stats;
+    assert!(s.accepted + s.rejected < 5_000, "{s:?}");
+    assert!(s.jacobians < s.accepted, "{s:?}");
+    assert!(s.lu_factorizations <= s.accepted + s.rejected + s.jacobians);
+    assert_eq!(s.jacobian_rhs_calls, 2 * s.jacobians);
+
+    // A tight reference: the two agree on the slow branch.
+    let reference = TrBdf2::new()
+        .rtol(1e-9)
+        .atol(1e-9)
+        .solve_model(&model, 0.0, &[2.0, 0.0], t_end, &[])
+        .unwrap();
+    println!("reference: x = {:?}, {:?}", reference.x, reference.stats);
+    assert!((sol.x[0] - reference.x[0]).abs() < 1e-2, "{:?}", sol.x);
+    // Half a period is ≈ (3 − 2 ln 2) μ / 2 ≈ 807: by t = 2000 x has jumped
+    // twice (near 807 and 1614) and is back on the positive branch.
+    assert!(sol.x[0] > 1.0 && sol.x[0] < 2.1, "{:?}", sol.x);
+    let half = TrBdf2::new()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .solve_model(&model, 0.0, &[2.0, 0.0], 1000.0, &[])
+        .unwrap();
+    assert!(half.x[0] < -1.0 && half.x[0] > -2.1, "{:?}", half.x);
+}
+
+#[test]
+fn dopri5_cannot_do_van_der_pol_mu_1000_on_a_budget() {
+    // Over only a tenth of the interval above, the default 100 000 steps of
+    // Dopri5 are not enough (its step is held near 3.3 / (μ (x² − 1))).
+    let model = VanDerPol { mu: 1000.0 };
+    let r = Dopri5::new()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .max_steps(100_000)
+        .solve_model(&model, &[], 0.0, &[2.0, 0.0], 2000.0);
+    match r {
+        Err(IntegrateError::TooManySteps { t, steps }) => {
+            println!("Dopri5 van der Pol μ = 1000: {steps} steps reached only t = {t}");
+            assert!(t < 400.0);
+        }
+        other => panic!("{other:?}"),
+    }
+}
+
+#[test]
+fn backward_integration_returns_to_the_start() {
+    let fwd = TrBdf2::new()
+        .rtol(1e-10)
+        .atol(1e-10)
+        .solve_model(&Smooth, 0.0, &[1.0, 1.0, 0.0], 1.0, &[])
+        .unwrap();
+    let back = TrBdf2::new()
+        .rtol(1e-10)
+        .atol(1e-10)
+        .solve_model(&Smooth, 1.0, &fwd.x, 0.0, &[])
+        .unwrap();
+    assert_eq!(back.t, 0.0);
+    assert!(max_err(&back.x, &[1.0, 1.0, 0.0]) < 1e-7, "{:?}", back.x);
+}
+
+#[test]
+fn zero_length_interval_returns_the_initial_state() {
+    let sol = TrBdf2::new()
+        .solve_model(&Smooth, 1.0, &[1.0, 2.0, 3.0], 1.0, &[])
+        .unwrap();
+    assert_eq!(sol.x, vec![1.0, 2.0, 3.0]);
+    assert_eq!(sol.stats, TrBdf2Stats::default());
+}
+
+#[test]
+fn errors_are_typed() {
+    let s = TrBdf2::new();
+    let stiff = StiffLinear { lambda: LAMBDA };
+    // Too many steps.
+    assert!(matches!(
+        s.max_steps(5).solve_model(&stiff, 0.0, &[0.0], 5.0, &[1.0]),
+        Err(IntegrateError::TooManySteps { steps: 5, t }) if t > 0.0 && t < 5.0
+    ));
+    // Blow-up at t = 1: the step shrinks to nothing there.
+    match s.solve_model(&BlowUp, 0.0, &[1.0], 2.0, &[]) {
+        Err(IntegrateError::StepSizeTooSmall { t, .. } | IntegrateError::NonFinite { t }) => {
+            assert!((t - 1.0).abs() < 1e-2, "{t}")
+        }
+        other => panic!("{other:?}"),
+    }
+    // A minimum step size that is too large.
+    assert!(matches!(
+        s.h_min(0.5).solve_model(&BlowUp, 0.0, &[1.0], 2.0, &[]),
+        Err(IntegrateError::StepSizeTooSmall { h, .. }) if h < 0.5
+    ));
+    // Model errors are passed on.
+    assert_eq!(
+        s.solve_model(&Singular, 0.0, &[0.0], 1.0, &[]),
+        Err(IntegrateError::Model(ModelError::SingularMassMatrix {
+            index: 0,
+            pivot: 0.0
+        }))
+    );
+    assert!(matches!(
+        s.solve_model(&stiff, 0.0, &[0.0, 1.0], 1.0, &[1.0]),
+        Err(IntegrateError::Model(ModelError::Length {
+            argument: "state",
+            expected: 1,
+            found: 2
+        }))
+    ));
+    assert!(matches!(
+        s.solve_model(&stiff, 0.0, &[0.0], 1.0, &[]),
+        Err(IntegrateError::Model(ModelError::Length {
+            argument: "inputs",
+            ..
+        }))
+    ));
+    // Non-finite initial state; a rhs that is NaN at the start.
+    assert_eq!(
+        s.solve_model(&stiff, 0.0, &[f64::NAN], 1.0, &[1.0]),
+        Err(IntegrateError::NonFinite { t: 0.0 })
+    );
+    assert_eq!(
+        s.solve_model(&stiff, 0.0, &[0.0], 1.0, &[f64::INFINITY]),
+        Err(IntegrateError::NonFinite { t: 0.0 })
+    );
+    // A rhs that becomes NaN past x = 0.5 (the step shrinks, then fails).
+    let f = |_t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+        dx[0] = if x[0] > 0.5 { f64::NAN } else { 1.0 };
+        Ok(())
+    };
+    let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+        j[0] = 0.0;
+        Ok(())
+    };
+    match s.solve(f, jac, 0.0, &[0.0], 1.0) {
+        Err(IntegrateError::NonFinite { t }) => assert!((t - 0.5).abs() < 1e-3, "{t}"),
+        other => panic!("{other:?}"),
+    }
+    // Invalid settings and arguments.
+    for bad in [
+        s.rtol(-1.0),
+        s.atol(f64::NAN),
+        s.rtol(0.0).atol(0.0),
+        s.h_init(Some(0.0)),
+        s.h_max(Some(-1.0)),
+        s.h_min(f64::INFINITY),
+        s.max_newton(0),
+        s.adaptive(false),
+    ] {
+        assert!(
+            matches!(
+                bad.solve_model(&stiff, 0.0, &[0.0], 1.0, &[1.0]),
+                Err(IntegrateError::InvalidInput { .. })
+            ),
+            "{bad:?}"
+        );
+    }
+    assert!(matches!(
+        s.solve_model(&stiff, 0.0, &[0.0], f64::NAN, &[1.0]),
+        Err(IntegrateError::InvalidInput { .. })
+    ));
+}
