@@ -47,6 +47,30 @@ fn main() -> Result<(), Box<dyn Error>> {
         &mut summary,
     )?;
 
+    // Throughput: steps and rhs calls per second of wall time, per method,
+    // at its most expensive setting on the wheel-axle (the benchmark the
+    // issue asks for; compare ratios in one run only).
+    writeln!(summary, "## Throughput on the wheel-axle (most expensive setting of each method)\n\n| method | setting | steps | rhs calls | time | steps/s | rhs calls/s |\n| --- | ---: | ---: | ---: | ---: | ---: | ---: |")?;
+    for name in accuracy::method_names(&axle_points) {
+        if let Some(p) = axle_points
+            .iter()
+            .filter(|p| p.method.name() == name)
+            .max_by(|a, b| a.seconds.total_cmp(&b.seconds))
+        {
+            writeln!(
+                summary,
+                "| {name} | {:e} | {} | {} | {:.1} µs | {:.2e} | {:.2e} |",
+                p.method.setting(),
+                p.steps,
+                p.rhs_calls,
+                p.seconds * 1e6,
+                p.steps as f64 / p.seconds,
+                p.rhs_calls as f64 / p.seconds
+            )?;
+        }
+    }
+    writeln!(summary)?;
+
     let disc = rolling_disc::RollingDisc::default();
     let disc_pb = Problem {
         model: &disc,

@@ -27,6 +27,9 @@ fn error_falls_with_step_and_tolerance() {
         Method::Dopri5(1e-4),
         Method::Dopri5(1e-6),
         Method::Dopri5(1e-8),
+        Method::TrBdf2(1e-4),
+        Method::TrBdf2(1e-6),
+        Method::TrBdf2(1e-8),
     ];
     let points = pb.sweep(&reference, &methods, 1, |_, _| {});
     assert_eq!(points.len(), methods.len());
@@ -46,6 +49,12 @@ fn error_falls_with_step_and_tolerance() {
     // Dormand–Prince: tighter tolerance, smaller error, more work.
     assert!(e(5) > e(6) && e(6) > e(7));
     assert!(points[5].rhs_calls < points[7].rhs_calls);
+    // TR-BDF2 (order 2, error per step controlled): the global error falls
+    // about as tol^(2/3), 1e-4 → 1e-8 divides it by roughly 2e-3 · 2.
+    assert!(e(8) > e(9) && e(9) > e(10));
+    assert!(points[8].rhs_calls < points[10].rhs_calls);
+    let slope = (e(8) / e(10)).log10() / 4.0;
+    assert!((0.5..0.85).contains(&slope), "TR-BDF2 error slope {slope}");
     let svg = appell::accuracy::svg_chart("wheel-axle", &points);
     assert!(svg.starts_with("<svg") && svg.contains("dopri5") && svg.contains("polyline"));
     assert_eq!(

@@ -12,7 +12,7 @@
 
 use std::time::Instant;
 
-use crate::integrate::{heun_step, midpoint_step, rk4_step, Dopri5, IntegrateError};
+use crate::integrate::{heun_step, midpoint_step, rk4_step, Dopri5, IntegrateError, TrBdf2};
 use crate::model::Model;
 
 /// An integrator and its setting.
@@ -27,6 +27,10 @@ pub enum Method {
     /// Dormand–Prince 5(4) with this relative tolerance (absolute = relative
     /// × 1e-2).
     Dopri5(f64),
+    /// TR-BDF2 (implicit, L-stable, order 2, Jacobian by dual numbers) with
+    /// this relative tolerance (absolute = relative × 1e-2). Its rhs count
+    /// includes the dual-number evaluations of the Jacobians.
+    TrBdf2(f64),
 }
 
 impl Method {
@@ -37,6 +41,7 @@ impl Method {
             Method::Heun(_) => "heun",
             Method::Midpoint(_) => "midpoint",
             Method::Dopri5(_) => "dopri5",
+            Method::TrBdf2(_) => "trbdf2",
         }
     }
 
@@ -44,7 +49,7 @@ impl Method {
     pub fn setting(&self) -> f64 {
         match *self {
             Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => n as f64,
-            Method::Dopri5(tol) => tol,
+            Method::Dopri5(tol) | Method::TrBdf2(tol) => tol,
         }
     }
 }
@@ -63,6 +68,8 @@ pub struct Point {
     pub seconds: f64,
     /// Right-hand-side evaluations of one integration.
     pub rhs_calls: u64,
+    /// Steps of one integration (accepted and rejected).
+    pub steps: u64,
 }
 
 /// An initial-value problem on a derived model: from `x0` at t = 0 to
@@ -112,7 +119,7 @@ impl<M: Model, const S: usize> Problem<'_, M, S> {
         let mut points = Vec::with_capacity(methods.len());
         for (i, &method) in methods.iter().enumerate() {
             progress(i, methods.len());
-            let Ok((states, rhs_calls)) = integrate(self, method) else {
+            let Ok((states, rhs_calls, steps)) = integrate(self, method) else {
                 continue;
             };
             let mut times = Vec::with_capacity(repeats.max(1));
@@ -134,6 +141,7 @@ impl<M: Model, const S: usize> Problem<'_, M, S> {
                 error_max: errors.iter().copied().fold(0.0, f64::max),
                 seconds: times[times.len() / 2],
                 rhs_calls,
+                steps,
             });
         }
         progress(methods.len(), methods.len());
@@ -148,12 +156,12 @@ fn relative_error<const S: usize>(x: &[f64; S], reference: &[f64; S]) -> f64 {
         .fold(0.0, f64::max)
 }
 
-/// One integration with `method`: the states at the checkpoints and the
-/// number of rhs calls.
+/// One integration with `method`: the states at the checkpoints, the number
+/// of rhs calls and the number of steps.
 fn integrate<M: Model, const S: usize>(
     pb: &Problem<'_, M, S>,
     method: Method,
-) -> Result<(Vec<[f64; S]>, u64), IntegrateError> {
+) -> Result<(Vec<[f64; S]>, u64, u64), IntegrateError> {
     let (model, inputs, checkpoints, t_end) =
         (pb.model, pb.inputs, pb.checkpoints.max(1), pb.t_end);
     match method {
@@ -169,7 +177,34 @@ fn integrate<M: Model, const S: usize>(
             Ok((
                 out.into_iter().map(|(_, x)| x).collect(),
                 sol.stats.rhs_calls as u64,
+                (sol.stats.accepted + sol.stats.rejected) as u64,
             ))
+        }
+        Method::TrBdf2(tol) => {
+            // TR-BDF2 has no dense output: integrate checkpoint to
+            // checkpoint, carrying the proposed step size over.
+            let mut solver = TrBdf2::new()
+                .rtol(tol)
+                .atol(tol * 1e-2)
+                .max_steps(10_000_000);
+            let mut x = pb.x0.to_vec();
+            let mut t = 0.0;
+            let (mut calls, mut steps) = (0u64, 0u64);
+            let mut out = Vec::with_capacity(checkpoints);
+            for k in 1..=checkpoints {
+                let t_next = t_end * k as f64 / checkpoints as f64;
+                let sol = solver.solve_model(model, t, &x, t_next, inputs)?;
+                calls += (sol.stats.rhs_calls + sol.stats.jacobian_rhs_calls) as u64;
+                steps += (sol.stats.accepted + sol.stats.rejected) as u64;
+                if sol.h_next.is_finite() && sol.h_next > 0.0 {
+                    solver = solver.h_init(Some(sol.h_next));
+                }
+                let mut state = [0.0; S];
+                state.copy_from_slice(&sol.x);
+                out.push(state);
+                (t, x) = (t_next, sol.x);
+            }
+            Ok((out, calls, steps))
         }
         Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => {
             let prepared = model.prepare::<f64>();
@@ -194,7 +229,7 @@ fn integrate<M: Model, const S: usize>(
                     out.push(x);
                 }
             }
-            Ok((out, (steps * stages) as u64))
+            Ok((out, (steps * stages) as u64, steps as u64))
         }
     }
 }
@@ -213,6 +248,9 @@ pub fn standard_methods(min_steps: usize, levels: usize) -> Vec<Method> {
     }
     for k in 0..levels + 2 {
         v.push(Method::Dopri5(10f64.powi(-3 - k as i32)));
+    }
+    for k in 0..levels {
+        v.push(Method::TrBdf2(10f64.powi(-3 - k as i32)));
     }
     v
 }
@@ -328,26 +366,33 @@ fn escape(s: &str) -> String {
         .replace('>', "&gt;")
 }
 
-/// The points as CSV: `method,setting,error_final,error_max,seconds,rhs_calls`.
+/// The points as CSV: `method,setting,error_final,error_max,seconds,rhs_calls,steps`.
 pub fn csv(points: &[Point]) -> String {
-    let mut s = String::from("method,setting,error_final,error_max,seconds,rhs_calls\n");
+    let mut s = String::from("method,setting,error_final,error_max,seconds,rhs_calls,steps\n");
     for p in points {
         s += &format!(
-            "{},{:e},{:e},{:e},{:e},{}\n",
+            "{},{:e},{:e},{:e},{:e},{},{}\n",
             p.method.name(),
             p.method.setting(),
             p.error_final,
             p.error_max,
             p.seconds,
-            p.rhs_calls
+            p.rhs_calls,
+            p.steps
         );
     }
     s
 }
 
-/// For each method, the least time that reached a relative error at or below
-/// each target (`None` where no setting did).
-pub fn time_to_reach(points: &[Point], targets: &[f64]) -> Vec<(&'static str, Vec<Option<f64>>)> {
+/// The names of the methods among `points`, in order of first appearance.
+///
+/// ```
+/// use appell_runtime::accuracy::{method_names, Method, Point};
+/// let p = |method| Point { method, error_final: 1e-6, error_max: 1e-6, seconds: 1e-5, rhs_calls: 40, steps: 10 };
+/// let points = [p(Method::Rk4(10)), p(Method::Dopri5(1e-6)), p(Method::Rk4(20))];
+/// assert_eq!(method_names(&points), ["rk4", "dopri5"]);
+/// ```
+pub fn method_names(points: &[Point]) -> Vec<&'static str> {
     let mut names: Vec<&'static str> = Vec::new();
     for p in points {
         if !names.contains(&p.method.name()) {
@@ -355,6 +400,12 @@ pub fn time_to_reach(points: &[Point], targets: &[f64]) -> Vec<(&'static str, Ve
         }
     }
     names
+}
+
+/// For each method, the least time that reached a relative error at or below
+/// each target (`None` where no setting did).
+pub fn time_to_reach(points: &[Point], targets: &[f64]) -> Vec<(&'static str, Vec<Option<f64>>)> {
+    method_names(points)
         .into_iter()
         .map(|n| {
             let times = targets
