@@ -209,7 +209,7 @@ fn run<M: Model, const S: usize>(
         dir.join(format!("{file}.svg")),
         accuracy::svg_chart(title, &points),
     )?;
-    writeln!(summary, "## {title}\n\nReference by Dormand–Prince at rtol 1e-14 (estimated error {estimate:.1e}). Time to reach a relative error (largest over 10 checkpoints):\n")?;
+    writeln!(summary, "## {title}\n\nReference by DOP853 at rtol 1e-15 (estimated error {estimate:.1e}). Time to reach a relative error (largest over 10 checkpoints):\n")?;
     writeln!(
         summary,
         "| method | 1e-6 | 1e-9 | 1e-12 |\n| --- | ---: | ---: | ---: |"

@@ -2,17 +2,19 @@
 //! derived model, against a reference solution computed far more
 //! accurately.
 //!
-//! [`sweep`] runs each [`Method`] at each of its settings (a step count for
+//! [`Problem::sweep`] runs each [`Method`] at each of its settings (a step count for
 //! the fixed-step methods, a tolerance for the adaptive one), measures the
 //! error at the final time and the largest error at evenly spaced
-//! checkpoints, and the wall time (median of repeated runs). [`reference`]
-//! computes the reference with Dormand–Prince at a tight tolerance and
-//! checks it against a second run ten times looser (the difference bounds
-//! the reference's own error).
+//! checkpoints, and the wall time (median of repeated runs).
+//! [`Problem::reference`] computes the reference with DOP853 at a tight
+//! tolerance and checks it against a second run ten times looser (the
+//! difference bounds the reference's own error).
 
 use std::time::Instant;
 
-use crate::integrate::{heun_step, midpoint_step, rk4_step, Dopri5, IntegrateError, TrBdf2};
+use crate::integrate::{
+    heun_step, midpoint_step, rk4_step, Dop853, Dopri5, IntegrateError, TrBdf2,
+};
 use crate::model::Model;
 
 /// An integrator and its setting.
@@ -27,6 +29,9 @@ pub enum Method {
     /// Dormand–Prince 5(4) with this relative tolerance (absolute = relative
     /// × 1e-2).
     Dopri5(f64),
+    /// DOP853 (Dormand–Prince 8(5,3)) with this relative tolerance
+    /// (absolute = relative × 1e-2).
+    Dop853(f64),
     /// TR-BDF2 (implicit, L-stable, order 2, Jacobian by dual numbers) with
     /// this relative tolerance (absolute = relative × 1e-2). Its rhs count
     /// includes the dual-number evaluations of the Jacobians.
@@ -41,6 +46,7 @@ impl Method {
             Method::Heun(_) => "heun",
             Method::Midpoint(_) => "midpoint",
             Method::Dopri5(_) => "dopri5",
+            Method::Dop853(_) => "dop853",
             Method::TrBdf2(_) => "trbdf2",
         }
     }
@@ -49,7 +55,7 @@ impl Method {
     pub fn setting(&self) -> f64 {
         match *self {
             Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => n as f64,
-            Method::Dopri5(tol) | Method::TrBdf2(tol) => tol,
+            Method::Dopri5(tol) | Method::Dop853(tol) | Method::TrBdf2(tol) => tol,
         }
     }
 }
@@ -64,7 +70,7 @@ pub struct Point {
     pub error_final: f64,
     /// The same, largest over the checkpoints.
     pub error_max: f64,
-    /// Median wall time of one integration [s].
+    /// Median wall time of one integration, in seconds.
     pub seconds: f64,
     /// Right-hand-side evaluations of one integration.
     pub rhs_calls: u64,
@@ -80,7 +86,7 @@ pub struct Problem<'a, M: Model, const S: usize> {
     pub model: &'a M,
     /// The initial reduced state.
     pub x0: [f64; S],
-    /// The horizon [s].
+    /// The horizon, in seconds.
     pub t_end: f64,
     /// Constant inputs.
     pub inputs: &'a [f64],
@@ -90,13 +96,13 @@ pub struct Problem<'a, M: Model, const S: usize> {
 
 impl<M: Model, const S: usize> Problem<'_, M, S> {
     /// The reference states at the checkpoints `t_end · k / checkpoints`
-    /// (k = 1..=checkpoints), by Dormand–Prince at rtol 1e-14, and an
-    /// estimate of their error (the largest relative difference from a run at
-    /// rtol 1e-13).
+    /// (k = 1..=checkpoints), by DOP853 at rtol 1e-15, and an estimate of
+    /// their error (the largest relative difference from a run at rtol
+    /// 1e-14).
     #[allow(clippy::type_complexity)] // (states at the checkpoints, error estimate)
     pub fn reference(&self) -> Result<(Vec<[f64; S]>, f64), IntegrateError> {
-        let tight = integrate(self, Method::Dopri5(1e-14))?.0;
-        let loose = integrate(self, Method::Dopri5(1e-13))?.0;
+        let tight = integrate(self, Method::Dop853(1e-15))?.0;
+        let loose = integrate(self, Method::Dop853(1e-14))?.0;
         let estimate = tight
             .iter()
             .zip(&loose)
@@ -180,6 +186,21 @@ fn integrate<M: Model, const S: usize>(
                 (sol.stats.accepted + sol.stats.rejected) as u64,
             ))
         }
+        Method::Dop853(tol) => {
+            let mut out: Vec<(f64, [f64; S])> = (1..=checkpoints)
+                .map(|k| (t_end * k as f64 / checkpoints as f64, [0.0; S]))
+                .collect();
+            let sol = Dop853::new()
+                .rtol(tol)
+                .atol(tol * 1e-2)
+                .max_steps(10_000_000)
+                .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?;
+            Ok((
+                out.into_iter().map(|(_, x)| x).collect(),
+                sol.stats.rhs_calls as u64,
+                (sol.stats.accepted + sol.stats.rejected) as u64,
+            ))
+        }
         Method::TrBdf2(tol) => {
             // TR-BDF2 has no dense output: integrate checkpoint to
             // checkpoint, carrying the proposed step size over.
@@ -235,9 +256,10 @@ fn integrate<M: Model, const S: usize>(
 }
 
 /// The methods of a standard sweep: RK4, Heun and midpoint at step counts
-/// doubling from `min_steps` (`levels` of them), Dormand–Prince at
-/// tolerances from 1e-3 down by factors of 10 (`levels + 2` of them, to
-/// 1e-12 for 8 levels).
+/// doubling from `min_steps` (`levels` of them), Dormand–Prince 5(4) and
+/// DOP853 at tolerances from 1e-3 down by factors of 10 (`levels + 2` of
+/// them, to 1e-12 for 8 levels) and TR-BDF2 at the first `levels` of those
+/// tolerances.
 pub fn standard_methods(min_steps: usize, levels: usize) -> Vec<Method> {
     let mut v = Vec::new();
     for k in 0..levels {
@@ -248,6 +270,7 @@ pub fn standard_methods(min_steps: usize, levels: usize) -> Vec<Method> {
     }
     for k in 0..levels + 2 {
         v.push(Method::Dopri5(10f64.powi(-3 - k as i32)));
+        v.push(Method::Dop853(10f64.powi(-3 - k as i32)));
     }
     for k in 0..levels {
         v.push(Method::TrBdf2(10f64.powi(-3 - k as i32)));

@@ -1,5 +1,6 @@
-//! Fixed-step integration of the reduced equations, without `std` and without
-//! allocation.
+//! Integration of the reduced equations: fixed-step and adaptive explicit
+//! methods without `std` and without allocation, and an implicit method for
+//! stiff models (with `std`).
 //!
 //! The classical fourth-order Runge–Kutta method on fixed-size arrays, generic
 //! over the [`Scalar`] so a trajectory can be integrated in `f32`, `f64` or
@@ -13,7 +14,11 @@
 //! [`heun_step_fn`] and [`midpoint_step_fn`] (with the model versions
 //! [`heun_step`] and [`midpoint_step`]) are second-order steps of the same
 //! shape. [`Dopri5`] is an adaptive Dormand–Prince 5(4) integrator with
-//! error control, dense output and event location, also without allocation.
+//! error control, dense output and event location, also without allocation;
+//! [`Dop853`] is its order-8 sibling (dense output of order 7), the choice
+//! for tight tolerances. With `std`, `TrBdf2` is an L-stable implicit
+//! method of order 2 whose Newton iterations use the Jacobian of the
+//! generated rhs by dual numbers, for stiff models.
 //!
 //! Every step checks that the new state is finite (its real part, for dual
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
@@ -22,6 +27,8 @@
 use crate::model::{Model, ModelError};
 use crate::scalar::Scalar;
 
+mod dop853;
+pub use dop853::*;
 mod dopri5;
 pub use dopri5::{Dopri5, EventFn, IntegrateError, Solution, Stats};
 #[cfg(feature = "std")]

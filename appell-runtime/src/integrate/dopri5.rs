@@ -9,7 +9,7 @@ use crate::scalar::Scalar;
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum IntegrateError {
     /// The step size the error control asked for fell below the minimum
-    /// ([`Dopri5::h_min`], and never below 16 ulp of `t`): the problem is
+    /// (`h_min` of the integrator, and never below 16 ulp of `t`): the problem is
     /// too stiff or singular near `t` for the tolerances.
     StepSizeTooSmall {
         /// Time reached.
@@ -17,7 +17,7 @@ pub enum IntegrateError {
         /// The step size that was too small (magnitude).
         h: f64,
     },
-    /// [`Dopri5::max_steps`] steps (accepted and rejected) were taken.
+    /// `max_steps` steps (accepted and rejected) were taken.
     TooManySteps {
         /// Time reached.
         t: f64,
