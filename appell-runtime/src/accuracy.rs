@@ -171,34 +171,26 @@ fn integrate<M: Model, const S: usize>(
     let (model, inputs, checkpoints, t_end) =
         (pb.model, pb.inputs, pb.checkpoints.max(1), pb.t_end);
     match method {
-        Method::Dopri5(tol) => {
+        Method::Dopri5(tol) | Method::Dop853(tol) => {
             let mut out: Vec<(f64, [f64; S])> = (1..=checkpoints)
                 .map(|k| (t_end * k as f64 / checkpoints as f64, [0.0; S]))
                 .collect();
-            let sol = Dopri5::new()
-                .rtol(tol)
-                .atol(tol * 1e-2)
-                .max_steps(10_000_000)
-                .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?;
+            let (rtol, atol, max_steps) = (tol, tol * 1e-2, 10_000_000);
+            let stats = if let Method::Dopri5(_) = method {
+                let solver = Dopri5::new().rtol(rtol).atol(atol).max_steps(max_steps);
+                solver
+                    .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?
+                    .stats
+            } else {
+                let solver = Dop853::new().rtol(rtol).atol(atol).max_steps(max_steps);
+                solver
+                    .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?
+                    .stats
+            };
             Ok((
                 out.into_iter().map(|(_, x)| x).collect(),
-                sol.stats.rhs_calls as u64,
-                (sol.stats.accepted + sol.stats.rejected) as u64,
-            ))
-        }
-        Method::Dop853(tol) => {
-            let mut out: Vec<(f64, [f64; S])> = (1..=checkpoints)
-                .map(|k| (t_end * k as f64 / checkpoints as f64, [0.0; S]))
-                .collect();
-            let sol = Dop853::new()
-                .rtol(tol)
-                .atol(tol * 1e-2)
-                .max_steps(10_000_000)
-                .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?;
-            Ok((
-                out.into_iter().map(|(_, x)| x).collect(),
-                sol.stats.rhs_calls as u64,
-                (sol.stats.accepted + sol.stats.rejected) as u64,
+                stats.rhs_calls as u64,
+                (stats.accepted + stats.rejected) as u64,
             ))
         }
         Method::TrBdf2(tol) => {

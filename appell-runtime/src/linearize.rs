@@ -645,6 +645,112 @@ pub fn holonomic_unknowns<M: Model>(
         .collect())
 }
 
+/// Projects a reduced state (retained coordinates, then privileged speeds,
+/// as [`Model::rhs`] takes it) back onto the holonomic constraint manifold:
+/// the dependent retained coordinates the constraints involve are corrected
+/// by [`solve_holonomic`] with the others held; the speeds are left alone
+/// (the reduced equations satisfy the velocity constraints by construction).
+/// Integrators drift off the manifold at the size of their local error; a
+/// projection between output times (or after every step) keeps a bicycle's
+/// pitch consistent with its lean and steer over long runs.
+///
+/// Coordinates the reduced state does not carry are taken as 0, as in the
+/// command line's `eval`. Returns the Euclidean norm of the residuals before
+/// the projection and the number of Newton steps taken.
+///
+/// Errors: a state of the wrong length or with non-finite values
+/// ([`LinearizeError::Model`]); [`LinearizeError::InvalidArgument`] when a
+/// constraint involves a coordinate outside the reduced state (it cannot be
+/// projected there); and the errors of [`solve_holonomic`] (`state` is then
+/// unchanged).
+///
+/// ```
+/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Ring { l: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Ring", parameters: &["l"], coordinates: &["x", "y"],
+/// #     speeds: &["x"], dependent: &["y"], cyclic: &[], ignorable: &[],
+/// #     retained: &["x", "y"], inputs: &[], effects: &[], holonomic: 1,
+/// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
+/// #     force_points: 0, torques: 0, symbolic_elimination: true,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Ring {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
+/// #         check_len("out", out, 1)?; out[0] = self.l; Ok(())
+/// #     }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, q: &[T], qd: &[T], h: &mut [T], v: &mut [T]) -> Result<(), ModelError> {
+/// #         check_len("q", q, 2)?; check_len("qdot", qd, 2)?;
+/// #         let l = T::from_f64(self.l);
+/// #         h[0] = (q[0] * q[0] + q[1] * q[1] - l * l) / T::from_f64(2.0);
+/// #         v[0] = q[0] * qd[0] + q[1] * qd[1];
+/// #         Ok(())
+/// #     }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// use appell_runtime::linearize::project_holonomic;
+///
+/// // A particle on a circle of radius 1 in Cartesian coordinates, state
+/// // (x, y, ẋ), drifted off the circle.
+/// let mut state = [0.6, -0.81, 0.3];
+/// let (residual, steps) = project_holonomic(&Ring { l: 1.0 }, 0.0, &mut state, 1e-14, 20).unwrap();
+/// assert!(residual > 1e-3 && steps > 0);
+/// assert!((state[0] * state[0] + state[1] * state[1] - 1.0).abs() < 1e-13);
+/// assert_eq!((state[0], state[2]), (0.6, 0.3)); // x and the speed are held
+/// ```
+pub fn project_holonomic<M: Model>(
+    model: &M,
+    t: f64,
+    state: &mut [f64],
+    tol: f64,
+    max_iter: usize,
+) -> Result<(f64, usize), LinearizeError> {
+    let info = M::info();
+    check_len("state", state, info.state_len())?;
+    finite(state, "state")?;
+    if info.holonomic == 0 {
+        return Ok((0.0, 0));
+    }
+    let retained = indices(info, info.retained, "retained")?;
+    let mut q = vec![0.0; info.coordinates.len()];
+    for (k, &i) in retained.iter().enumerate() {
+        q[i] = state[k];
+    }
+    let all: Vec<usize> = (0..q.len()).collect();
+    let (r, jac) = holonomic_jacobian(model, t, &q, &all)?;
+    if let Some(c) =
+        (0..q.len()).find(|&c| !retained.contains(&c) && jac.column(c).iter().any(|&x| x != 0.0))
+    {
+        return Err(LinearizeError::InvalidArgument(format!(
+            "the holonomic constraints involve `{}`, which the reduced state does not carry",
+            info.coordinates[c]
+        )));
+    }
+    let unknowns: Vec<usize> = holonomic_unknowns(model, t, &q)?
+        .into_iter()
+        .filter(|i| retained.contains(i))
+        .collect();
+    let steps = solve_holonomic(model, t, &mut q, &unknowns, tol, max_iter)?;
+    for (k, &i) in retained.iter().enumerate() {
+        state[k] = q[i];
+    }
+    Ok((r.norm(), steps))
+}
+
 /// The linearization in a minimal state at a full configuration `q_full`
 /// (every coordinate, ignorable ones included), privileged speeds `u` (one
 /// per [`ModelInfo::speeds`]) and `inputs`.
