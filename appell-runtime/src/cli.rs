@@ -7,6 +7,7 @@
 //! <program> info         the model's metadata as JSON
 //! <program> equations    the derived reduced equations, as text
 //! <program> bench        time the generated rhs against the oracle, as JSON
+//! <program> accuracy     a work-precision sweep of every integrator, as JSON
 //! <program> help         usage (also -h, --help)
 //! ```
 //!
@@ -74,7 +75,25 @@
 //! states and prints `{"rhs_ns": .., "oracle_ns": .., "ops": .., "states": ..}`
 //! (nanoseconds per call, [`OpCounts::total`](crate::OpCounts::total) of the
 //! rhs, number of states used). See [`bench()`].
+//!
+//! # `accuracy`
+//!
+//! Reads one JSON object from stdin: an `eval` state (`t` must be 0 or
+//! omitted) plus `t_end` (the horizon, required), `checkpoints` (default
+//! 10), `levels` (default 4) and `repeats` (default 3), for example
+//!
+//! ```text
+//! {"q": {"phi": 0.3}, "u": {"phi": 0.2, "psi1": 1.0}, "inputs": {"tau": 0.4}, "t_end": 10}
+//! ```
+//!
+//! and prints what accuracy costs on that problem: every integrator of
+//! [`crate::accuracy::standard_methods`] against a DOP853 reference, as
+//! `{"t_end", "checkpoints", "reference_error", "points": [{"method",
+//! "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}]}`.
+//! A problem it cannot run is answered with `{"error": ".."}` and exit
+//! status 1. States up to [`ACCURACY_MAX_STATE`] entries. See [`accuracy()`].
 
+use crate::accuracy::{standard_methods, Problem};
 use crate::model::{Model, ModelError, ModelInfo};
 use serde_json::{json, Map, Value};
 use std::error::Error;
@@ -94,6 +113,8 @@ pub enum CliError {
     Model(ModelError),
     /// `bench` found no state where both the rhs and the oracle succeed.
     Bench(String),
+    /// `accuracy` could not read its problem or compute the reference.
+    Accuracy(String),
     /// The example's default action failed.
     Action(Box<dyn Error>),
 }
@@ -105,6 +126,7 @@ impl core::fmt::Display for CliError {
             CliError::Io(e) => write!(f, "i/o error: {e}"),
             CliError::Model(e) => write!(f, "{e}"),
             CliError::Bench(why) => write!(f, "bench: {why}"),
+            CliError::Accuracy(why) => write!(f, "accuracy: {why}"),
             CliError::Action(e) => write!(f, "{e}"),
         }
     }
@@ -116,7 +138,7 @@ impl Error for CliError {
             CliError::Io(e) => Some(e),
             CliError::Model(e) => Some(e),
             CliError::Action(e) => Some(e.as_ref()),
-            CliError::Usage(_) | CliError::Bench(_) => None,
+            CliError::Usage(_) | CliError::Bench(_) | CliError::Accuracy(_) => None,
         }
     }
 }
@@ -144,12 +166,12 @@ impl From<ModelError> for CliError {
 /// #     symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
 /// # };
 /// let text = appell_runtime::cli::usage("pendulum", &info);
-/// assert!(text.starts_with("usage: pendulum [eval|info|equations|bench|help]"));
+/// assert!(text.starts_with("usage: pendulum [eval|info|equations|bench|accuracy|help]"));
 /// assert!(text.contains("Pendulum"));
 /// ```
 pub fn usage(program: &str, info: &ModelInfo) -> String {
     format!(
-        "usage: {program} [eval|info|equations|bench|help]\n\
+        "usage: {program} [eval|info|equations|bench|accuracy|help]\n\
          \n\
          Model `{name}`.\n\
          \n\
@@ -162,6 +184,9 @@ pub fn usage(program: &str, info: &ModelInfo) -> String {
          \x20 info        print the model's metadata as JSON\n\
          \x20 equations   print the derived equations\n\
          \x20 bench       time the generated rhs against the oracle, print JSON\n\
+         \x20 accuracy    read one JSON problem from stdin (an `eval` state plus\n\
+         \x20             \"t_end\", optional \"checkpoints\", \"levels\", \"repeats\") and\n\
+         \x20             print the work-precision sweep of every integrator as JSON\n\
          \x20 help        print this text (also -h, --help)\n",
         name = info.name
     )
@@ -319,6 +344,21 @@ pub fn run_with<M: Model>(
                 Err(e)
             }
         },
+        "accuracy" => {
+            let mut text = String::new();
+            stdin.read_to_string(&mut text)?;
+            match accuracy(model, &text) {
+                Ok(report) => {
+                    writeln!(stdout, "{report}")?;
+                    Ok(stdout.flush()?)
+                }
+                Err(why) => {
+                    writeln!(stdout, "{}", json!({ "error": why }))?;
+                    stdout.flush()?;
+                    Err(CliError::Accuracy(why))
+                }
+            }
+        }
         "help" | "-h" | "--help" => {
             write!(stdout, "{}", usage(program, info))?;
             Ok(stdout.flush()?)
@@ -523,23 +563,65 @@ impl<M: Model> Evaluator<M> {
         }
     }
 
-    fn try_eval(&mut self, line: &str) -> Result<Value, String> {
-        // A scene has the model's coordinates, speeds and parameters but its
-        // own reduced state.
-        let info = match self.scene {
+    /// The info of the model or of the selected scene (a scene has the
+    /// model's coordinates, speeds and parameters but its own reduced state).
+    fn info(&self) -> &'static ModelInfo {
+        match self.scene {
             Some(i) => M::scene_infos()[i],
             None => M::info(),
-        };
+        }
+    }
+
+    fn try_eval(&mut self, line: &str) -> Result<Value, String> {
+        let info = self.info();
         let value: Value =
             serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
         let Value::Object(obj) = value else {
             return Err("expected a JSON object".to_string());
         };
+        let point = self.parse_point(&obj, &[])?;
+        let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);
+        let mut dstate = vec![0.0; info.state_len()];
+        match self.scene {
+            Some(i) => self.model.scene_rhs(i, t, &state, &inputs, &mut dstate),
+            None => {
+                let prepared = self.model.prepare::<f64>();
+                self.model.rhs(&prepared, t, &state, &inputs, &mut dstate)
+            }
+        }
+        .map_err(|e| e.to_string())?;
+        let mut qdot = vec![0.0; info.coordinates.len()];
+        self.model
+            .coordinate_rates(t, &q, &u, &mut qdot)
+            .map_err(|e| e.to_string())?;
+
+        let mut qdot_out = Map::new();
+        for (name, v) in info.coordinates.iter().zip(&qdot) {
+            qdot_out.insert(name.to_string(), result_number(*v, name)?);
+        }
+        let mut udot_out = Map::new();
+        let udot = dstate.get(info.retained.len()..).unwrap_or(&[]);
+        for (name, v) in info.speeds.iter().zip(udot) {
+            udot_out.insert(name.to_string(), result_number(*v, name)?);
+        }
+        Ok(json!({ "qdot": qdot_out, "udot": udot_out }))
+    }
+
+    /// Reads `t`, `params`, `q`, `u` and `inputs` of a JSON object (fields
+    /// in `extra` are allowed and left to the caller), sets the parameters
+    /// and assembles the reduced state.
+    fn parse_point(&mut self, obj: &Map<String, Value>, extra: &[&str]) -> Result<Point, String> {
+        let info = self.info();
         for key in obj.keys() {
-            if !["t", "params", "q", "u", "inputs"].contains(&key.as_str()) {
-                return Err(format!(
-                    "unknown field `{key}` (expected t, params, q, u, inputs)"
-                ));
+            if !["t", "params", "q", "u", "inputs"].contains(&key.as_str())
+                && !extra.contains(&key.as_str())
+            {
+                let mut expected = String::from("t, params, q, u, inputs");
+                for e in extra {
+                    expected += ", ";
+                    expected += e;
+                }
+                return Err(format!("unknown field `{key}` (expected {expected})"));
             }
         }
         let t = match obj.get("t") {
@@ -583,31 +665,23 @@ impl<M: Model> Evaluator<M> {
             state.push(q[i]);
         }
         state.extend_from_slice(&u);
-        let mut dstate = vec![0.0; info.state_len()];
-        match self.scene {
-            Some(i) => self.model.scene_rhs(i, t, &state, &inputs, &mut dstate),
-            None => {
-                let prepared = self.model.prepare::<f64>();
-                self.model.rhs(&prepared, t, &state, &inputs, &mut dstate)
-            }
-        }
-        .map_err(|e| e.to_string())?;
-        let mut qdot = vec![0.0; info.coordinates.len()];
-        self.model
-            .coordinate_rates(t, &q, &u, &mut qdot)
-            .map_err(|e| e.to_string())?;
-
-        let mut qdot_out = Map::new();
-        for (name, v) in info.coordinates.iter().zip(&qdot) {
-            qdot_out.insert(name.to_string(), result_number(*v, name)?);
-        }
-        let mut udot_out = Map::new();
-        let udot = dstate.get(info.retained.len()..).unwrap_or(&[]);
-        for (name, v) in info.speeds.iter().zip(udot) {
-            udot_out.insert(name.to_string(), result_number(*v, name)?);
-        }
-        Ok(json!({ "qdot": qdot_out, "udot": udot_out }))
+        Ok(Point {
+            t,
+            q,
+            u,
+            inputs,
+            state,
+        })
     }
+}
+
+/// A parsed `eval` object.
+struct Point {
+    t: f64,
+    q: Vec<f64>,
+    u: Vec<f64>,
+    inputs: Vec<f64>,
+    state: Vec<f64>,
 }
 
 /// A finite JSON number from a value.
@@ -818,4 +892,112 @@ pub fn bench<M: Model>(model: &M) -> Result<BenchReport, CliError> {
         ops: info.rhs_ops.total,
         states: states.len(),
     })
+}
+
+/// The largest reduced state `accuracy` handles (the integrators work on
+/// fixed-size arrays; the sweep is compiled for every size up to this).
+pub const ACCURACY_MAX_STATE: usize = 16;
+
+/// The `accuracy` subcommand: parses one problem (an `eval` object plus
+/// `t_end`, and optionally `checkpoints` (default 10), `levels` (default 4)
+/// and `repeats` (default 3)), computes the reference and runs
+/// [`standard_methods`]`(100, levels)` over it ([`Problem::sweep`]). Returns
+/// the report as one JSON object, or why it could not.
+///
+/// The report: `{"t_end", "checkpoints", "reference_error", "points": [{"method",
+/// "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}, ..]}`
+/// with the fields of [`crate::accuracy::Point`]; methods that fail (a
+/// step-size underflow, say) are left out.
+pub fn accuracy<M: Model>(model: M, text: &str) -> Result<Value, String> {
+    let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
+    let Value::Object(obj) = value else {
+        return Err("expected a JSON object".to_string());
+    };
+    let mut evaluator = Evaluator::new(model).map_err(|e| e.to_string())?;
+    let extra = ["t_end", "checkpoints", "levels", "repeats"];
+    let point = evaluator.parse_point(&obj, &extra)?;
+    if point.t != 0.0 {
+        return Err("`t` must be 0 (or omitted): a sweep starts at t = 0".to_string());
+    }
+    let t_end = match obj.get("t_end") {
+        Some(v) => number(v, "`t_end`")?,
+        None => return Err("missing field `t_end` (the horizon)".to_string()),
+    };
+    if t_end <= 0.0 {
+        return Err(format!("`t_end` must be positive, not {t_end}"));
+    }
+    let count = |key: &str, default: usize, max: usize| -> Result<usize, String> {
+        match obj.get(key) {
+            None => Ok(default),
+            Some(v) => match v.as_u64() {
+                Some(n) if (1..=max as u64).contains(&n) => Ok(n as usize),
+                _ => Err(format!(
+                    "`{key}` must be an integer from 1 to {max}, found {v}"
+                )),
+            },
+        }
+    };
+    let checkpoints = count("checkpoints", 10, 1000)?;
+    let levels = count("levels", 4, 10)?;
+    let repeats = count("repeats", 3, 100)?;
+    let model = evaluator.model();
+    macro_rules! sizes {
+        ($($n:literal)*) => {
+            match point.state.len() {
+                $($n => sweep_report::<M, $n>(model, &point, t_end, checkpoints, levels, repeats),)*
+                n => Err(format!(
+                    "the reduced state has {n} entries; `accuracy` handles up to {ACCURACY_MAX_STATE}"
+                )),
+            }
+        };
+    }
+    sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+fn sweep_report<M: Model, const S: usize>(
+    model: &M,
+    point: &Point,
+    t_end: f64,
+    checkpoints: usize,
+    levels: usize,
+    repeats: usize,
+) -> Result<Value, String> {
+    let mut x0 = [0.0; S];
+    x0.copy_from_slice(&point.state);
+    let problem = Problem {
+        model,
+        x0,
+        t_end,
+        inputs: &point.inputs,
+        checkpoints,
+    };
+    let (reference, estimate) = problem
+        .reference()
+        .map_err(|e| format!("the reference integration failed: {e}"))?;
+    let points = problem.sweep(
+        &reference,
+        &standard_methods(100, levels),
+        repeats,
+        |_, _| {},
+    );
+    let points: Vec<Value> = points
+        .iter()
+        .map(|p| {
+            json!({
+                "method": p.method.name(),
+                "setting": p.method.setting(),
+                "error_final": finite_or_null(p.error_final),
+                "error_max": finite_or_null(p.error_max),
+                "seconds": p.seconds,
+                "rhs_calls": p.rhs_calls,
+                "steps": p.steps,
+            })
+        })
+        .collect();
+    Ok(json!({
+        "t_end": t_end,
+        "checkpoints": checkpoints,
+        "reference_error": finite_or_null(estimate),
+        "points": points,
+    }))
 }

@@ -346,3 +346,82 @@ fn bench_with_no_valid_state_fails() {
     assert!(error_of(&v).contains("`m`"), "{v}");
     assert!(bench(&broken).is_err());
 }
+
+#[test]
+fn accuracy_sweeps_every_integrator() {
+    let (r, out) = run(
+        PENDULUM,
+        &["accuracy"],
+        br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}, "t_end": 2, "checkpoints": 4, "levels": 2, "repeats": 1}"#,
+    );
+    r.unwrap();
+    assert_eq!(out.lines().count(), 1);
+    let v: Value = serde_json::from_str(out.trim()).unwrap();
+    assert!(
+        v["reference_error"].as_f64().is_some_and(|e| e < 1e-11),
+        "{v}"
+    );
+    assert_eq!(v["checkpoints"], 4);
+    let points = v["points"].as_array().unwrap();
+    // levels = 2: RK4, Heun, midpoint at 2 step counts; both Dormand–Prince
+    // pairs at 4 tolerances; TR-BDF2 at 2.
+    assert_eq!(points.len(), 3 * 2 + 2 * 4 + 2, "{v}");
+    let error = |method: &str, setting: f64| {
+        points
+            .iter()
+            .find(|p| p["method"] == method && p["setting"].as_f64() == Some(setting))
+            .and_then(|p| p["error_max"].as_f64())
+            .unwrap_or_else(|| panic!("no {method} at {setting} in {v}"))
+    };
+    // Halving the RK4 step divides the error by about 16.
+    let ratio = error("rk4", 100.0) / error("rk4", 200.0);
+    assert!((10.0..24.0).contains(&ratio), "RK4 ratio {ratio}");
+    assert!(error("dop853", 1e-6) < error("dop853", 1e-3));
+    for p in points {
+        assert!(p["seconds"].as_f64().is_some_and(|s| s > 0.0), "{p}");
+        assert!(p["rhs_calls"].as_u64().is_some_and(|n| n > 0), "{p}");
+        assert!(p["steps"].as_u64().is_some_and(|n| n > 0), "{p}");
+    }
+}
+
+#[test]
+fn accuracy_rejects_bad_problems_with_json_errors() {
+    for (input, needle) in [
+        (
+            &br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}}"#[..],
+            "t_end",
+        ),
+        (
+            br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}, "t_end": -1}"#,
+            "positive",
+        ),
+        (
+            br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}, "t_end": 1, "t": 2}"#,
+            "`t`",
+        ),
+        (
+            br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}, "t_end": 1, "levels": 0}"#,
+            "levels",
+        ),
+        (br#"{"q": {"theta": 0.3}, "t_end": 1}"#, "theta"),
+        (
+            br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}, "t_end": 1, "speed": 3}"#,
+            "unknown field",
+        ),
+        (b"not json", "malformed"),
+    ] {
+        let (r, out) = run(PENDULUM, &["accuracy"], input);
+        assert!(matches!(r, Err(CliError::Accuracy(_))), "{r:?}");
+        let v: Value = serde_json::from_str(out.trim()).unwrap();
+        assert!(error_of(&v).contains(needle), "{needle}: {v}");
+    }
+    // A model that fails everywhere: the reference cannot be computed.
+    let broken = Pendulum { l: 0.0, ..PENDULUM };
+    let (r, out) = run(
+        broken,
+        &["accuracy"],
+        br#"{"q": {"theta": 0.3}, "u": {"theta": 0.0}, "t_end": 1}"#,
+    );
+    assert!(matches!(r, Err(CliError::Accuracy(_))), "{r:?}");
+    assert!(out.contains("error"), "{out}");
+}
