@@ -30,6 +30,7 @@ use crate::scalar::Scalar;
 mod dop853;
 pub use dop853::*;
 mod dopri5;
+mod explicit;
 pub use dopri5::{Dopri5, EventFn, IntegrateError, Solution, Stats};
 #[cfg(feature = "std")]
 mod implicit;

@@ -394,42 +394,40 @@ fn event_on_a_kepler_orbit_and_outputs_stop_there() {
     assert_eq!(sol.t, 1.0);
 }
 
+/// x' = −x in any scalar.
+fn decay<T: Copy + std::ops::Neg<Output = T>>(
+    _t: T,
+    x: &[T; 1],
+    dx: &mut [T; 1],
+) -> Result<(), ModelError> {
+    dx[0] = -x[0];
+    Ok(())
+}
+
 #[test]
 fn backward_integration_and_other_scalars() {
-    let f = |_t: f64, x: &[f64; 1], dx: &mut [f64; 1]| -> Result<(), ModelError> {
-        dx[0] = -x[0];
-        Ok(())
-    };
     let e1 = (-1.0f64).exp();
     let mut out = [(0.5, [0.0]), (0.0, [0.0])];
     let sol = Dop853::new()
         .rtol(1e-10)
         .atol(1e-12)
-        .solve_at(f, 1.0, &[e1], &mut out)
+        .solve_at(decay, 1.0, &[e1], &mut out)
         .unwrap();
     assert_eq!(sol.t, 0.0);
     assert!((sol.x[0] - 1.0).abs() < 1e-9);
     assert!((out[0].1[0] - (-0.5f64).exp()).abs() < 1e-9);
     // f32 state.
-    let f = |_t: f32, x: &[f32; 1], dx: &mut [f32; 1]| -> Result<(), ModelError> {
-        dx[0] = -x[0];
-        Ok(())
-    };
     let sol = Dop853::new()
         .rtol(1e-5)
         .atol(1e-6)
-        .solve(f, 0.0, &[1.0f32], 2.0)
+        .solve(decay, 0.0, &[1.0f32], 2.0)
         .unwrap();
     assert!((sol.x[0] as f64 - (-2.0f64).exp()).abs() < 1e-4);
     // Dual numbers: d x(t) / d x0 for x' = −x is exp(−t).
-    let f = |_t: Dual64, x: &[Dual64; 1], dx: &mut [Dual64; 1]| -> Result<(), ModelError> {
-        dx[0] = -x[0];
-        Ok(())
-    };
     let sol = Dop853::new()
         .rtol(1e-10)
         .atol(1e-12)
-        .solve(f, 0.0, &[Dual64::new(2.0, 1.0)], 2.0)
+        .solve(decay, 0.0, &[Dual64::new(2.0, 1.0)], 2.0)
         .unwrap();
     assert!((sol.x[0].re - 2.0 * (-2.0f64).exp()).abs() < 1e-9);
     assert!((sol.x[0].eps - (-2.0f64).exp()).abs() < 1e-9);

@@ -6,6 +6,9 @@
 
 use super::check_state_len;
 use super::dopri5::{EventFn, IntegrateError, Solution, Stats};
+use super::explicit::{
+    self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
+};
 use crate::model::{Model, ModelError};
 use crate::scalar::Scalar;
 
@@ -86,17 +89,15 @@ use crate::scalar::Scalar;
 ///     assert!((x[0] - t.cos()).abs() < 1e-9);
 /// }
 /// ```
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, PartialEq)]
 pub struct Dop853 {
-    rtol: f64,
-    atol: f64,
-    max_steps: usize,
-    h_init: Option<f64>,
-    h_min: f64,
-    h_max: Option<f64>,
-    beta: f64,
-    event_tol: f64,
-    adaptive: bool,
+    set: Settings,
+}
+
+impl core::fmt::Debug for Dop853 {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        self.set.debug("Dop853", true, f)
+    }
 }
 
 impl Default for Dop853 {
@@ -279,52 +280,54 @@ const D: [[f64; 12]; 4] = [
     ],
 ];
 
-const SAFETY: f64 = 0.9;
 /// Smallest factor `h_new / h`.
 const FAC_MIN: f64 = 1.0 / 3.0;
 /// Largest factor `h_new / h`.
 const FAC_MAX: f64 = 6.0;
-/// Factor of the retry after a non-finite stage.
-const FAC_NON_FINITE: f64 = 0.2;
-const EVENT_MAX_ITER: usize = 200;
 
-/// Where requested outputs go.
-trait Sink<T, const S: usize> {
-    fn len(&self) -> usize;
-    fn time(&self, i: usize) -> f64;
-    fn put(&mut self, i: usize, x: &[T; S]);
-}
-
-struct SliceSink<'a, T, const S: usize>(&'a mut [(f64, [T; S])]);
-
-impl<T: Copy, const S: usize> Sink<T, S> for SliceSink<'_, T, S> {
-    fn len(&self) -> usize {
-        self.0.len()
-    }
-    fn time(&self, i: usize) -> f64 {
-        self.0[i].0
-    }
-    fn put(&mut self, i: usize, x: &[T; S]) {
-        self.0[i].1 = *x;
-    }
-}
-
-struct CallbackSink<'a, 'b, T, const S: usize> {
-    times: &'a [f64],
-    cb: &'b mut dyn FnMut(f64, &[T; S]),
-}
-
-impl<T, const S: usize> Sink<T, S> for CallbackSink<'_, '_, T, S> {
-    fn len(&self) -> usize {
-        self.times.len()
-    }
-    fn time(&self, i: usize) -> f64 {
-        self.times[i]
-    }
-    fn put(&mut self, i: usize, x: &[T; S]) {
-        (self.cb)(self.times[i], x)
-    }
-}
+/// The extra stages 14 to 16 of the dense output: the node, and the weights
+/// with the (0-based) stages they multiply.
+const EXTRA: [(f64, [(f64, usize); 8]); 3] = [
+    (
+        C14,
+        [
+            (A141, 0),
+            (A147, 6),
+            (A148, 7),
+            (A149, 8),
+            (A1410, 9),
+            (A1411, 10),
+            (A1412, 11),
+            (A1413, 12),
+        ],
+    ),
+    (
+        C15,
+        [
+            (A151, 0),
+            (A156, 5),
+            (A157, 6),
+            (A158, 7),
+            (A1511, 10),
+            (A1512, 11),
+            (A1513, 12),
+            (A1514, 13),
+        ],
+    ),
+    (
+        C16,
+        [
+            (A161, 0),
+            (A166, 5),
+            (A167, 6),
+            (A168, 7),
+            (A169, 8),
+            (A1613, 12),
+            (A1614, 13),
+            (A1615, 14),
+        ],
+    ),
+];
 
 /// The continuous extension (order 7) of one accepted step.
 struct Dense<T, const S: usize> {
@@ -333,7 +336,7 @@ struct Dense<T, const S: usize> {
     r: [[T; S]; 8],
 }
 
-impl<T: Scalar, const S: usize> Dense<T, S> {
+impl<T: Scalar, const S: usize> DenseOutput<T, S> for Dense<T, S> {
     fn at(&self, t: f64) -> [T; S] {
         let s = (t - self.t) / self.h;
         let (s, s1) = (T::from_f64(s), T::from_f64(1.0 - s));
@@ -345,10 +348,6 @@ impl<T: Scalar, const S: usize> Dense<T, S> {
         }
         out
     }
-}
-
-fn all_finite<T: Scalar, const S: usize>(x: &[T; S]) -> bool {
-    x.iter().all(|v| v.re().is_finite())
 }
 
 /// `x + h Σ w_j k_j`.
@@ -373,569 +372,82 @@ struct Stages<T, const S: usize> {
     k: [[T; S]; 16],
 }
 
-impl Dop853 {
-    /// The integrator with the documented defaults ([`Dop853`]).
-    pub const fn new() -> Self {
-        Dop853 {
-            rtol: 1e-6,
-            atol: 1e-9,
-            max_steps: 100_000,
-            h_init: None,
-            h_min: 0.0,
-            h_max: None,
-            beta: 0.0,
-            event_tol: 1e-12,
-            adaptive: true,
-        }
+impl<T: Scalar, const S: usize> EmbeddedPair<T, S> for Stages<T, S> {
+    const EXPO: f64 = 1.0 / 8.0;
+    const BETA_WEIGHT: f64 = 0.2;
+    const FAC_MIN: f64 = FAC_MIN;
+    const FAC_MAX: f64 = FAC_MAX;
+    const BETA_CLOSED: bool = true;
+    type Dense = Dense<T, S>;
+
+    fn new(k1: [T; S]) -> Self {
+        let mut k = [[T::zero(); S]; 16];
+        k[0] = k1;
+        Stages { k }
     }
 
-    /// Relative tolerance (default `1e-6`; must be ≥ 0).
-    pub const fn rtol(mut self, rtol: f64) -> Self {
-        self.rtol = rtol;
-        self
+    fn k1(&self) -> &[T; S] {
+        &self.k[0]
     }
 
-    /// Absolute tolerance (default `1e-9`; must be ≥ 0, and `rtol` and
-    /// `atol` not both 0).
-    pub const fn atol(mut self, atol: f64) -> Self {
-        self.atol = atol;
-        self
-    }
-
-    /// Maximum number of steps, accepted and rejected (default `100_000`).
-    pub const fn max_steps(mut self, max_steps: usize) -> Self {
-        self.max_steps = max_steps;
-        self
-    }
-
-    /// The first step size (magnitude), or `None` (default) for Hairer's
-    /// automatic choice. With [`Dop853::adaptive`]`(false)` it is the size
-    /// of every step and must be given.
-    pub const fn h_init(mut self, h_init: Option<f64>) -> Self {
-        self.h_init = h_init;
-        self
-    }
-
-    /// Minimum step size (default `0`: only the floor of 16 ulp of `t`); a
-    /// smaller proposed step is [`IntegrateError::StepSizeTooSmall`]. The
-    /// last step, cut to end exactly at `t_end`, may be smaller.
-    pub const fn h_min(mut self, h_min: f64) -> Self {
-        self.h_min = h_min;
-        self
-    }
-
-    /// Maximum step size, or `None` (default) for the interval length.
-    pub const fn h_max(mut self, h_max: Option<f64>) -> Self {
-        self.h_max = h_max;
-        self
-    }
-
-    /// The controller's β (default `0`, the elementary controller of
-    /// `DOP853`; must be in `[0, 0.2]`).
-    pub const fn beta(mut self, beta: f64) -> Self {
-        self.beta = beta;
-        self
-    }
-
-    /// Absolute time tolerance of event location (default `1e-12`, never
-    /// below 4 ulp of the event time).
-    pub const fn event_tol(mut self, event_tol: f64) -> Self {
-        self.event_tol = event_tol;
-        self
-    }
-
-    /// Error control on (default `true`). With `false`, every step has the
-    /// size [`Dop853::h_init`] (required; the last step is cut to end at
-    /// `t_end`, and [`Dop853::h_max`] is ignored) and is accepted without an
-    /// error estimate; a non-finite state is reported at once.
-    pub const fn adaptive(mut self, adaptive: bool) -> Self {
-        self.adaptive = adaptive;
-        self
-    }
-
-    /// Integrates `dx/dt = f(t, x)` from `(t0, x0)` to `t_end` (which may
-    /// be before `t0`). `f(t, x, dx)` writes the derivative into `dx`.
-    ///
-    /// See [`Dop853`] for an example.
-    pub fn solve<T, F, const S: usize>(
-        &self,
-        f: F,
-        t0: f64,
-        x0: &[T; S],
-        t_end: f64,
-    ) -> Result<Solution<T, S>, IntegrateError>
-    where
-        T: Scalar,
-        F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
-    {
-        let mut sink = CallbackSink {
-            times: &[],
-            cb: &mut |_, _| {},
-        };
-        self.run(f, t0, x0, t_end, &mut sink, None)
-    }
-
-    /// As [`Dop853::solve`], stopping at the first sign change of the event
-    /// function `g(t, x)` (see [`Dop853`]); [`Solution::event`] tells
-    /// whether it happened. A zero of `g` at `t0` is not an event.
-    ///
-    /// The reported time is the end of the final bracket on the far side of
-    /// the crossing (where `g` has its new sign or is zero), within
-    /// [`Dop853::event_tol`] of the root of `g` on the dense output; the
-    /// state there comes from the dense output.
-    pub fn solve_until<T, F, G, const S: usize>(
-        &self,
-        f: F,
-        mut g: G,
-        t0: f64,
-        x0: &[T; S],
-        t_end: f64,
-    ) -> Result<Solution<T, S>, IntegrateError>
-    where
-        T: Scalar,
-        F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
-        G: FnMut(f64, &[T; S]) -> f64,
-    {
-        let mut sink = CallbackSink {
-            times: &[],
-            cb: &mut |_, _| {},
-        };
-        self.run(f, t0, x0, t_end, &mut sink, Some(&mut g))
-    }
-
-    /// Integrates from `(t0, x0)` to the last time of `out` and writes the
-    /// state at each `out[i].0` (set by the caller, ordered in the
-    /// direction of integration) into `out[i].1`, from the dense output.
-    ///
-    /// ```
-    /// use appell_runtime::integrate::Dop853;
-    /// use appell_runtime::ModelError;
-    ///
-    /// let f = |_t: f64, x: &[f64; 1], dx: &mut [f64; 1]| -> Result<(), ModelError> {
-    ///     dx[0] = -x[0];
-    ///     Ok(())
-    /// };
-    /// let mut out = [(0.5, [0.0]), (1.0, [0.0]), (2.0, [0.0])];
-    /// let sol = Dop853::new().rtol(1e-9).atol(1e-12).solve_at(f, 0.0, &[1.0], &mut out).unwrap();
-    /// assert_eq!(sol.outputs, 3);
-    /// for (t, x) in out {
-    ///     assert!((x[0] - (-t).exp()).abs() < 1e-8);
-    /// }
-    /// ```
-    pub fn solve_at<T, F, const S: usize>(
-        &self,
-        f: F,
-        t0: f64,
-        x0: &[T; S],
-        out: &mut [(f64, [T; S])],
-    ) -> Result<Solution<T, S>, IntegrateError>
-    where
-        T: Scalar,
-        F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
-    {
-        let t_end = out.last().map_or(t0, |o| o.0);
-        self.run(f, t0, x0, t_end, &mut SliceSink(out), None)
-    }
-
-    /// The general form: integrates from `(t0, x0)` to `t_end`, calls
-    /// `on_output(t, x)` at each of `times` (ordered in the direction of
-    /// integration and within the interval), and stops at an event of `g`
-    /// when one is given (as [`Dop853::solve_until`]); output times past the
-    /// event are not reached.
-    #[allow(clippy::too_many_arguments)]
-    pub fn solve_with<T, F, const S: usize>(
-        &self,
-        f: F,
-        t0: f64,
-        x0: &[T; S],
-        t_end: f64,
-        times: &[f64],
-        on_output: &mut dyn FnMut(f64, &[T; S]),
-        event: Option<&mut EventFn<'_, T, S>>,
-    ) -> Result<Solution<T, S>, IntegrateError>
-    where
-        T: Scalar,
-        F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
-    {
-        let mut sink = CallbackSink {
-            times,
-            cb: on_output,
-        };
-        self.run(f, t0, x0, t_end, &mut sink, event)
-    }
-
-    /// [`Dop853::solve`] of a model's reduced equations ([`Model::rhs`],
-    /// after one [`Model::prepare`]) with `inputs` held constant. The array
-    /// length `S` must be the reduced state length.
-    pub fn solve_model<M: Model, T: Scalar, const S: usize>(
-        &self,
-        model: &M,
-        inputs: &[T],
-        t0: f64,
-        x0: &[T; S],
-        t_end: f64,
-    ) -> Result<Solution<T, S>, IntegrateError> {
-        check_state_len::<M>(S)?;
-        let p = model.prepare::<T>();
-        let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-        self.solve(f, t0, x0, t_end)
-    }
-
-    /// [`Dop853::solve_at`] of a model's reduced equations, as
-    /// [`Dop853::solve_model`].
-    pub fn solve_model_at<M: Model, T: Scalar, const S: usize>(
-        &self,
-        model: &M,
-        inputs: &[T],
-        t0: f64,
-        x0: &[T; S],
-        out: &mut [(f64, [T; S])],
-    ) -> Result<Solution<T, S>, IntegrateError> {
-        check_state_len::<M>(S)?;
-        let p = model.prepare::<T>();
-        let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-        self.solve_at(f, t0, x0, out)
-    }
-
-    /// [`Dop853::solve_until`] of a model's reduced equations, as
-    /// [`Dop853::solve_model`].
-    pub fn solve_model_until<M: Model, T: Scalar, G, const S: usize>(
-        &self,
-        model: &M,
-        inputs: &[T],
-        g: G,
-        t0: f64,
-        x0: &[T; S],
-        t_end: f64,
-    ) -> Result<Solution<T, S>, IntegrateError>
-    where
-        G: FnMut(f64, &[T; S]) -> f64,
-    {
-        check_state_len::<M>(S)?;
-        let p = model.prepare::<T>();
-        let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-        self.solve_until(f, g, t0, x0, t_end)
-    }
-
-    fn check_settings(&self) -> Result<(), IntegrateError> {
-        let bad = |what| Err(IntegrateError::InvalidInput { what });
-        if !(self.rtol >= 0.0 && self.rtol.is_finite()) {
-            return bad("rtol must be finite and >= 0");
-        }
-        if !(self.atol >= 0.0 && self.atol.is_finite()) {
-            return bad("atol must be finite and >= 0");
-        }
-        if self.rtol == 0.0 && self.atol == 0.0 {
-            return bad("rtol and atol are both 0");
-        }
-        if !(self.h_min >= 0.0 && self.h_min.is_finite()) {
-            return bad("h_min must be finite and >= 0");
-        }
-        if let Some(h) = self.h_init {
-            if !(h.is_finite() && h != 0.0) {
-                return bad("h_init must be finite and nonzero");
-            }
-        }
-        if !self.adaptive && self.h_init.is_none() {
-            return bad("fixed steps (adaptive(false)) need h_init");
-        }
-        if let Some(h) = self.h_max {
-            if h.is_nan() || h <= 0.0 {
-                return bad("h_max must be > 0");
-            }
-        }
-        if !(0.0..=0.2).contains(&self.beta) {
-            return bad("beta must be in [0, 0.2]");
-        }
-        if self.event_tol.is_nan() || self.event_tol < 0.0 {
-            return bad("event_tol must be >= 0");
-        }
-        Ok(())
-    }
-
-    /// The weight `atol + rtol |x|`, kept positive.
-    fn scale(&self, a: f64, b: f64) -> f64 {
-        let sk = self.atol + self.rtol * a.abs().max(b.abs());
-        sk.max(f64::MIN_POSITIVE)
-    }
-
-    /// Hairer's `HINIT` for order 8: a first step from the size of `x`, `f`
-    /// and an estimate of the second derivative (one rhs call).
-    #[allow(clippy::too_many_arguments)]
-    fn initial_step<T, F, const S: usize>(
-        &self,
+    /// Stages 2 to 12, then the FSAL stage 13 at the new state only when
+    /// the step is accepted (a rejected step costs 11 rhs calls).
+    #[inline]
+    fn step<F>(
+        &mut self,
         f: &mut F,
+        set: &Settings,
         t: f64,
+        hs: f64,
+        t_new: f64,
         x: &[T; S],
-        k1: &[T; S],
-        dir: f64,
-        h_max: f64,
         stats: &mut Stats,
-    ) -> Result<f64, IntegrateError>
+    ) -> Result<Option<([T; S], f64)>, ModelError>
     where
-        T: Scalar,
         F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
     {
-        let (mut dnf, mut dny) = (0.0, 0.0);
-        for i in 0..S {
-            let sk = self.scale(x[i].re(), 0.0);
-            dnf += (k1[i].re() / sk) * (k1[i].re() / sk);
-            dny += (x[i].re() / sk) * (x[i].re() / sk);
-        }
-        let mut h = if dnf <= 1e-10 || dny <= 1e-10 {
-            1e-6
+        stats.rhs_calls += 11;
+        let x_new = stages(f, t, hs, x, &mut self.k)?;
+        let mut finite = all_finite(&x_new);
+        let err = if set.adaptive {
+            error_norm(set, hs, x, &x_new, &self.k)
         } else {
-            libm::sqrt(dny / dnf) * 0.01
+            0.0
         };
-        h = h.min(h_max);
-        let x1 = combine(x, T::from_f64(dir * h), [(1.0, k1)]);
-        let mut f1 = [T::zero(); S];
-        stats.rhs_calls += 1;
-        f(T::from_f64(t + dir * h), &x1, &mut f1)?;
-        if !all_finite(&f1) {
-            // Let the main loop shrink the step.
-            return Ok(h);
+        finite &= err.is_finite();
+        if finite && err <= 1.0 {
+            stats.rhs_calls += 1;
+            f(T::from_f64(t_new), &x_new, &mut self.k[12])?;
+            finite &= all_finite(&self.k[12]);
         }
-        let mut der2 = 0.0;
-        for i in 0..S {
-            let sk = self.scale(x[i].re(), 0.0);
-            let d = (f1[i].re() - k1[i].re()) / sk;
-            der2 += d * d;
-        }
-        let der2 = libm::sqrt(der2) / h;
-        let der12 = der2.max(libm::sqrt(dnf));
-        let h1 = if der12 <= 1e-15 {
-            (h * 1e-3).max(1e-6)
-        } else {
-            libm::pow(0.01 / der12, 1.0 / 8.0)
-        };
-        Ok((100.0 * h).min(h1).min(h_max))
+        Ok(if finite { Some((x_new, err)) } else { None })
     }
 
-    /// Stages 2 to 12 (`st.k[0]` holds stage 1); returns the new state.
-    fn stages<T, F, const S: usize>(
-        f: &mut F,
-        t: f64,
-        hs: f64,
-        x: &[T; S],
-        st: &mut Stages<T, S>,
-    ) -> Result<[T; S], ModelError>
-    where
-        T: Scalar,
-        F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
-    {
-        let hh = T::from_f64(hs);
-        let tc = |c: f64| T::from_f64(t + c * hs);
-        let k = &mut st.k;
-        let y = combine(x, hh, [(A21, &k[0])]);
-        f(tc(C2), &y, &mut k[1])?;
-        let y = combine(x, hh, [(A31, &k[0]), (A32, &k[1])]);
-        f(tc(C3), &y, &mut k[2])?;
-        let y = combine(x, hh, [(A41, &k[0]), (A43, &k[2])]);
-        f(tc(C4), &y, &mut k[3])?;
-        let y = combine(x, hh, [(A51, &k[0]), (A53, &k[2]), (A54, &k[3])]);
-        f(tc(C5), &y, &mut k[4])?;
-        let y = combine(x, hh, [(A61, &k[0]), (A64, &k[3]), (A65, &k[4])]);
-        f(tc(C6), &y, &mut k[5])?;
-        let y = combine(
-            x,
-            hh,
-            [(A71, &k[0]), (A74, &k[3]), (A75, &k[4]), (A76, &k[5])],
-        );
-        f(tc(C7), &y, &mut k[6])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A81, &k[0]),
-                (A84, &k[3]),
-                (A85, &k[4]),
-                (A86, &k[5]),
-                (A87, &k[6]),
-            ],
-        );
-        f(tc(C8), &y, &mut k[7])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A91, &k[0]),
-                (A94, &k[3]),
-                (A95, &k[4]),
-                (A96, &k[5]),
-                (A97, &k[6]),
-                (A98, &k[7]),
-            ],
-        );
-        f(tc(C9), &y, &mut k[8])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A101, &k[0]),
-                (A104, &k[3]),
-                (A105, &k[4]),
-                (A106, &k[5]),
-                (A107, &k[6]),
-                (A108, &k[7]),
-                (A109, &k[8]),
-            ],
-        );
-        f(tc(C10), &y, &mut k[9])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A111, &k[0]),
-                (A114, &k[3]),
-                (A115, &k[4]),
-                (A116, &k[5]),
-                (A117, &k[6]),
-                (A118, &k[7]),
-                (A119, &k[8]),
-                (A1110, &k[9]),
-            ],
-        );
-        f(tc(C11), &y, &mut k[10])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A121, &k[0]),
-                (A124, &k[3]),
-                (A125, &k[4]),
-                (A126, &k[5]),
-                (A127, &k[6]),
-                (A128, &k[7]),
-                (A129, &k[8]),
-                (A1210, &k[9]),
-                (A1211, &k[10]),
-            ],
-        );
-        f(T::from_f64(t + hs), &y, &mut k[11])?;
-        Ok(combine(
-            x,
-            hh,
-            [
-                (B1, &k[0]),
-                (B6, &k[5]),
-                (B7, &k[6]),
-                (B8, &k[7]),
-                (B9, &k[8]),
-                (B10, &k[9]),
-                (B11, &k[10]),
-                (B12, &k[11]),
-            ],
-        ))
+    fn accept(&mut self) {
+        self.k[0] = self.k[12];
     }
 
-    /// The combined 5th/3rd-order error norm of a step of size `hs`.
-    fn error_norm<T: Scalar, const S: usize>(
-        &self,
-        hs: f64,
-        x: &[T; S],
-        x_new: &[T; S],
-        k: &[[T; S]; 16],
-    ) -> f64 {
-        let (mut e5, mut e3) = (0.0, 0.0);
-        for i in 0..S {
-            let kr = |j: usize| k[j][i].re();
-            let sk = self.scale(x[i].re(), x_new[i].re());
-            let bsum = B1 * kr(0)
-                + B6 * kr(5)
-                + B7 * kr(6)
-                + B8 * kr(7)
-                + B9 * kr(8)
-                + B10 * kr(9)
-                + B11 * kr(10)
-                + B12 * kr(11);
-            let d3 = (bsum - BHH1 * kr(0) - BHH2 * kr(8) - BHH3 * kr(11)) / sk;
-            let d5 = (ER1 * kr(0)
-                + ER6 * kr(5)
-                + ER7 * kr(6)
-                + ER8 * kr(7)
-                + ER9 * kr(8)
-                + ER10 * kr(9)
-                + ER11 * kr(10)
-                + ER12 * kr(11))
-                / sk;
-            e3 += d3 * d3;
-            e5 += d5 * d5;
-        }
-        if S == 0 {
-            return 0.0;
-        }
-        let mut deno = e5 + 0.01 * e3;
-        if deno <= 0.0 {
-            deno = 1.0;
-        }
-        hs.abs() * e5 / libm::sqrt(S as f64 * deno)
-    }
-
-    /// The dense output of an accepted step (stages 1 to 13 in `st`): the
-    /// three extra stages 14 to 16, then the polynomial coefficients.
-    #[allow(clippy::too_many_arguments)]
-    fn dense<T, F, const S: usize>(
+    /// The dense output of an accepted step (stages 1 to 13): the three
+    /// extra stages 14 to 16, then the polynomial coefficients.
+    fn dense<F>(
+        &mut self,
         f: &mut F,
         t: f64,
         hs: f64,
         x: &[T; S],
         x_new: &[T; S],
-        st: &mut Stages<T, S>,
         stats: &mut Stats,
     ) -> Result<Dense<T, S>, IntegrateError>
     where
-        T: Scalar,
         F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
     {
         let hh = T::from_f64(hs);
-        let k = &mut st.k;
+        let k = &mut self.k;
         stats.rhs_calls += 3;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A141, &k[0]),
-                (A147, &k[6]),
-                (A148, &k[7]),
-                (A149, &k[8]),
-                (A1410, &k[9]),
-                (A1411, &k[10]),
-                (A1412, &k[11]),
-                (A1413, &k[12]),
-            ],
-        );
-        f(T::from_f64(t + C14 * hs), &y, &mut k[13])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A151, &k[0]),
-                (A156, &k[5]),
-                (A157, &k[6]),
-                (A158, &k[7]),
-                (A1511, &k[10]),
-                (A1512, &k[11]),
-                (A1513, &k[12]),
-                (A1514, &k[13]),
-            ],
-        );
-        f(T::from_f64(t + C15 * hs), &y, &mut k[14])?;
-        let y = combine(
-            x,
-            hh,
-            [
-                (A161, &k[0]),
-                (A166, &k[5]),
-                (A167, &k[6]),
-                (A168, &k[7]),
-                (A169, &k[8]),
-                (A1613, &k[12]),
-                (A1614, &k[13]),
-                (A1615, &k[14]),
-            ],
-        );
-        f(T::from_f64(t + C16 * hs), &y, &mut k[15])?;
+        for (j, (c, w)) in EXTRA.iter().enumerate() {
+            let y = combine(x, hh, w.map(|(a, s)| (a, &k[s])));
+            f(T::from_f64(t + c * hs), &y, &mut k[13 + j])?;
+        }
         if !(all_finite(&k[13]) && all_finite(&k[14]) && all_finite(&k[15])) {
             return Err(IntegrateError::NonFinite { t });
         }
@@ -957,292 +469,198 @@ impl Dop853 {
         }
         Ok(Dense { t, h: hs, r })
     }
+}
 
-    /// The integration loop behind every `solve*`.
-    fn run<T, F, K, const S: usize>(
-        &self,
-        mut f: F,
-        t0: f64,
-        x0: &[T; S],
-        t_end: f64,
-        sink: &mut K,
-        mut event: Option<&mut EventFn<'_, T, S>>,
-    ) -> Result<Solution<T, S>, IntegrateError>
-    where
-        T: Scalar,
-        F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
-        K: Sink<T, S>,
-    {
-        self.check_settings()?;
-        if !t0.is_finite() || !t_end.is_finite() {
-            return Err(IntegrateError::InvalidInput {
-                what: "t0 and t_end must be finite",
-            });
-        }
-        let dir = if t_end >= t0 { 1.0 } else { -1.0 };
-        // Output times: finite, ordered, inside [t0, t_end].
-        let n_out = sink.len();
-        let mut prev = t0;
-        for i in 0..n_out {
-            let ti = sink.time(i);
-            if !ti.is_finite() || (ti - prev) * dir < 0.0 || (ti - t_end) * dir > 0.0 {
-                return Err(IntegrateError::InvalidInput {
-                    what: "output times must be finite, ordered and within [t0, t_end]",
-                });
-            }
-            prev = ti;
-        }
-        if !all_finite(x0) {
-            return Err(IntegrateError::NonFinite { t: t0 });
-        }
+/// Stages 2 to 12 (`k[0]` holds stage 1); returns the new state.
+fn stages<T, F, const S: usize>(
+    f: &mut F,
+    t: f64,
+    hs: f64,
+    x: &[T; S],
+    k: &mut [[T; S]; 16],
+) -> Result<[T; S], ModelError>
+where
+    T: Scalar,
+    F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
+{
+    let hh = T::from_f64(hs);
+    let tc = |c: f64| T::from_f64(t + c * hs);
+    let y = combine(x, hh, [(A21, &k[0])]);
+    f(tc(C2), &y, &mut k[1])?;
+    let y = combine(x, hh, [(A31, &k[0]), (A32, &k[1])]);
+    f(tc(C3), &y, &mut k[2])?;
+    let y = combine(x, hh, [(A41, &k[0]), (A43, &k[2])]);
+    f(tc(C4), &y, &mut k[3])?;
+    let y = combine(x, hh, [(A51, &k[0]), (A53, &k[2]), (A54, &k[3])]);
+    f(tc(C5), &y, &mut k[4])?;
+    let y = combine(x, hh, [(A61, &k[0]), (A64, &k[3]), (A65, &k[4])]);
+    f(tc(C6), &y, &mut k[5])?;
+    let y = combine(
+        x,
+        hh,
+        [(A71, &k[0]), (A74, &k[3]), (A75, &k[4]), (A76, &k[5])],
+    );
+    f(tc(C7), &y, &mut k[6])?;
+    let y = combine(
+        x,
+        hh,
+        [
+            (A81, &k[0]),
+            (A84, &k[3]),
+            (A85, &k[4]),
+            (A86, &k[5]),
+            (A87, &k[6]),
+        ],
+    );
+    f(tc(C8), &y, &mut k[7])?;
+    let y = combine(
+        x,
+        hh,
+        [
+            (A91, &k[0]),
+            (A94, &k[3]),
+            (A95, &k[4]),
+            (A96, &k[5]),
+            (A97, &k[6]),
+            (A98, &k[7]),
+        ],
+    );
+    f(tc(C9), &y, &mut k[8])?;
+    let y = combine(
+        x,
+        hh,
+        [
+            (A101, &k[0]),
+            (A104, &k[3]),
+            (A105, &k[4]),
+            (A106, &k[5]),
+            (A107, &k[6]),
+            (A108, &k[7]),
+            (A109, &k[8]),
+        ],
+    );
+    f(tc(C10), &y, &mut k[9])?;
+    let y = combine(
+        x,
+        hh,
+        [
+            (A111, &k[0]),
+            (A114, &k[3]),
+            (A115, &k[4]),
+            (A116, &k[5]),
+            (A117, &k[6]),
+            (A118, &k[7]),
+            (A119, &k[8]),
+            (A1110, &k[9]),
+        ],
+    );
+    f(tc(C11), &y, &mut k[10])?;
+    let y = combine(
+        x,
+        hh,
+        [
+            (A121, &k[0]),
+            (A124, &k[3]),
+            (A125, &k[4]),
+            (A126, &k[5]),
+            (A127, &k[6]),
+            (A128, &k[7]),
+            (A129, &k[8]),
+            (A1210, &k[9]),
+            (A1211, &k[10]),
+        ],
+    );
+    f(T::from_f64(t + hs), &y, &mut k[11])?;
+    Ok(combine(
+        x,
+        hh,
+        [
+            (B1, &k[0]),
+            (B6, &k[5]),
+            (B7, &k[6]),
+            (B8, &k[7]),
+            (B9, &k[8]),
+            (B10, &k[9]),
+            (B11, &k[10]),
+            (B12, &k[11]),
+        ],
+    ))
+}
 
-        let mut stats = Stats::default();
-        let mut t = t0;
-        let mut x = *x0;
-        let mut next_out = 0;
-        while next_out < n_out && sink.time(next_out) == t0 {
-            sink.put(next_out, &x);
-            next_out += 1;
-        }
-        let mut g_old = match event.as_mut() {
-            Some(g) => {
-                let v = g(t, &x);
-                if !v.is_finite() {
-                    return Err(IntegrateError::NonFinite { t });
-                }
-                v
-            }
-            None => 0.0,
-        };
-        let finish = |t, x, stats, event, outputs, h_next| {
-            Ok(Solution {
-                t,
-                x,
-                stats,
-                event,
-                outputs,
-                h_next,
-            })
-        };
-        if t_end == t0 {
-            return finish(t, x, stats, false, next_out, 0.0);
-        }
+/// The combined 5th/3rd-order error norm of a step of size `hs`.
+fn error_norm<T: Scalar, const S: usize>(
+    set: &Settings,
+    hs: f64,
+    x: &[T; S],
+    x_new: &[T; S],
+    k: &[[T; S]; 16],
+) -> f64 {
+    let (mut e5, mut e3) = (0.0, 0.0);
+    for i in 0..S {
+        let kr = |j: usize| k[j][i].re();
+        let sk = set.scale(x[i].re(), x_new[i].re());
+        let bsum = B1 * kr(0)
+            + B6 * kr(5)
+            + B7 * kr(6)
+            + B8 * kr(7)
+            + B9 * kr(8)
+            + B10 * kr(9)
+            + B11 * kr(10)
+            + B12 * kr(11);
+        let d3 = (bsum - BHH1 * kr(0) - BHH2 * kr(8) - BHH3 * kr(11)) / sk;
+        let d5 = (ER1 * kr(0)
+            + ER6 * kr(5)
+            + ER7 * kr(6)
+            + ER8 * kr(7)
+            + ER9 * kr(8)
+            + ER10 * kr(9)
+            + ER11 * kr(10)
+            + ER12 * kr(11))
+            / sk;
+        e3 += d3 * d3;
+        e5 += d5 * d5;
+    }
+    if S == 0 {
+        return 0.0;
+    }
+    let mut deno = e5 + 0.01 * e3;
+    if deno <= 0.0 {
+        deno = 1.0;
+    }
+    hs.abs() * e5 / libm::sqrt(S as f64 * deno)
+}
 
-        let mut st = Stages {
-            k: [[T::zero(); S]; 16],
-        };
-        stats.rhs_calls += 1;
-        f(T::from_f64(t), &x, &mut st.k[0])?;
-        if !all_finite(&st.k[0]) {
-            return Err(IntegrateError::NonFinite { t });
-        }
-        let span = (t_end - t0).abs();
-        let h_max = if self.adaptive {
-            self.h_max.unwrap_or(f64::INFINITY).min(span)
-        } else {
-            span
-        };
-        let mut h = match self.h_init {
-            Some(h) => h.abs().min(h_max),
-            None => self.initial_step(&mut f, t, &x, &st.k[0], dir, h_max, &mut stats)?,
-        };
-        let h_fixed = h;
-        let expo1 = 0.125 - 0.2 * self.beta;
-        let mut fac_old: f64 = 1e-4;
-        let mut last_rejected = false;
-        let mut steps = 0usize;
-
-        loop {
-            if steps >= self.max_steps {
-                return Err(IntegrateError::TooManySteps { t, steps });
-            }
-            let h_floor = self
-                .h_min
-                .max(16.0 * f64::EPSILON * t.abs())
-                .max(f64::MIN_POSITIVE);
-            let remaining = (t_end - t).abs();
-            let last = 1.01 * h >= remaining;
-            if !last && h < h_floor {
-                return Err(IntegrateError::StepSizeTooSmall { t, h });
-            }
-            if last {
-                h = remaining;
-            }
-            steps += 1;
-            let hs = dir * h;
-            let t_new = if last { t_end } else { t + hs };
-
-            // Stages 2..12, then the FSAL stage 13 at the new state.
-            stats.rhs_calls += 11;
-            let x_new = Self::stages(&mut f, t, hs, &x, &mut st)?;
-            let mut finite = all_finite(&x_new);
-            let err = if self.adaptive {
-                self.error_norm(hs, &x, &x_new, &st.k)
-            } else {
-                0.0
-            };
-            finite &= err.is_finite();
-            if finite && err <= 1.0 {
-                stats.rhs_calls += 1;
-                f(T::from_f64(t_new), &x_new, &mut st.k[12])?;
-                finite &= all_finite(&st.k[12]);
-            }
-            if !finite {
-                // A non-finite stage: retry with a much smaller step.
-                stats.rejected += 1;
-                last_rejected = true;
-                h *= FAC_NON_FINITE;
-                if !self.adaptive || h < h_floor {
-                    return Err(IntegrateError::NonFinite { t });
-                }
-                continue;
-            }
-
-            let fac11 = libm::pow(err, expo1);
-            if err <= 1.0 {
-                // Accepted.
-                stats.accepted += 1;
-                let mut h_new = if self.adaptive {
-                    let fac = fac11 / libm::pow(fac_old, self.beta);
-                    let fac = (fac / SAFETY).clamp(1.0 / FAC_MAX, 1.0 / FAC_MIN);
-                    fac_old = err.max(1e-4);
-                    h / fac
-                } else {
-                    h_fixed
-                };
-                if last_rejected {
-                    h_new = h_new.min(h);
-                }
-                last_rejected = false;
-
-                // Event at the end of the step.
-                let mut crossed = false;
-                let mut g_new = 0.0;
-                if let Some(g) = event.as_mut() {
-                    g_new = g(t_new, &x_new);
-                    if !g_new.is_finite() {
-                        return Err(IntegrateError::NonFinite { t });
-                    }
-                    crossed = g_old != 0.0 && (g_new == 0.0 || (g_new > 0.0) != (g_old > 0.0));
-                }
-                let need_dense = (crossed && g_new != 0.0)
-                    || (next_out < n_out && (sink.time(next_out) - t_new) * dir < 0.0);
-                let dense = if need_dense {
-                    Some(Self::dense(&mut f, t, hs, &x, &x_new, &mut st, &mut stats)?)
-                } else {
-                    None
-                };
-
-                let mut stop: Option<(f64, [T; S])> = None;
-                if crossed {
-                    if let (Some(g), Some(d)) = (event.as_mut(), dense.as_ref()) {
-                        stop = Some(self.locate(&mut **g, d, t, g_old, t_new, g_new, &x_new)?);
-                    } else {
-                        // g is exactly zero at the end of the step.
-                        stop = Some((t_new, x_new));
-                    }
-                }
-                g_old = g_new;
-
-                // Outputs up to the end of the step (or the event).
-                let t_stop = stop.as_ref().map_or(t_new, |s| s.0);
-                while next_out < n_out && (sink.time(next_out) - t_stop) * dir <= 0.0 {
-                    let to = sink.time(next_out);
-                    let xo = match dense.as_ref() {
-                        Some(d) if to != t_new => d.at(to),
-                        _ => x_new,
-                    };
-                    if !all_finite(&xo) {
-                        return Err(IntegrateError::NonFinite { t });
-                    }
-                    sink.put(next_out, &xo);
-                    next_out += 1;
-                }
-                let h_next = if self.adaptive {
-                    h_new.min(h_max)
-                } else {
-                    h_fixed
-                };
-                if let Some((te, xe)) = stop {
-                    return finish(te, xe, stats, true, next_out, h_next);
-                }
-
-                t = t_new;
-                x = x_new;
-                st.k[0] = st.k[12];
-                h = h_next;
-                if last {
-                    return finish(t, x, stats, false, next_out, h);
-                }
-            } else {
-                // Rejected.
-                stats.rejected += 1;
-                last_rejected = true;
-                h /= (fac11 / SAFETY).min(1.0 / FAC_MIN);
-            }
+impl Dop853 {
+    /// The integrator with the documented defaults ([`Dop853`]).
+    pub const fn new() -> Self {
+        Dop853 {
+            set: Settings::new(0.0),
         }
     }
 
-    /// Illinois root finding of `g` on the dense output over `[a, b]` (in
-    /// the direction of integration), `g(a) = ga`, `g(b) = gb` of opposite
-    /// signs or `gb = 0`. Returns the far end of the final bracket.
-    #[allow(clippy::too_many_arguments)]
-    fn locate<T: Scalar, const S: usize>(
-        &self,
-        g: &mut dyn FnMut(f64, &[T; S]) -> f64,
-        dense: &Dense<T, S>,
-        a: f64,
-        ga: f64,
-        b: f64,
-        gb: f64,
-        xb: &[T; S],
-    ) -> Result<(f64, [T; S]), IntegrateError> {
-        let (mut lo, mut glo) = (a, ga);
-        let (mut hi, mut ghi, mut xhi) = (b, gb, *xb);
-        if ghi == 0.0 {
-            return Ok((hi, xhi));
-        }
-        let mut side = 0i8;
-        for _ in 0..EVENT_MAX_ITER {
-            let tol = self
-                .event_tol
-                .max(4.0 * f64::EPSILON * lo.abs().max(hi.abs()));
-            if (hi - lo).abs() <= tol {
-                break;
-            }
-            let mut tc = (lo * ghi - hi * glo) / (ghi - glo);
-            let (mn, mx) = (lo.min(hi), lo.max(hi));
-            if !(tc > mn && tc < mx) {
-                tc = 0.5 * (lo + hi);
-                if !(tc > mn && tc < mx) {
-                    break;
-                }
-            }
-            let xc = dense.at(tc);
-            let gc = g(tc, &xc);
-            if !gc.is_finite() {
-                return Err(IntegrateError::NonFinite { t: tc });
-            }
-            if gc == 0.0 {
-                return Ok((tc, xc));
-            }
-            if (gc > 0.0) == (ghi > 0.0) {
-                hi = tc;
-                ghi = gc;
-                xhi = xc;
-                if side == -1 {
-                    glo *= 0.5;
-                }
-                side = -1;
-            } else {
-                lo = tc;
-                glo = gc;
-                if side == 1 {
-                    ghi *= 0.5;
-                }
-                side = 1;
-            }
-        }
-        Ok((hi, xhi))
+    /// The first step size (magnitude), or `None` (default) for Hairer's
+    /// automatic choice. With [`Dop853::adaptive`]`(false)` it is the size
+    /// of every step and must be given.
+    pub const fn h_init(mut self, h_init: Option<f64>) -> Self {
+        self.set.h_init = h_init;
+        self
     }
+
+    /// The controller's β (default `0`, the elementary controller of
+    /// `DOP853`; must be in `[0, 0.2]`).
+    pub const fn beta(mut self, beta: f64) -> Self {
+        self.set.beta = beta;
+        self
+    }
+
+    /// Error control on (default `true`). With `false`, every step has the
+    /// size [`Dop853::h_init`] (required; the last step is cut to end at
+    /// `t_end`, and [`Dop853::h_max`] is ignored) and is accepted without an
+    /// error estimate; a non-finite state is reported at once.
+    pub const fn adaptive(mut self, adaptive: bool) -> Self {
+        self.set.adaptive = adaptive;
+        self
+    }
+
+    explicit::explicit_api!(Dop853, Stages);
 }
