@@ -86,3 +86,64 @@ fn projection_errors_are_typed() {
     ));
     assert_eq!(off, before);
 }
+
+#[test]
+fn integrators_project_after_every_step() {
+    use appell::integrate::{Dop853, Dopri5};
+    let p = WhippleBicycle::default();
+    let mut x0 = [
+        0.1,
+        std::f64::consts::PI / 10.0,
+        0.05,
+        0.3,
+        -4.6 / p.rr,
+        0.0,
+    ];
+    project_holonomic(&p, 0.0, &mut x0, 1e-14, 30).unwrap();
+    let mut failures = 0;
+    let mut onto_manifold = |t: f64, x: &mut [f64; 6]| {
+        let ok = project_holonomic(&p, t, x, 1e-14, 30).is_ok();
+        failures += usize::from(!ok);
+        ok
+    };
+    // A loose tolerance, so the drift is visible.
+    let dop853 = Dop853::new().rtol(1e-5).atol(1e-7);
+    let free = dop853.solve_model(&p, &[0.0], 0.0, &x0, 10.0).unwrap();
+    let kept = dop853
+        .solve_model_projected(&p, &[0.0], &mut onto_manifold, 0.0, &x0, 10.0)
+        .unwrap();
+    let dopri5 = Dopri5::new().rtol(1e-5).atol(1e-7);
+    let kept5 = dopri5
+        .solve_model_projected(&p, &[0.0], &mut onto_manifold, 0.0, &x0, 10.0)
+        .unwrap();
+    let (r_free, r_kept, r_kept5) = (
+        residual(&p, &free.x),
+        residual(&p, &kept.x),
+        residual(&p, &kept5.x),
+    );
+    println!(
+        "DOP853 rtol 1e-5, 10 s: residual {r_free:.2e} free, {r_kept:.2e} projected \
+         ({} against {} rhs calls); Dopri5 projected {r_kept5:.2e}",
+        kept.stats.rhs_calls, free.stats.rhs_calls
+    );
+    assert_eq!(failures, 0);
+    assert!(r_kept < 1e-14 && r_kept5 < 1e-14);
+    assert!(r_free > 1e2 * r_kept.max(1e-16), "{r_free:e}");
+    // Projection costs at most one extra rhs call per accepted step.
+    assert!(kept.stats.rhs_calls <= free.stats.rhs_calls + kept.stats.accepted + 20);
+    // A projection that fails is a typed error at the step it failed.
+    let err = dop853
+        .solve_model_projected(
+            &p,
+            &[0.0],
+            &mut |t: f64, _: &mut [f64; 6]| t < 1.0,
+            0.0,
+            &x0,
+            10.0,
+        )
+        .unwrap_err();
+    assert!(
+        matches!(err, appell::integrate::IntegrateError::Projection { t } if (1.0..2.0).contains(&t)),
+        "{err:?}"
+    );
+}

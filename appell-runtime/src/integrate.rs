@@ -31,7 +31,7 @@ mod dop853;
 pub use dop853::*;
 mod dopri5;
 mod explicit;
-pub use dopri5::{Dopri5, EventFn, IntegrateError, Solution, Stats};
+pub use dopri5::{Dopri5, EventFn, IntegrateError, ProjectFn, Solution, Stats};
 #[cfg(feature = "std")]
 mod implicit;
 #[cfg(feature = "std")]

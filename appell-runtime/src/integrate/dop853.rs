@@ -5,7 +5,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::check_state_len;
-use super::dopri5::{EventFn, IntegrateError, Solution, Stats};
+use super::dopri5::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
 };

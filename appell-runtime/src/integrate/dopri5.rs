@@ -33,6 +33,12 @@ pub enum IntegrateError {
         /// Time reached (the start of the failing step).
         t: f64,
     },
+    /// The projection passed to `solve_projected` reported failure (or
+    /// left a non-finite state) after the step ending at `t`.
+    Projection {
+        /// Time of the state that could not be projected.
+        t: f64,
+    },
     /// A setting or an argument is invalid (non-finite times, negative
     /// tolerances, output times out of order or outside the interval).
     InvalidInput {
@@ -59,6 +65,9 @@ impl core::fmt::Display for IntegrateError {
                 write!(f, "{steps} steps taken, stopped at t = {t}")
             }
             IntegrateError::NonFinite { t } => write!(f, "non-finite value at t = {t}"),
+            IntegrateError::Projection { t } => {
+                write!(f, "projection onto the constraints failed at t = {t}")
+            }
             IntegrateError::InvalidInput { what } => write!(f, "invalid input: {what}"),
             IntegrateError::Model(e) => write!(f, "model error: {e}"),
         }
@@ -71,6 +80,12 @@ impl std::error::Error for IntegrateError {}
 /// An event function `g(t, x)` as passed to [`Dopri5::solve_with`]: the
 /// integration stops where its sign changes.
 pub type EventFn<'a, T, const S: usize> = dyn FnMut(f64, &[T; S]) -> f64 + 'a;
+
+/// A projection `p(t, x)` as passed to [`Dopri5::solve_projected`]: moves
+/// `x` in place back onto a constraint manifold (for a model, with
+/// [`project_holonomic`](crate::linearize::project_holonomic)) and returns
+/// `false` if it could not.
+pub type ProjectFn<'a, T, const S: usize> = dyn FnMut(f64, &mut [T; S]) -> bool + 'a;
 
 /// Work counts of an adaptive integration.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -7,7 +7,7 @@
 //! and FSAL handling) and its continuous extension. Everything is generic
 //! and monomorphised per method, without allocation.
 
-use super::dopri5::{EventFn, IntegrateError, Solution, Stats};
+use super::dopri5::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use crate::model::ModelError;
 use crate::scalar::Scalar;
 
@@ -285,6 +285,7 @@ where
 }
 
 /// The integration loop behind every `solve*` of the method `P`.
+#[allow(clippy::too_many_arguments)] // the problem, the outputs and two optional hooks
 pub(super) fn run<P, T, F, K, const S: usize>(
     set: &Settings,
     mut f: F,
@@ -293,6 +294,7 @@ pub(super) fn run<P, T, F, K, const S: usize>(
     t_end: f64,
     sink: &mut K,
     mut event: Option<&mut EventFn<'_, T, S>>,
+    mut project: Option<&mut ProjectFn<'_, T, S>>,
 ) -> Result<Solution<T, S>, IntegrateError>
 where
     P: EmbeddedPair<T, S>,
@@ -492,6 +494,29 @@ where
             t = t_new;
             x = x_new;
             st.accept();
+            if let Some(p) = project.as_mut() {
+                // Back onto the manifold; a moved state needs its own first
+                // stage (one rhs call) and event value.
+                let before = x;
+                if !p(t, &mut x) || !all_finite(&x) {
+                    return Err(IntegrateError::Projection { t });
+                }
+                if x.iter().zip(&before).any(|(a, b)| a.re() != b.re()) {
+                    let mut k1 = [T::zero(); S];
+                    stats.rhs_calls += 1;
+                    f(T::from_f64(t), &x, &mut k1)?;
+                    if !all_finite(&k1) {
+                        return Err(IntegrateError::NonFinite { t });
+                    }
+                    st = P::new(k1);
+                    if let Some(g) = event.as_mut() {
+                        g_old = g(t, &x);
+                        if !g_old.is_finite() {
+                            return Err(IntegrateError::NonFinite { t });
+                        }
+                    }
+                }
+            }
             h = h_next;
             if last {
                 return finish(t, x, stats, false, next_out, h);
@@ -631,7 +656,7 @@ macro_rules! explicit_api {
                 times: &[],
                 cb: &mut |_, _| {},
             };
-            explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, &mut sink, None)
+            explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, &mut sink, None, None)
         }
 
         #[doc = concat!("As [`", stringify!($ty), "::solve`], stopping at the first sign change of the event")]
@@ -667,6 +692,7 @@ macro_rules! explicit_api {
                 t_end,
                 &mut sink,
                 Some(&mut g),
+                None,
             )
         }
 
@@ -709,6 +735,7 @@ macro_rules! explicit_api {
                 t_end,
                 &mut SliceSink(out),
                 None,
+                None,
             )
         }
 
@@ -736,7 +763,85 @@ macro_rules! explicit_api {
                 times,
                 cb: on_output,
             };
-            explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, &mut sink, event)
+            explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, &mut sink, event, None)
+        }
+
+        #[doc = concat!("As [`", stringify!($ty), "::solve`], with `project(t, x)` applied to the state")]
+        /// after every accepted step: it moves `x` back onto a constraint
+        /// manifold (a holonomic constraint the integration drifts from, an
+        /// invariant) and returns `false` if it cannot
+        /// ([`IntegrateError::Projection`]). When it moves the state, the next
+        /// step starts afresh from the projected state (one more rhs call,
+        /// counted). The step's error control and dense output are those of the
+        /// unprojected step.
+        ///
+        /// ```
+        #[doc = concat!("use appell_runtime::integrate::", stringify!($ty), ";")]
+        /// // The harmonic oscillator keeps x² + v² = 1; projecting onto that
+        /// // circle removes the slow drift of a loose tolerance.
+        /// let f = |_t: f64, x: &[f64; 2], dx: &mut [f64; 2]| {
+        ///     dx[0] = x[1];
+        ///     dx[1] = -x[0];
+        ///     Ok(())
+        /// };
+        /// let mut onto_circle = |_t: f64, x: &mut [f64; 2]| {
+        ///     let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
+        ///     x[0] /= r;
+        ///     x[1] /= r;
+        ///     r > 0.0
+        /// };
+        #[doc = concat!("let solver = ", stringify!($ty), "::new().rtol(1e-4).atol(1e-6);")]
+        /// let free = solver.solve(f, 0.0, &[1.0, 0.0], 100.0).unwrap();
+        /// let kept = solver.solve_projected(f, &mut onto_circle, 0.0, &[1.0, 0.0], 100.0).unwrap();
+        /// let radius = |x: [f64; 2]| (x[0] * x[0] + x[1] * x[1]).sqrt();
+        /// assert!((radius(kept.x) - 1.0).abs() < 1e-15);
+        /// assert!((radius(free.x) - 1.0).abs() > (radius(kept.x) - 1.0).abs());
+        /// ```
+        pub fn solve_projected<T, F, const S: usize>(
+            &self,
+            f: F,
+            project: &mut ProjectFn<'_, T, S>,
+            t0: f64,
+            x0: &[T; S],
+            t_end: f64,
+        ) -> Result<Solution<T, S>, IntegrateError>
+        where
+            T: Scalar,
+            F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
+        {
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            explicit::run::<$pair<T, S>, _, _, _, S>(
+                &self.set,
+                f,
+                t0,
+                x0,
+                t_end,
+                &mut sink,
+                None,
+                Some(project),
+            )
+        }
+
+        #[doc = concat!("[`", stringify!($ty), "::solve_projected`] of a model's reduced equations, as")]
+        #[doc = concat!("[`", stringify!($ty), "::solve_model`]; with")]
+        /// [`project_holonomic`](crate::linearize::project_holonomic) as the
+        /// projection it keeps a model on its holonomic constraints.
+        pub fn solve_model_projected<M: Model, T: Scalar, const S: usize>(
+            &self,
+            model: &M,
+            inputs: &[T],
+            project: &mut ProjectFn<'_, T, S>,
+            t0: f64,
+            x0: &[T; S],
+            t_end: f64,
+        ) -> Result<Solution<T, S>, IntegrateError> {
+            check_state_len::<M>(S)?;
+            let p = model.prepare::<T>();
+            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
+            self.solve_projected(f, project, t0, x0, t_end)
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve`] of a model's reduced equations ([`Model::rhs`],")]
