@@ -77,6 +77,34 @@ fn midpoint_is_second_order() {
 }
 
 #[test]
+fn dopri5_fixed_steps_are_fifth_order() {
+    let t_end = 16.0;
+    let error = |n: usize| {
+        let sol = Dopri5::new()
+            .adaptive(false)
+            .h_init(Some(t_end / n as f64))
+            .solve(oscillator, 0.0, &[1.0, 0.0], t_end)
+            .unwrap();
+        assert_eq!((sol.stats.accepted, sol.stats.rejected), (n, 0));
+        err2(&sol.x, &oscillator_exact(t_end))
+    };
+    let ns = [32, 64, 128, 256];
+    let errs: Vec<f64> = ns.iter().map(|&n| error(n)).collect();
+    for i in 1..ns.len() {
+        let p = (errs[i - 1] / errs[i]).log2();
+        println!("dopri5 N = {} -> {}: order {p:.3}", ns[i - 1], ns[i]);
+        assert!((p - 5.0).abs() < 0.3, "dopri5: order {p} vs 5");
+    }
+    // Fixed steps need h_init.
+    assert!(matches!(
+        Dopri5::new()
+            .adaptive(false)
+            .solve(oscillator, 0.0, &[1.0, 0.0], 1.0),
+        Err(IntegrateError::InvalidInput { .. })
+    ));
+}
+
+#[test]
 fn second_order_steps_report_non_finite_and_model_errors() {
     let mut nan = |_t: f64, _x: &[f64; 1], dx: &mut [f64; 1]| -> Result<(), ModelError> {
         dx[0] = f64::NAN;

@@ -96,7 +96,7 @@ pub struct Dop853 {
 
 impl core::fmt::Debug for Dop853 {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        self.set.debug("Dop853", true, f)
+        self.set.debug("Dop853", f)
     }
 }
 

@@ -188,7 +188,7 @@ pub struct Dopri5 {
 
 impl core::fmt::Debug for Dopri5 {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
-        self.set.debug("Dopri5", false, f)
+        self.set.debug("Dopri5", f)
     }
 }
 
@@ -355,7 +355,7 @@ impl<T: Scalar, const S: usize> EmbeddedPair<T, S> for Stages<T, S> {
             let sk = set.scale(x[i].re(), x_new[i].re());
             err += (e / sk) * (e / sk);
         }
-        let err = if S == 0 {
+        let err = if S == 0 || !set.adaptive {
             0.0
         } else {
             libm::sqrt(err / S as f64)
@@ -424,6 +424,15 @@ impl Dopri5 {
     /// controller; must be in `[0, 0.2)`).
     pub const fn beta(mut self, beta: f64) -> Self {
         self.set.beta = beta;
+        self
+    }
+
+    /// Error control on (default `true`). With `false`, every step has the
+    /// size [`Dopri5::h_init`] (required; the last step is cut to end at
+    /// `t_end`, and [`Dopri5::h_max`] is ignored) and is accepted without an
+    /// error estimate: a fixed-step order-5 method with dense output.
+    pub const fn adaptive(mut self, adaptive: bool) -> Self {
+        self.set.adaptive = adaptive;
         self
     }
 

@@ -46,27 +46,19 @@ impl Settings {
         }
     }
 
-    /// `Debug` of the integrator `name` as if its settings were its fields
-    /// (`adaptive` only when `with_adaptive`).
-    pub(super) fn debug(
-        &self,
-        name: &str,
-        with_adaptive: bool,
-        f: &mut core::fmt::Formatter<'_>,
-    ) -> core::fmt::Result {
-        let mut d = f.debug_struct(name);
-        d.field("rtol", &self.rtol)
+    /// `Debug` of the integrator `name` as if its settings were its fields.
+    pub(super) fn debug(&self, name: &str, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        f.debug_struct(name)
+            .field("rtol", &self.rtol)
             .field("atol", &self.atol)
             .field("max_steps", &self.max_steps)
             .field("h_init", &self.h_init)
             .field("h_min", &self.h_min)
             .field("h_max", &self.h_max)
             .field("beta", &self.beta)
-            .field("event_tol", &self.event_tol);
-        if with_adaptive {
-            d.field("adaptive", &self.adaptive);
-        }
-        d.finish()
+            .field("event_tol", &self.event_tol)
+            .field("adaptive", &self.adaptive)
+            .finish()
     }
 
     /// Validation; `beta` must be in `[0, 0.2]`, or `[0, 0.2)` unless
