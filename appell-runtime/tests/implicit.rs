@@ -624,3 +624,310 @@ fn errors_are_typed() {
         Err(IntegrateError::InvalidInput { .. })
     ));
 }
+
+// ---------------------------------------------------------------------------
+// Dense output, output times and events.
+
+/// The states at the ends of all accepted steps (recorded by an event
+/// function that never changes sign) and the final solution.
+fn step_ends<M: Model>(
+    s: TrBdf2,
+    model: &M,
+    x0: &[f64],
+    t_end: f64,
+    inputs: &[f64],
+) -> Vec<(f64, Vec<f64>)> {
+    let mut ends = vec![(0.0, x0.to_vec())];
+    let g = |t: f64, x: &[f64]| {
+        ends.push((t, x.to_vec()));
+        1.0
+    };
+    let sol = s
+        .solve_model_until(model, g, 0.0, x0, t_end, inputs)
+        .unwrap();
+    assert!(!sol.event);
+    assert_eq!(sol.t, t_end);
+    // The first call of g is at t0.
+    ends.remove(0);
+    ends
+}
+
+/// Max error of the step ends and of the dense output at `k` times per step
+/// (strictly inside each step), against `exact`.
+fn dense_vs_ends<M: Model>(
+    s: TrBdf2,
+    model: &M,
+    x0: &[f64],
+    t_end: f64,
+    inputs: &[f64],
+    exact: impl Fn(f64) -> Vec<f64>,
+    k: usize,
+) -> (f64, f64, usize) {
+    let ends = step_ends(s, model, x0, t_end, inputs);
+    let e_ends = ends
+        .iter()
+        .map(|(t, x)| max_err(x, &exact(*t)))
+        .fold(0.0, f64::max);
+    let mut out = Vec::new();
+    for w in ends.windows(2) {
+        let (a, b) = (w[0].0, w[1].0);
+        for j in 1..=k {
+            out.push((a + (b - a) * j as f64 / (k + 1) as f64, Vec::new()));
+        }
+    }
+    out.push((t_end, Vec::new()));
+    let sol = s.solve_model_at(model, 0.0, x0, &mut out, inputs).unwrap();
+    assert_eq!(sol.outputs, out.len());
+    assert!(!sol.event);
+    let e_dense = out
+        .iter()
+        .map(|(t, x)| max_err(x, &exact(*t)))
+        .fold(0.0, f64::max);
+    (e_ends, e_dense, ends.len() - 1)
+}
+
+#[test]
+fn dense_output_is_as_accurate_as_the_step_ends_on_the_smooth_problem() {
+    for tol in [1e-5, 1e-7, 1e-9] {
+        let s = TrBdf2::new().rtol(tol).atol(tol);
+        let (e_ends, e_dense, steps) = dense_vs_ends(
+            s,
+            &Smooth,
+            &[1.0, 1.0, 0.0],
+            5.0,
+            &[],
+            |t| smooth_exact(t).to_vec(),
+            9,
+        );
+        println!(
+            "smooth tol {tol:e}: {steps} steps, step-end error {e_ends:.3e}, dense error {e_dense:.3e}"
+        );
+        assert!(e_dense <= 2.0 * e_ends, "{e_dense} vs {e_ends}");
+    }
+}
+
+#[test]
+fn dense_output_is_as_accurate_as_the_step_ends_on_the_stiff_problem() {
+    for tol in [1e-5, 1e-6, 1e-7, 1e-8, 1e-9] {
+        let s = TrBdf2::new().rtol(tol).atol(tol);
+        let (e_ends, e_dense, steps) = dense_vs_ends(
+            s,
+            &StiffLinear { lambda: LAMBDA },
+            &[0.0],
+            5.0,
+            &[1.0],
+            |t| vec![stiff_exact(LAMBDA, t)],
+            9,
+        );
+        println!(
+            "stiff tol {tol:e}: {steps} steps, step-end error {e_ends:.3e}, dense error {e_dense:.3e}"
+        );
+        // Once the steps resolve cos t (tol ≤ 1e-6) the interpolant is as
+        // good as the step ends; at 1e-5 the longest steps (≈ 0.5) leave an
+        // interpolation error of ≈ 8.5× the (L-stably damped) end error.
+        let factor = if tol >= 1e-5 { 10.0 } else { 2.5 };
+        assert!(e_dense <= factor * e_ends, "{e_dense} vs {e_ends}");
+    }
+}
+
+#[test]
+fn solve_at_costs_no_extra_work_and_ends_where_solve_ends() {
+    let s = TrBdf2::new().rtol(1e-8).atol(1e-8);
+    let stiff = StiffLinear { lambda: LAMBDA };
+    let plain = s.solve_model(&stiff, 0.0, &[0.0], 5.0, &[1.0]).unwrap();
+    let mut out: Vec<(f64, Vec<f64>)> = (0..=500).map(|k| (0.01 * k as f64, vec![])).collect();
+    let at = s
+        .solve_model_at(&stiff, 0.0, &[0.0], &mut out, &[1.0])
+        .unwrap();
+    assert_eq!(at.t, 5.0);
+    assert_eq!(at.x, plain.x);
+    assert_eq!(at.stats, plain.stats);
+    assert_eq!(at.outputs, 501);
+    assert_eq!(out[0].1, vec![0.0]);
+    assert_eq!(out[500].1, plain.x);
+    // The closure form, backward, with repeated times.
+    let f = |_t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+        dx[0] = -x[0];
+        Ok(())
+    };
+    let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+        j[0] = -1.0;
+        Ok(())
+    };
+    let mut out = vec![
+        (1.0, vec![9.0; 4]),
+        (0.5, vec![]),
+        (0.5, vec![]),
+        (-1.0, vec![]),
+    ];
+    let sol = s.solve_at(f, jac, 1.0, &[1.0], &mut out).unwrap();
+    assert_eq!((sol.t, sol.outputs, sol.event), (-1.0, 4, false));
+    assert_eq!(out[0].1, vec![1.0]);
+    for (t, x) in &out {
+        assert_eq!(x.len(), 1);
+        assert!(
+            (x[0] - (1.0 - t).exp()).abs() < 1e-5 * (1.0 - t).exp(),
+            "{t} {x:?}"
+        );
+    }
+    // Nothing to do.
+    let sol = s.solve_at(f, jac, 1.0, &[1.0], &mut []).unwrap();
+    assert_eq!((sol.t, sol.outputs), (1.0, 0));
+}
+
+#[test]
+fn output_times_are_validated() {
+    let s = TrBdf2::new();
+    for times in [
+        vec![0.5, 0.2, 1.0],      // out of order
+        vec![-0.5, 1.0],          // before t0
+        vec![0.5, f64::NAN, 1.0], // not finite
+        vec![0.5, f64::INFINITY], // not finite end
+        vec![0.5, -1.0],          // changes direction
+    ] {
+        let mut out: Vec<(f64, Vec<f64>)> = times.iter().map(|&t| (t, vec![])).collect();
+        let r = s.solve_model_at(&Smooth, 0.0, &[1.0, 1.0, 0.0], &mut out, &[]);
+        assert!(
+            matches!(r, Err(IntegrateError::InvalidInput { .. })),
+            "{times:?}: {r:?}"
+        );
+        assert!(out.iter().all(|o| o.1.is_empty()), "{times:?}");
+    }
+    // Wrong state length is a model error.
+    let mut out = vec![(1.0, vec![])];
+    assert!(matches!(
+        s.solve_model_at(&Smooth, 0.0, &[1.0], &mut out, &[]),
+        Err(IntegrateError::Model(ModelError::Length { .. }))
+    ));
+}
+
+#[test]
+fn event_is_located_to_tolerance() {
+    // y = 1/(1 + t) reaches 1/4 at t = 3; x = cos t reaches 1/2 at π/3.
+    let s = TrBdf2::new().rtol(1e-10).atol(1e-10);
+    let x0 = [1.0, 1.0, 0.0];
+    let sol = s
+        .solve_model_until(&Smooth, |_t, x: &[f64]| x[1] - 0.25, 0.0, &x0, 10.0, &[])
+        .unwrap();
+    println!(
+        "event y = 1/4: t = {:.15}, error {:.3e}, {} steps",
+        sol.t,
+        sol.t - 3.0,
+        sol.stats.accepted
+    );
+    assert!(sol.event);
+    // Located to tolerance on the dense output: g = y − 1/4 has slope
+    // −1/16 there, so within event_tol = 1e-12 of the root |g| ≤ 1e-13, on
+    // the far side of the crossing.
+    assert!(sol.x[1] <= 0.25 && sol.x[1] > 0.25 - 1e-13, "{}", sol.x[1]);
+    // The time error is that of the solution: 16 × the error of y.
+    let ey = sol.x[1] - 1.0 / (1.0 + sol.t);
+    assert!((sol.t - 3.0).abs() < 1e-6, "{}", sol.t);
+    assert!(
+        ((sol.t - 3.0) - 16.0 * ey).abs() < 1e-3 * (sol.t - 3.0).abs() + 1e-12,
+        "{} {ey}",
+        sol.t
+    );
+
+    let sol = s
+        .solve_model_until(&Smooth, |_t, x: &[f64]| x[0] - 0.5, 0.0, &x0, 10.0, &[])
+        .unwrap();
+    let exact = std::f64::consts::FRAC_PI_3;
+    println!(
+        "event cos t = 1/2: t = {:.15}, error {:.3e}",
+        sol.t,
+        sol.t - exact
+    );
+    assert!(sol.event);
+    assert!((sol.t - exact).abs() < 1e-6, "{}", sol.t);
+    assert!(sol.x[0] <= 0.5 && sol.x[0] > 0.5 - 1e-12);
+
+    // The located time is within event_tol of the root of g on the dense
+    // output: with a coarse event_tol, the reported time is past the root by
+    // at most event_tol.
+    let coarse = s.event_tol(1e-3);
+    let sol = coarse
+        .solve_model_until(&Smooth, |_t, x: &[f64]| x[1] - 0.25, 0.0, &x0, 10.0, &[])
+        .unwrap();
+    println!("event_tol 1e-3: t = {:.15}", sol.t);
+    assert!(
+        sol.event && sol.t >= 3.0 - 1e-6 && sol.t <= 3.0 + 1e-3 + 1e-6,
+        "{}",
+        sol.t
+    );
+
+    // Backward: from t = 3 to 0, y = 1/(1 + t) reaches 1/2 at t = 1.
+    let sol = s
+        .solve_model_until(
+            &Smooth,
+            |_t, x: &[f64]| x[1] - 0.5,
+            3.0,
+            &smooth_exact(3.0),
+            0.0,
+            &[],
+        )
+        .unwrap();
+    assert!(sol.event);
+    assert!((sol.t - 1.0).abs() < 1e-6, "{}", sol.t);
+    assert!(sol.x[1] >= 0.5 && sol.x[1] < 0.5 + 1e-12);
+
+    // A zero at t0 is not an event (cos t − 1 ≤ 0 touches 0 again only at 2π).
+    let sol = s
+        .solve_model_until(&Smooth, |_t, x: &[f64]| x[0] - 1.0, 0.0, &x0, 5.0, &[])
+        .unwrap();
+    assert!(!sol.event);
+    assert_eq!(sol.t, 5.0);
+
+    // The closure form on the stiff problem: x crosses 1/2 in the layer, at
+    // t ≈ ln 2 / 1000.
+    let f = |t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+        dx[0] = -LAMBDA * (x[0] - t.cos());
+        Ok(())
+    };
+    let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+        j[0] = -LAMBDA;
+        Ok(())
+    };
+    let sol = TrBdf2::new()
+        .rtol(1e-9)
+        .atol(1e-12)
+        .solve_until(f, jac, |_t, x: &[f64]| x[0] - 0.5, 0.0, &[0.0], 5.0)
+        .unwrap();
+    let g_exact = stiff_exact(LAMBDA, sol.t) - 0.5;
+    println!(
+        "stiff event: t = {:.12}, exact x − 1/2 there {g_exact:.3e}",
+        sol.t
+    );
+    assert!(sol.event);
+    assert!((sol.t - 2.0_f64.ln() / LAMBDA).abs() < 1e-5, "{}", sol.t);
+    assert!(g_exact.abs() < 1e-6);
+}
+
+#[test]
+fn non_finite_event_function_is_an_error() {
+    let s = TrBdf2::new();
+    let x0 = [1.0, 1.0, 0.0];
+    assert_eq!(
+        s.solve_model_until(&Smooth, |_t, _x: &[f64]| f64::NAN, 0.0, &x0, 5.0, &[]),
+        Err(IntegrateError::NonFinite { t: 0.0 })
+    );
+    match s.solve_model_until(
+        &Smooth,
+        |t, _x: &[f64]| if t > 1.0 { f64::INFINITY } else { 1.0 },
+        0.0,
+        &x0,
+        5.0,
+        &[],
+    ) {
+        Err(IntegrateError::NonFinite { t }) => assert!(t > 0.0 && t <= 1.0, "{t}"),
+        other => panic!("{other:?}"),
+    }
+    // A bad event tolerance.
+    for tol in [-1.0, f64::NAN] {
+        assert!(matches!(
+            s.event_tol(tol)
+                .solve_model_until(&Smooth, |_t, x: &[f64]| x[0], 0.0, &x0, 5.0, &[]),
+            Err(IntegrateError::InvalidInput { .. })
+        ));
+    }
+}

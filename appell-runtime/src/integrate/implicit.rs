@@ -41,6 +41,12 @@ pub struct TrBdf2Solution {
     pub stats: TrBdf2Stats,
     /// The size (magnitude) of the next step the error control proposed.
     pub h_next: f64,
+    /// Whether the integration stopped at an event ([`TrBdf2::solve_until`]);
+    /// [`TrBdf2Solution::t`] is then the event time, not the end of the
+    /// interval.
+    pub event: bool,
+    /// How many output times were written ([`TrBdf2::solve_at`]).
+    pub outputs: usize,
 }
 
 /// Adaptive TR-BDF2 integrator for stiff problems (Bank et al. 1985; the
@@ -81,12 +87,23 @@ pub struct TrBdf2Solution {
 ///   growth right after a rejection.
 /// * **Initial step**: `0.01 ‖x0‖/‖f(t0, x0)‖` in the error norm (`1e-6`
 ///   when either is tiny) unless [`TrBdf2::h_init`] gives one.
+/// * **Dense output**: on each accepted step from `(t, x)` to
+///   `(t + h, x₁)`, the cubic Hermite interpolant of `x`, `f(t, x)`, `x₁`
+///   and the last stage derivative `f₁ ≈ f(t + h, x₁)` (the FSAL first
+///   stage of the next step, so no extra rhs call). It is locally of order 3,
+///   one above the method, so interpolated states are as accurate as the
+///   step ends. It serves [`TrBdf2::solve_at`] and [`TrBdf2::solve_until`].
+/// * **Events** ([`TrBdf2::solve_until`]): after each accepted step the
+///   event function `g(t, x)` is evaluated at its end; a sign change (or a
+///   zero at the end, when `g` was nonzero at the start) is located on the
+///   dense output by the Illinois method to [`TrBdf2::event_tol`] and the
+///   integration stops there. A zero of `g` at `t0` is not an event.
 /// * **Failures** are typed [`IntegrateError`]s, never a panic or a NaN.
 ///
 /// Defaults: `rtol = 1e-6`, `atol = 1e-9`, `max_steps = 100_000`,
 /// `h_init = None` (automatic), `h_min = 0` (only the floor of 16 ulp of
 /// `t`), `h_max = None` (the interval length), `max_newton = 7`,
-/// `adaptive = true`.
+/// `adaptive = true`, `event_tol = 1e-12`.
 ///
 /// ```
 /// use appell_runtime::integrate::TrBdf2;
@@ -119,6 +136,7 @@ pub struct TrBdf2 {
     h_max: Option<f64>,
     max_newton: usize,
     adaptive: bool,
+    event_tol: f64,
 }
 
 impl Default for TrBdf2 {
@@ -156,6 +174,111 @@ fn wrms(v: &[f64], sk: &[f64]) -> f64 {
 
 fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
+}
+
+/// An event function `g(t, x)`.
+type EventG<'a> = dyn FnMut(f64, &[f64]) -> f64 + 'a;
+
+/// Most iterations of the event search (the bracket shrinks long before).
+const EVENT_MAX_ITER: usize = 200;
+
+/// Overwrites `slot` with `x`.
+fn put(slot: &mut Vec<f64>, x: &[f64]) {
+    slot.clear();
+    slot.extend_from_slice(x);
+}
+
+/// The cubic Hermite interpolant of one accepted step from `(t, x0)` with
+/// derivative `f0` to `(t + h, x1)` with derivative `f1` (`h` signed).
+struct Hermite<'a> {
+    t: f64,
+    /// The end of the step (exactly).
+    t1: f64,
+    h: f64,
+    x0: &'a [f64],
+    f0: &'a [f64],
+    x1: &'a [f64],
+    f1: &'a [f64],
+}
+
+impl Hermite<'_> {
+    /// The interpolated state at `tau` into `slot` (resized).
+    fn at(&self, tau: f64, slot: &mut Vec<f64>) {
+        let s = (tau - self.t) / self.h;
+        let s2 = s * s;
+        let s3 = s2 * s;
+        let h00 = 2.0 * s3 - 3.0 * s2 + 1.0;
+        let h10 = (s3 - 2.0 * s2 + s) * self.h;
+        let h01 = 3.0 * s2 - 2.0 * s3;
+        let h11 = (s3 - s2) * self.h;
+        slot.clear();
+        slot.extend(
+            (0..self.x0.len())
+                .map(|i| h00 * self.x0[i] + h10 * self.f0[i] + h01 * self.x1[i] + h11 * self.f1[i]),
+        );
+    }
+}
+
+/// Illinois root finding of `g` on the dense output over its step (in the
+/// direction of integration), `g` at the start `ga` and at the end `gb`, of
+/// opposite signs or `gb = 0`, to `event_tol` (never below 4 ulp). Returns
+/// the far end of the final bracket and the state there.
+fn locate(
+    event_tol: f64,
+    g: &mut EventG<'_>,
+    dense: &Hermite<'_>,
+    ga: f64,
+    gb: f64,
+) -> Result<(f64, Vec<f64>), IntegrateError> {
+    let (mut lo, mut glo) = (dense.t, ga);
+    let (mut hi, mut ghi, mut xhi) = (dense.t1, gb, dense.x1.to_vec());
+    if ghi == 0.0 {
+        return Ok((hi, xhi));
+    }
+    let mut xc = Vec::with_capacity(xhi.len());
+    let mut side = 0i8;
+    for _ in 0..EVENT_MAX_ITER {
+        let tol = event_tol.max(4.0 * f64::EPSILON * lo.abs().max(hi.abs()));
+        if (hi - lo).abs() <= tol {
+            break;
+        }
+        let mut tc = (lo * ghi - hi * glo) / (ghi - glo);
+        let (mn, mx) = (lo.min(hi), lo.max(hi));
+        if !(tc > mn && tc < mx) {
+            tc = 0.5 * (lo + hi);
+            if !(tc > mn && tc < mx) {
+                break;
+            }
+        }
+        dense.at(tc, &mut xc);
+        if !all_finite(&xc) {
+            return Err(IntegrateError::NonFinite { t: tc });
+        }
+        let gc = g(tc, &xc);
+        if !gc.is_finite() {
+            return Err(IntegrateError::NonFinite { t: tc });
+        }
+        if gc == 0.0 {
+            return Ok((tc, xc));
+        }
+        if (gc > 0.0) == (ghi > 0.0) {
+            hi = tc;
+            ghi = gc;
+            core::mem::swap(&mut xhi, &mut xc);
+            if side == -1 {
+                glo *= 0.5;
+            }
+            side = -1;
+        } else {
+            lo = tc;
+            glo = gc;
+            if side == 1 {
+                ghi *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    Ok((hi, xhi))
 }
 
 /// How a Newton solve of a stage ended (model errors are passed on).
@@ -289,6 +412,7 @@ impl TrBdf2 {
             h_max: None,
             max_newton: 7,
             adaptive: true,
+            event_tol: 1e-12,
         }
     }
 
@@ -348,6 +472,14 @@ impl TrBdf2 {
         self
     }
 
+    /// Absolute time tolerance of event location (default `1e-12`; must be
+    /// ≥ 0; never tighter than 4 ulp of the event time), see
+    /// [`TrBdf2::solve_until`].
+    pub const fn event_tol(mut self, event_tol: f64) -> Self {
+        self.event_tol = event_tol;
+        self
+    }
+
     fn check_settings(&self) -> Result<(), IntegrateError> {
         let bad = |what| Err(IntegrateError::InvalidInput { what });
         if !(self.rtol >= 0.0 && self.rtol.is_finite()) {
@@ -378,6 +510,9 @@ impl TrBdf2 {
         if !self.adaptive && self.h_init.is_none() {
             return bad("a fixed-step integration needs h_init");
         }
+        if self.event_tol.is_nan() || self.event_tol < 0.0 {
+            return bad("event_tol must be >= 0");
+        }
         Ok(())
     }
 
@@ -400,7 +535,105 @@ impl TrBdf2 {
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
         J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
     {
-        self.run(f, jac, t0, x0, t_end)
+        self.run(f, jac, t0, x0, t_end, &mut [], None)
+    }
+
+    /// Integrates from `(t0, x0)` to the last time of `out` and writes the
+    /// state at each `out[i].0` (set by the caller) into `out[i].1` (the
+    /// vector is cleared and refilled with the `x0.len()` components), from
+    /// the dense output ([`TrBdf2`]). The times must be finite and ordered in
+    /// the direction of integration (which is that from `t0` to the last
+    /// time; equal times are allowed), else [`IntegrateError::InvalidInput`].
+    /// An empty `out` integrates nothing. [`TrBdf2Solution::outputs`] counts
+    /// the written entries; the solution holds the state at the last time.
+    ///
+    /// ```
+    /// use appell_runtime::integrate::TrBdf2;
+    /// use appell_runtime::ModelError;
+    ///
+    /// let f = |_t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+    ///     dx[0] = -x[0];
+    ///     Ok(())
+    /// };
+    /// let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+    ///     j[0] = -1.0;
+    ///     Ok(())
+    /// };
+    /// let mut out = vec![(0.5, vec![]), (1.0, vec![]), (2.0, vec![])];
+    /// let sol = TrBdf2::new()
+    ///     .rtol(1e-8)
+    ///     .atol(1e-10)
+    ///     .solve_at(f, jac, 0.0, &[1.0], &mut out)
+    ///     .unwrap();
+    /// assert_eq!((sol.t, sol.outputs), (2.0, 3));
+    /// for (t, x) in &out {
+    ///     assert!((x[0] - (-t).exp()).abs() < 1e-5);
+    /// }
+    /// ```
+    pub fn solve_at<F, J>(
+        &self,
+        f: F,
+        jac: J,
+        t0: f64,
+        x0: &[f64],
+        out: &mut [(f64, Vec<f64>)],
+    ) -> Result<TrBdf2Solution, IntegrateError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+        J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+    {
+        let t_end = out.last().map_or(t0, |o| o.0);
+        self.run(f, jac, t0, x0, t_end, out, None)
+    }
+
+    /// As [`TrBdf2::solve`], stopping at the first sign change of the event
+    /// function `g(t, x)` (see [`TrBdf2`]); [`TrBdf2Solution::event`] tells
+    /// whether it happened. A zero of `g` at `t0` is not an event; a
+    /// non-finite value of `g` is [`IntegrateError::NonFinite`].
+    ///
+    /// The reported time is the end of the final bracket on the far side of
+    /// the crossing (where `g` has its new sign or is zero), within
+    /// [`TrBdf2::event_tol`] of the root of `g` on the dense output; the
+    /// state there comes from the dense output.
+    ///
+    /// ```
+    /// use appell_runtime::integrate::TrBdf2;
+    /// use appell_runtime::ModelError;
+    ///
+    /// // x' = −x from 1: x = 1/2 at t = ln 2.
+    /// let f = |_t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+    ///     dx[0] = -x[0];
+    ///     Ok(())
+    /// };
+    /// let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+    ///     j[0] = -1.0;
+    ///     Ok(())
+    /// };
+    /// let g = |_t: f64, x: &[f64]| x[0] - 0.5;
+    /// let sol = TrBdf2::new()
+    ///     .rtol(1e-9)
+    ///     .atol(1e-12)
+    ///     .solve_until(f, jac, g, 0.0, &[1.0], 5.0)
+    ///     .unwrap();
+    /// assert!(sol.event);
+    /// assert!((sol.t - 2.0_f64.ln()).abs() < 1e-5);
+    /// assert!(sol.x[0] <= 0.5);
+    /// ```
+    pub fn solve_until<F, J, G>(
+        &self,
+        f: F,
+        jac: J,
+        mut g: G,
+        t0: f64,
+        x0: &[f64],
+        t_end: f64,
+    ) -> Result<TrBdf2Solution, IntegrateError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+        J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+        G: FnMut(f64, &[f64]) -> f64,
+    {
+        self.run(f, jac, t0, x0, t_end, &mut [], Some(&mut g))
     }
 
     /// Integrates a model's reduced equations ([`Model::rhs`]) from
@@ -420,6 +653,157 @@ impl TrBdf2 {
         x0: &[f64],
         t_end: f64,
         inputs: &[f64],
+    ) -> Result<TrBdf2Solution, IntegrateError> {
+        self.run_model(model, t0, x0, t_end, inputs, &mut [], None)
+    }
+
+    /// [`TrBdf2::solve_at`] of a model's reduced equations, as
+    /// [`TrBdf2::solve_model`].
+    ///
+    /// ```
+    /// use appell_runtime::integrate::TrBdf2;
+    /// use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+    /// # // A hand-written harmonic oscillator x'' = -w² x (what the derive would
+    /// # // generate has the same shape). Only `info`, `prepare` and `rhs` matter
+    /// # // to the integrator.
+    /// # struct Oscillator { w: f64 }
+    /// # static INFO: ModelInfo = ModelInfo {
+    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
+    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+    /// #     effects: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+    /// #     torques: 0, symbolic_elimination: true, rhs_ops: OpCounts {
+    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     equations: "x'' = -w^2 x",
+    /// # };
+    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+    /// # impl Model for Oscillator {
+    /// #     type Prepared<T: Scalar> = T;
+    /// #     fn info() -> &'static ModelInfo { &INFO }
+    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
+    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
+    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
+    /// #         appell_runtime::check_len("state", s, 2)?;
+    /// #         appell_runtime::check_len("dstate", ds, 2)?;
+    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
+    /// #     }
+    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+    /// # }
+    ///
+    /// // x'' = −w² x, x(0) = 1, x'(0) = 0: x(t) = cos(w t).
+    /// let model = Oscillator { w: 2.0 };
+    /// let mut out: Vec<(f64, Vec<f64>)> = (1..=10).map(|k| (0.1 * k as f64, vec![])).collect();
+    /// let sol = TrBdf2::new()
+    ///     .rtol(1e-9)
+    ///     .atol(1e-12)
+    ///     .solve_model_at(&model, 0.0, &[1.0, 0.0], &mut out, &[])
+    ///     .unwrap();
+    /// assert_eq!(sol.outputs, 10);
+    /// for (t, x) in &out {
+    ///     assert!((x[0] - (2.0 * t).cos()).abs() < 1e-6);
+    /// }
+    /// // Output times out of order are invalid input.
+    /// let mut bad = vec![(0.5, vec![]), (0.2, vec![])];
+    /// assert!(TrBdf2::new().solve_model_at(&model, 0.0, &[1.0, 0.0], &mut bad, &[]).is_err());
+    /// ```
+    pub fn solve_model_at<M: Model>(
+        &self,
+        model: &M,
+        t0: f64,
+        x0: &[f64],
+        out: &mut [(f64, Vec<f64>)],
+        inputs: &[f64],
+    ) -> Result<TrBdf2Solution, IntegrateError> {
+        let t_end = out.last().map_or(t0, |o| o.0);
+        self.run_model(model, t0, x0, t_end, inputs, out, None)
+    }
+
+    /// [`TrBdf2::solve_until`] of a model's reduced equations, as
+    /// [`TrBdf2::solve_model`].
+    ///
+    /// ```
+    /// use appell_runtime::integrate::TrBdf2;
+    /// use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+    /// # // A hand-written harmonic oscillator x'' = -w² x (what the derive would
+    /// # // generate has the same shape). Only `info`, `prepare` and `rhs` matter
+    /// # // to the integrator.
+    /// # struct Oscillator { w: f64 }
+    /// # static INFO: ModelInfo = ModelInfo {
+    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
+    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+    /// #     effects: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+    /// #     torques: 0, symbolic_elimination: true, rhs_ops: OpCounts {
+    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     equations: "x'' = -w^2 x",
+    /// # };
+    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+    /// # impl Model for Oscillator {
+    /// #     type Prepared<T: Scalar> = T;
+    /// #     fn info() -> &'static ModelInfo { &INFO }
+    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
+    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
+    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
+    /// #         appell_runtime::check_len("state", s, 2)?;
+    /// #         appell_runtime::check_len("dstate", ds, 2)?;
+    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
+    /// #     }
+    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+    /// # }
+    ///
+    /// // x = cos(2t) first reaches 0 at t = π/4.
+    /// let model = Oscillator { w: 2.0 };
+    /// let sol = TrBdf2::new()
+    ///     .rtol(1e-10)
+    ///     .atol(1e-12)
+    ///     .solve_model_until(&model, |_t, x: &[f64]| x[0], 0.0, &[1.0, 0.0], 10.0, &[])
+    ///     .unwrap();
+    /// assert!(sol.event);
+    /// assert!((sol.t - core::f64::consts::FRAC_PI_4).abs() < 1e-6);
+    /// ```
+    pub fn solve_model_until<M: Model, G>(
+        &self,
+        model: &M,
+        mut g: G,
+        t0: f64,
+        x0: &[f64],
+        t_end: f64,
+        inputs: &[f64],
+    ) -> Result<TrBdf2Solution, IntegrateError>
+    where
+        G: FnMut(f64, &[f64]) -> f64,
+    {
+        self.run_model(model, t0, x0, t_end, inputs, &mut [], Some(&mut g))
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_model<M: Model>(
+        &self,
+        model: &M,
+        t0: f64,
+        x0: &[f64],
+        t_end: f64,
+        inputs: &[f64],
+        out: &mut [(f64, Vec<f64>)],
+        event: Option<&mut EventG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError> {
         let n = M::info().state_len();
         check_len("state", x0, n)?;
@@ -445,11 +829,12 @@ impl TrBdf2 {
             }
             Ok(())
         };
-        let mut sol = self.run(f, jac, t0, x0, t_end)?;
+        let mut sol = self.run(f, jac, t0, x0, t_end, out, event)?;
         sol.stats.jacobian_rhs_calls = sol.stats.jacobians * n;
         Ok(sol)
     }
 
+    #[allow(clippy::too_many_arguments)]
     fn run<F, J>(
         &self,
         mut f: F,
@@ -457,6 +842,8 @@ impl TrBdf2 {
         t0: f64,
         x0: &[f64],
         t_end: f64,
+        out: &mut [(f64, Vec<f64>)],
+        mut event: Option<&mut EventG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError>
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
@@ -468,6 +855,18 @@ impl TrBdf2 {
                 what: "t0 and t_end must be finite",
             });
         }
+        let dir = if t_end >= t0 { 1.0 } else { -1.0 };
+        // Output times: finite, ordered, inside [t0, t_end].
+        let mut prev = t0;
+        for o in out.iter() {
+            let ti = o.0;
+            if !ti.is_finite() || (ti - prev) * dir < 0.0 || (ti - t_end) * dir > 0.0 {
+                return Err(IntegrateError::InvalidInput {
+                    what: "output times must be finite, ordered and within [t0, t_end]",
+                });
+            }
+            prev = ti;
+        }
         if !all_finite(x0) {
             return Err(IntegrateError::NonFinite { t: t0 });
         }
@@ -475,15 +874,31 @@ impl TrBdf2 {
         let mut stats = TrBdf2Stats::default();
         let mut t = t0;
         let mut x = x0.to_vec();
+        let mut next_out = 0;
+        while next_out < out.len() && out[next_out].0 == t0 {
+            put(&mut out[next_out].1, &x);
+            next_out += 1;
+        }
+        let mut g_old = match event.as_mut() {
+            Some(g) => {
+                let v = g(t, &x);
+                if !v.is_finite() {
+                    return Err(IntegrateError::NonFinite { t });
+                }
+                v
+            }
+            None => 0.0,
+        };
         if t_end == t0 {
             return Ok(TrBdf2Solution {
                 t,
                 x,
                 stats,
                 h_next: 0.0,
+                event: false,
+                outputs: next_out,
             });
         }
-        let dir = if t_end > t0 { 1.0 } else { -1.0 };
 
         let mut f0 = vec![0.0; n];
         stats.rhs_calls += 1;
@@ -658,7 +1073,62 @@ impl TrBdf2 {
             let accept = !self.adaptive || err <= 1.0;
             if accept {
                 stats.accepted += 1;
-                t = if last { t_end } else { t + hs };
+                let t_new = if last { t_end } else { t + hs };
+
+                // Event at the end of the step.
+                let mut crossed = false;
+                let mut g_new = 0.0;
+                if let Some(g) = event.as_mut() {
+                    g_new = g(t_new, &y3);
+                    if !g_new.is_finite() {
+                        return Err(IntegrateError::NonFinite { t });
+                    }
+                    crossed = g_old != 0.0 && (g_new == 0.0 || (g_new > 0.0) != (g_old > 0.0));
+                }
+                let dense = Hermite {
+                    t,
+                    t1: t_new,
+                    h: t_new - t,
+                    x0: &x,
+                    f0: &f0,
+                    x1: &y3,
+                    f1: &f3,
+                };
+                let mut stop: Option<(f64, Vec<f64>)> = None;
+                if crossed {
+                    if let Some(g) = event.as_mut() {
+                        stop = Some(locate(self.event_tol, &mut **g, &dense, g_old, g_new)?);
+                    }
+                }
+                g_old = g_new;
+
+                // Outputs up to the end of the step (or the event).
+                let t_stop = stop.as_ref().map_or(t_new, |s| s.0);
+                while next_out < out.len() && (out[next_out].0 - t_stop) * dir <= 0.0 {
+                    let to = out[next_out].0;
+                    let slot = &mut out[next_out].1;
+                    if to == t_new {
+                        put(slot, &y3);
+                    } else {
+                        dense.at(to, slot);
+                        if !all_finite(slot) {
+                            return Err(IntegrateError::NonFinite { t });
+                        }
+                    }
+                    next_out += 1;
+                }
+                if let Some((te, xe)) = stop {
+                    return Ok(TrBdf2Solution {
+                        t: te,
+                        x: xe,
+                        stats,
+                        h_next: h,
+                        event: true,
+                        outputs: next_out,
+                    });
+                }
+
+                t = t_new;
                 x.copy_from_slice(&y3);
                 f0.copy_from_slice(&f3);
                 for i in 0..n {
@@ -692,6 +1162,8 @@ impl TrBdf2 {
                         x,
                         stats,
                         h_next: h_new,
+                        event: false,
+                        outputs: next_out,
                     });
                 }
                 h = h_new;
