@@ -194,30 +194,27 @@ fn integrate<M: Model, const S: usize>(
             ))
         }
         Method::TrBdf2(tol) => {
-            // TR-BDF2 has no dense output: integrate checkpoint to
-            // checkpoint, carrying the proposed step size over.
-            let mut solver = TrBdf2::new()
+            let mut out: Vec<(f64, Vec<f64>)> = (1..=checkpoints)
+                .map(|k| (t_end * k as f64 / checkpoints as f64, Vec::new()))
+                .collect();
+            let sol = TrBdf2::new()
                 .rtol(tol)
                 .atol(tol * 1e-2)
-                .max_steps(10_000_000);
-            let mut x = pb.x0.to_vec();
-            let mut t = 0.0;
-            let (mut calls, mut steps) = (0u64, 0u64);
-            let mut out = Vec::with_capacity(checkpoints);
-            for k in 1..=checkpoints {
-                let t_next = t_end * k as f64 / checkpoints as f64;
-                let sol = solver.solve_model(model, t, &x, t_next, inputs)?;
-                calls += (sol.stats.rhs_calls + sol.stats.jacobian_rhs_calls) as u64;
-                steps += (sol.stats.accepted + sol.stats.rejected) as u64;
-                if sol.h_next.is_finite() && sol.h_next > 0.0 {
-                    solver = solver.h_init(Some(sol.h_next));
-                }
-                let mut state = [0.0; S];
-                state.copy_from_slice(&sol.x);
-                out.push(state);
-                (t, x) = (t_next, sol.x);
-            }
-            Ok((out, calls, steps))
+                .max_steps(10_000_000)
+                .solve_model_at(model, 0.0, &pb.x0, &mut out, inputs)?;
+            let states = out
+                .iter()
+                .map(|(_, x)| {
+                    let mut state = [0.0; S];
+                    state.copy_from_slice(x);
+                    state
+                })
+                .collect();
+            Ok((
+                states,
+                (sol.stats.rhs_calls + sol.stats.jacobian_rhs_calls) as u64,
+                (sol.stats.accepted + sol.stats.rejected) as u64,
+            ))
         }
         Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => {
             let prepared = model.prepare::<f64>();
