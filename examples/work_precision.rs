@@ -93,7 +93,7 @@ fn main() -> Result<(), Box<dyn Error>> {
     let (reference, _) = axle_pb.reference()?;
     let end = reference.last().copied().unwrap_or_default();
     let mut f32_rows = Vec::new();
-    writeln!(summary, "\n## RK4 in f32 and f64 (wheel-axle)\n\n| steps | error f64 | error f32 |\n| ---: | ---: | ---: |")?;
+    writeln!(summary, "\n## RK4 in f32 and f64 (wheel-axle)\n\n![RK4 in f32 and f64](rk4_f32_f64.svg)\n\n| steps | error f64 | error f32 |\n| ---: | ---: | ---: |")?;
     for k in 0..levels.min(8) {
         let n = 100usize << k;
         let h = 10.0 / n as f64;
@@ -130,6 +130,18 @@ fn main() -> Result<(), Box<dyn Error>> {
         writeln!(csv32, "{n},{a:e},{b:e}")?;
     }
     std::fs::write(dir.join("rk4_f32_f64.csv"), csv32)?;
+    let line = |pick: fn(&(usize, f64, f64)) -> f64| -> Vec<(f64, f64)> {
+        f32_rows.iter().map(|r| (r.0 as f64, pick(r))).collect()
+    };
+    std::fs::write(
+        dir.join("rk4_f32_f64.svg"),
+        accuracy::svg_loglog(
+            "RK4 on the wheel-axle, 10 s: f64 and f32",
+            "steps",
+            "relative error at the final time",
+            &[("f64", line(|r| r.1)), ("f32", line(|r| r.2))],
+        ),
+    )?;
 
     // The oracle (multiplier route) as the rhs of the same RK4, at equal steps.
     writeln!(summary, "\n## Generated code against the multiplier oracle (RK4, wheel-axle)\n\n| steps | error | generated | oracle | ratio |\n| ---: | ---: | ---: | ---: | ---: |")?;

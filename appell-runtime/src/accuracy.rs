@@ -270,21 +270,61 @@ pub fn standard_methods(min_steps: usize, levels: usize) -> Vec<Method> {
 /// A log–log chart (error against time) as a self-contained SVG document,
 /// one polyline per method name; `title` on top.
 pub fn svg_chart(title: &str, points: &[Point]) -> String {
-    let (w, h, left, bottom, top, right) = (720.0, 480.0, 80.0, 60.0, 40.0, 150.0);
-    let pts: Vec<&Point> = points
-        .iter()
-        .filter(|p| p.error_final > 0.0 && p.seconds > 0.0 && p.error_final.is_finite())
+    let series: Vec<(&str, Vec<(f64, f64)>)> = method_names(points)
+        .into_iter()
+        .map(|name| {
+            let line = points
+                .iter()
+                .filter(|p| p.method.name() == name)
+                .map(|p| (p.seconds, p.error_final))
+                .collect();
+            (name, line)
+        })
         .collect();
-    let lx = |p: &Point| p.seconds.log10();
-    let ly = |p: &Point| p.error_final.max(1e-17).log10();
+    svg_loglog(
+        title,
+        "wall time per integration [s]",
+        "relative error at the final time",
+        &series,
+    )
+}
+
+/// A log–log line chart as a self-contained SVG document: one polyline per
+/// named series of `(x, y)` points (sorted by x; points that are not
+/// positive and finite are left out), decade grid lines, axis labels and a
+/// legend.
+///
+/// ```
+/// use appell_runtime::accuracy::svg_loglog;
+/// let f64_line = vec![(100.0, 7.6e-7), (200.0, 4.7e-8), (400.0, 2.9e-9)];
+/// let f32_line = vec![(100.0, 5.3e-7), (200.0, 8.1e-7), (400.0, 6.9e-7)];
+/// let svg = svg_loglog("RK4", "steps", "error", &[("f64", f64_line), ("f32", f32_line)]);
+/// assert!(svg.starts_with("<svg") && svg.matches("<polyline").count() == 2);
+/// ```
+pub fn svg_loglog(
+    title: &str,
+    x_label: &str,
+    y_label: &str,
+    series: &[(&str, Vec<(f64, f64)>)],
+) -> String {
+    let (w, h, left, bottom, top, right) = (720.0, 480.0, 80.0, 60.0, 40.0, 150.0);
+    let good = |&(x, y): &(f64, f64)| x > 0.0 && y > 0.0 && x.is_finite() && y.is_finite();
+    let lx = |p: &(f64, f64)| p.0.log10();
+    let ly = |p: &(f64, f64)| p.1.max(1e-17).log10();
     let (mut x0, mut x1, mut y0, mut y1) = (f64::MAX, f64::MIN, f64::MAX, f64::MIN);
-    for p in &pts {
+    let mut any = false;
+    for p in series
+        .iter()
+        .flat_map(|(_, line)| line.iter())
+        .filter(|p| good(p))
+    {
+        any = true;
         x0 = x0.min(lx(p).floor());
         x1 = x1.max(lx(p).ceil());
         y0 = y0.min(ly(p).floor());
         y1 = y1.max(ly(p).ceil());
     }
-    if pts.is_empty() {
+    if !any {
         (x0, x1, y0, y1) = (-6.0, 0.0, -16.0, 0.0);
     }
     if x1 <= x0 {
@@ -322,28 +362,22 @@ pub fn svg_chart(title: &str, points: &[Point]) -> String {
         );
     }
     s += &format!(
-        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">wall time per integration [s]</text>\n\
-         <text x=\"18\" y=\"{}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {})\">relative error at the final time</text>\n",
+        "<text x=\"{}\" y=\"{}\" text-anchor=\"middle\">{}</text>\n\
+         <text x=\"18\" y=\"{}\" text-anchor=\"middle\" transform=\"rotate(-90 18 {})\">{}</text>\n",
         (sx(x0) + sx(x1)) / 2.0,
         h - 12.0,
+        escape(x_label),
         (sy(y0) + sy(y1)) / 2.0,
-        (sy(y0) + sy(y1)) / 2.0
+        (sy(y0) + sy(y1)) / 2.0,
+        escape(y_label)
     );
     let colors = [
         "#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b",
     ];
-    let mut names: Vec<&str> = pts.iter().map(|p| p.method.name()).collect();
-    names.dedup();
-    let mut seen: Vec<&str> = Vec::new();
-    for n in names {
-        if !seen.contains(&n) {
-            seen.push(n);
-        }
-    }
-    for (k, name) in seen.iter().enumerate() {
+    for (k, (name, line)) in series.iter().enumerate() {
         let color = colors[k % colors.len()];
-        let mut line: Vec<&&Point> = pts.iter().filter(|p| p.method.name() == *name).collect();
-        line.sort_by(|a, b| a.seconds.total_cmp(&b.seconds));
+        let mut line: Vec<&(f64, f64)> = line.iter().filter(|p| good(p)).collect();
+        line.sort_by(|a, b| a.0.total_cmp(&b.0));
         let path: Vec<String> = line
             .iter()
             .map(|p| format!("{:.2},{:.2}", sx(lx(p)), sy(ly(p))))
@@ -361,11 +395,12 @@ pub fn svg_chart(title: &str, points: &[Point]) -> String {
         }
         let ly_legend = top + 20.0 + 20.0 * k as f64;
         s += &format!(
-            "<line x1=\"{}\" y1=\"{ly_legend}\" x2=\"{}\" y2=\"{ly_legend}\" stroke=\"{color}\" stroke-width=\"2\"/><text x=\"{}\" y=\"{}\">{name}</text>\n",
+            "<line x1=\"{}\" y1=\"{ly_legend}\" x2=\"{}\" y2=\"{ly_legend}\" stroke=\"{color}\" stroke-width=\"2\"/><text x=\"{}\" y=\"{}\">{}</text>\n",
             w - right + 15.0,
             w - right + 40.0,
             w - right + 46.0,
-            ly_legend + 4.0
+            ly_legend + 4.0,
+            escape(name)
         );
     }
     s += "</svg>\n";
