@@ -653,14 +653,5 @@ impl Dop853 {
         self
     }
 
-    /// Error control on (default `true`). With `false`, every step has the
-    /// size [`Dop853::h_init`] (required; the last step is cut to end at
-    /// `t_end`, and [`Dop853::h_max`] is ignored) and is accepted without an
-    /// error estimate; a non-finite state is reported at once.
-    pub const fn adaptive(mut self, adaptive: bool) -> Self {
-        self.set.adaptive = adaptive;
-        self
-    }
-
     explicit::explicit_api!(Dop853, Stages);
 }

@@ -427,14 +427,5 @@ impl Dopri5 {
         self
     }
 
-    /// Error control on (default `true`). With `false`, every step has the
-    /// size [`Dopri5::h_init`] (required; the last step is cut to end at
-    /// `t_end`, and [`Dopri5::h_max`] is ignored) and is accepted without an
-    /// error estimate: a fixed-step order-5 method with dense output.
-    pub const fn adaptive(mut self, adaptive: bool) -> Self {
-        self.set.adaptive = adaptive;
-        self
-    }
-
     explicit::explicit_api!(Dopri5, Stages);
 }

@@ -589,6 +589,16 @@ fn locate<T: Scalar, D: DenseOutput<T, S>, const S: usize>(
 /// method is `$pair<T, S>`.
 macro_rules! explicit_api {
     ($ty:ident, $pair:ident) => {
+        /// Error control on (default `true`). With `false`, every step has the
+        #[doc = concat!("size [`", stringify!($ty), "::h_init`] (required; the last step is cut to end at")]
+        #[doc = concat!("`t_end`, and [`", stringify!($ty), "::h_max`] is ignored) and is accepted without an")]
+        /// error estimate (a fixed-step method with dense output, for
+        /// convergence studies); a non-finite state is reported at once.
+        pub const fn adaptive(mut self, adaptive: bool) -> Self {
+            self.set.adaptive = adaptive;
+            self
+        }
+
         /// Relative tolerance (default `1e-6`; must be ≥ 0).
         pub const fn rtol(mut self, rtol: f64) -> Self {
             self.set.rtol = rtol;
