@@ -233,3 +233,37 @@ fn input_power_is_torque_times_wheel_rate() {
         0.0
     );
 }
+
+#[test]
+fn energy_rate_is_the_input_power_in_every_scene() {
+    // Gravity lives in V and rolling without slip does no work, so
+    // d(T + V)/dt is the drive torque's power τ ψ̇1 in the full model, zero
+    // in the coasting scene, and again τ ψ̇1 in the driven scene (V = 0).
+    use appell::energy::energies;
+    let p = WheelAxle::default();
+    let mut rng = Rng(0xe4e7);
+    let mut worst: f64 = 0.0;
+    for _ in 0..1000 {
+        let q: Vec<f64> = (0..7).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let u = [rng.uniform(-3.0, 3.0), rng.uniform(-10.0, 10.0)];
+        let tau = [rng.uniform(-2.0, 2.0)];
+        let full = energies(&p, 0.0, &q, &u, &tau).unwrap();
+        let coasting = energies(&WheelAxleCoasting(p.clone()), 0.0, &q, &u, &tau).unwrap();
+        let driven = energies(&WheelAxleDriven(p.clone()), 0.0, &q, &u, &tau).unwrap();
+        let scale = 1.0 + full.kinetic.abs() + full.potential.abs();
+        assert!(close(full.input_power, tau[0] * u[1], 1e-15));
+        assert_eq!(driven.potential, 0.0);
+        for (rate, power) in [
+            (full.rate, full.input_power),
+            (coasting.rate, 0.0),
+            (driven.rate, driven.input_power),
+        ] {
+            worst = worst.max((rate - power).abs() / scale);
+        }
+    }
+    println!("wheel-axle: |d(T+V)/dt − input power| / (1 + |T| + |V|) at most {worst:.2e}");
+    assert!(worst < 1e-12, "{worst:e}");
+    // Bad arguments are typed errors.
+    assert!(energies(&p, 0.0, &[0.0; 6], &[0.0; 2], &[0.0]).is_err());
+    assert!(energies(&p, f64::NAN, &[0.0; 7], &[0.0; 2], &[0.0]).is_err());
+}

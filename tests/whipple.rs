@@ -144,3 +144,28 @@ fn coasting_scene_is_the_bicycle_without_its_rider() {
         WhippleBicycleCoasting::info().rhs_ops.total < WhippleBicycleRidden::info().rhs_ops.total
     );
 }
+
+#[test]
+fn energy_rate_is_the_riders_power() {
+    // No friction, rolling without slip, gravity in V: d(T + V)/dt is the
+    // power of the steer torque, at any state.
+    let p = WhippleBicycle::default();
+    let mut seed = 0xb1c_u64;
+    let mut next = |lo: f64, hi: f64| {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        lo + (hi - lo) * ((seed >> 11) as f64 / (1u64 << 53) as f64)
+    };
+    let mut worst: f64 = 0.0;
+    for _ in 0..200 {
+        let mut q: Vec<f64> = (0..8).map(|_| next(-1.0, 1.0)).collect();
+        q[4] = std::f64::consts::PI / 10.0 + next(-0.2, 0.2);
+        let u = [next(-2.0, 2.0), next(-20.0, 0.0), next(-2.0, 2.0)];
+        let steer = [next(-5.0, 5.0)];
+        let e = appell::energy::energies(&p, 0.0, &q, &u, &steer).unwrap();
+        worst = worst.max((e.rate - e.input_power).abs() / (1.0 + e.kinetic + e.potential.abs()));
+    }
+    println!("bicycle: |d(T+V)/dt − rider's power| / (1 + T + |V|) at most {worst:.2e}");
+    assert!(worst < 1e-12, "{worst:e}");
+}

@@ -16,6 +16,8 @@
 pub mod accuracy;
 #[cfg(feature = "std")]
 pub mod cli;
+#[cfg(feature = "std")]
+pub mod energy;
 pub mod integrate;
 pub mod linalg;
 #[cfg(feature = "std")]
