@@ -627,7 +627,7 @@ fn error_norm<T: Scalar, const S: usize>(
     if deno <= 0.0 {
         deno = 1.0;
     }
-    hs.abs() * e5 / libm::sqrt(S as f64 * deno)
+    hs.abs() * e5 / explicit::sqrt(S as f64 * deno)
 }
 
 impl Dop853 {

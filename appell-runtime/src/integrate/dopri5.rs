@@ -358,7 +358,7 @@ impl<T: Scalar, const S: usize> EmbeddedPair<T, S> for Stages<T, S> {
         let err = if S == 0 || !set.adaptive {
             0.0
         } else {
-            libm::sqrt(err / S as f64)
+            explicit::sqrt(err / S as f64)
         };
         if !err.is_finite() || !all_finite(k7) {
             return Ok(None);
