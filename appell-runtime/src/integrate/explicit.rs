@@ -463,16 +463,9 @@ where
             let mut stop: Option<(f64, [T; S])> = None;
             if crossed {
                 if let (Some(g), Some(d)) = (event.as_mut(), dense.as_ref()) {
-                    stop = Some(locate(
-                        set.event_tol,
-                        &mut **g,
-                        d,
-                        t,
-                        g_old,
-                        t_new,
-                        g_new,
-                        &x_new,
-                    )?);
+                    let on_dense = |tc: f64| Ok(g(tc, &d.at(tc)));
+                    let te = illinois(set.event_tol, on_dense, t, g_old, t_new, g_new)?;
+                    stop = Some((te, if te == t_new { x_new } else { d.at(te) }));
                 } else {
                     // g is exactly zero at the end of the step.
                     stop = Some((t_new, x_new));
@@ -542,25 +535,23 @@ where
     }
 }
 
-/// Illinois root finding of `g` on the dense output over `[a, b]` (in the
-/// direction of integration), `g(a) = ga`, `g(b) = gb` of opposite signs or
-/// `gb = 0`, to `event_tol` (never below 4 ulp). Returns the far end of the
-/// final bracket.
-#[allow(clippy::too_many_arguments)]
-fn locate<T: Scalar, D: DenseOutput<T, S>, const S: usize>(
+/// Illinois root finding of an event function `g(t)` (evaluated on a dense
+/// output) over `[a, b]` (in the direction of integration), `g(a) = ga`,
+/// `g(b) = gb` of opposite signs or `gb = 0`, to `event_tol` (never below 4
+/// ulp). Returns the far end of the final bracket: where `g` has its new
+/// sign or is zero. Shared by every integrator with events.
+pub(super) fn illinois(
     event_tol: f64,
-    g: &mut dyn FnMut(f64, &[T; S]) -> f64,
-    dense: &D,
+    mut g: impl FnMut(f64) -> Result<f64, IntegrateError>,
     a: f64,
     ga: f64,
     b: f64,
     gb: f64,
-    xb: &[T; S],
-) -> Result<(f64, [T; S]), IntegrateError> {
+) -> Result<f64, IntegrateError> {
     let (mut lo, mut glo) = (a, ga);
-    let (mut hi, mut ghi, mut xhi) = (b, gb, *xb);
+    let (mut hi, mut ghi) = (b, gb);
     if ghi == 0.0 {
-        return Ok((hi, xhi));
+        return Ok(hi);
     }
     let mut side = 0i8;
     for _ in 0..EVENT_MAX_ITER {
@@ -576,18 +567,16 @@ fn locate<T: Scalar, D: DenseOutput<T, S>, const S: usize>(
                 break;
             }
         }
-        let xc = dense.at(tc);
-        let gc = g(tc, &xc);
+        let gc = g(tc)?;
         if !gc.is_finite() {
             return Err(IntegrateError::NonFinite { t: tc });
         }
         if gc == 0.0 {
-            return Ok((tc, xc));
+            return Ok(tc);
         }
         if (gc > 0.0) == (ghi > 0.0) {
             hi = tc;
             ghi = gc;
-            xhi = xc;
             if side == -1 {
                 glo *= 0.5;
             }
@@ -601,7 +590,7 @@ fn locate<T: Scalar, D: DenseOutput<T, S>, const S: usize>(
             side = 1;
         }
     }
-    Ok((hi, xhi))
+    Ok(hi)
 }
 
 /// The builder setters common to both integrators and the public `solve*`

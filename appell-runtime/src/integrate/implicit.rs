@@ -1,5 +1,6 @@
 //! Adaptive implicit integration for stiff models: TR-BDF2 (std only).
 
+use super::explicit::illinois;
 use super::IntegrateError;
 use crate::model::{check_len, Model, ModelError};
 use nalgebra::{DMatrix, DVector};
@@ -179,9 +180,6 @@ fn all_finite(v: &[f64]) -> bool {
 /// An event function `g(t, x)`.
 type EventG<'a> = dyn FnMut(f64, &[f64]) -> f64 + 'a;
 
-/// Most iterations of the event search (the bracket shrinks long before).
-const EVENT_MAX_ITER: usize = 200;
-
 /// Overwrites `slot` with `x`.
 fn put(slot: &mut Vec<f64>, x: &[f64]) {
     slot.clear();
@@ -219,10 +217,11 @@ impl Hermite<'_> {
     }
 }
 
-/// Illinois root finding of `g` on the dense output over its step (in the
-/// direction of integration), `g` at the start `ga` and at the end `gb`, of
-/// opposite signs or `gb = 0`, to `event_tol` (never below 4 ulp). Returns
-/// the far end of the final bracket and the state there.
+/// The event of `g` inside the step of `dense` (`g` is `ga` at its start
+/// and `gb` at its end, of opposite signs or `gb = 0`), located by
+/// [`illinois`] on the interpolant: the far end of the final bracket and
+/// the state there (the step's end state exactly when the bracket did not
+/// move).
 fn locate(
     event_tol: f64,
     g: &mut EventG<'_>,
@@ -230,55 +229,23 @@ fn locate(
     ga: f64,
     gb: f64,
 ) -> Result<(f64, Vec<f64>), IntegrateError> {
-    let (mut lo, mut glo) = (dense.t, ga);
-    let (mut hi, mut ghi, mut xhi) = (dense.t1, gb, dense.x1.to_vec());
-    if ghi == 0.0 {
-        return Ok((hi, xhi));
-    }
-    let mut xc = Vec::with_capacity(xhi.len());
-    let mut side = 0i8;
-    for _ in 0..EVENT_MAX_ITER {
-        let tol = event_tol.max(4.0 * f64::EPSILON * lo.abs().max(hi.abs()));
-        if (hi - lo).abs() <= tol {
-            break;
-        }
-        let mut tc = (lo * ghi - hi * glo) / (ghi - glo);
-        let (mn, mx) = (lo.min(hi), lo.max(hi));
-        if !(tc > mn && tc < mx) {
-            tc = 0.5 * (lo + hi);
-            if !(tc > mn && tc < mx) {
-                break;
-            }
-        }
+    let mut xc = Vec::with_capacity(dense.x1.len());
+    let on_dense = |tc: f64| {
         dense.at(tc, &mut xc);
-        if !all_finite(&xc) {
-            return Err(IntegrateError::NonFinite { t: tc });
-        }
-        let gc = g(tc, &xc);
-        if !gc.is_finite() {
-            return Err(IntegrateError::NonFinite { t: tc });
-        }
-        if gc == 0.0 {
-            return Ok((tc, xc));
-        }
-        if (gc > 0.0) == (ghi > 0.0) {
-            hi = tc;
-            ghi = gc;
-            core::mem::swap(&mut xhi, &mut xc);
-            if side == -1 {
-                glo *= 0.5;
-            }
-            side = -1;
+        if all_finite(&xc) {
+            Ok(g(tc, &xc))
         } else {
-            lo = tc;
-            glo = gc;
-            if side == 1 {
-                ghi *= 0.5;
-            }
-            side = 1;
+            Err(IntegrateError::NonFinite { t: tc })
         }
+    };
+    let te = illinois(event_tol, on_dense, dense.t, ga, dense.t1, gb)?;
+    if te == dense.t1 {
+        Ok((te, dense.x1.to_vec()))
+    } else {
+        let mut xe = Vec::with_capacity(dense.x1.len());
+        dense.at(te, &mut xe);
+        Ok((te, xe))
     }
-    Ok((hi, xhi))
 }
 
 /// How a Newton solve of a stage ended (model errors are passed on).
