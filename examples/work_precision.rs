@@ -1,17 +1,21 @@
 //! What accuracy costs: every integrator over a sweep of step sizes or
-//! tolerances on the wheel-axle (10 s, drive torque on) and the rolling disc
-//! (5 s), error against a reference at much higher accuracy, wall time as the
-//! median of repeated runs. Writes, under `docs/work_precision/`, an SVG chart
-//! and a CSV per model, the f32-vs-f64 RK4 comparison, the cost of the
-//! multiplier oracle at equal accuracy, and a markdown summary.
+//! tolerances on the wheel-axle (10 s, drive torque on), the rolling disc
+//! (5 s) and the Whipple bicycle (5 s), error against a reference at much
+//! higher accuracy, wall time as the median of repeated runs. Writes, under
+//! `docs/work_precision/`, an SVG chart and a CSV per model, the f32-vs-f64
+//! RK4 comparison, the cost of the multiplier oracle at equal accuracy, and
+//! a markdown summary.
 //!
-//! `cargo run --release --example work_precision` (about a minute);
+//! `cargo run --release --example work_precision` (a few seconds);
 //! `-- --quick` for a reduced sweep.
 
 #[path = "models/rolling_disc.rs"]
 mod rolling_disc;
 #[path = "models/wheel_axle.rs"]
 mod wheel_axle;
+#[allow(dead_code)] // the model file's helpers serve other programs
+#[path = "models/whipple_bicycle.rs"]
+mod whipple_bicycle;
 
 use std::error::Error;
 use std::fmt::Write as _;
@@ -83,6 +87,35 @@ fn main() -> Result<(), Box<dyn Error>> {
         "rolling disc, 5 s",
         "rolling_disc",
         &disc_pb,
+        levels,
+        repeats,
+        dir,
+        &mut summary,
+    )?;
+
+    // The benchmark bicycle at 4.6 m/s (self-stable), leaning 0.1 rad and
+    // steering 0.05 rad, its pitch made consistent first.
+    let bike = whipple_bicycle::WhippleBicycle::default();
+    let mut bike_x0 = [
+        0.1,
+        std::f64::consts::PI / 10.0,
+        0.05,
+        0.3,
+        -4.6 / bike.rr,
+        0.0,
+    ];
+    appell::linearize::project_holonomic(&bike, 0.0, &mut bike_x0, 1e-14, 30)?;
+    let bike_pb = Problem {
+        model: &bike,
+        x0: bike_x0,
+        t_end: 5.0,
+        inputs: &[0.0],
+        checkpoints: 10,
+    };
+    run(
+        "Whipple bicycle, 5 s at 4.6 m/s",
+        "whipple_bicycle",
+        &bike_pb,
         levels,
         repeats,
         dir,
