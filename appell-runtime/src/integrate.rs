@@ -68,19 +68,7 @@ where
     F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
 {
     let half_h = h * T::from_f64(0.5);
-    let mut k1 = [T::zero(); S];
-    f(t, state, &mut k1)?;
-    let mut x = *state;
-    for i in 0..S {
-        x[i] = state[i] + h * k1[i];
-    }
-    let mut k2 = [T::zero(); S];
-    f(t + h, &x, &mut k2)?;
-    let mut out = *state;
-    for i in 0..S {
-        out[i] = state[i] + half_h * (k1[i] + k2[i]);
-    }
-    finite_state(out)
+    two_stage(f, t, h, h, state, |k1, k2| half_h * (k1 + k2))
 }
 
 /// One step of the explicit midpoint method (order 2) of `dx/dt = f(t, x)`
@@ -111,17 +99,34 @@ where
     F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
 {
     let half_h = h * T::from_f64(0.5);
+    two_stage(f, t, half_h, half_h, state, |_, k2| h * k2)
+}
+
+/// A two-stage explicit step: `k1 = f(t, x)`, `k2 = f(t + c, x + a k1)`,
+/// then `x + increment(k1, k2)` componentwise, checked to be finite.
+fn two_stage<T, F, const S: usize>(
+    f: &mut F,
+    t: T,
+    c: T,
+    a: T,
+    state: &[T; S],
+    increment: impl Fn(T, T) -> T,
+) -> Result<[T; S], ModelError>
+where
+    T: Scalar,
+    F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
+{
     let mut k1 = [T::zero(); S];
     f(t, state, &mut k1)?;
     let mut x = *state;
     for i in 0..S {
-        x[i] = state[i] + half_h * k1[i];
+        x[i] = state[i] + a * k1[i];
     }
     let mut k2 = [T::zero(); S];
-    f(t + half_h, &x, &mut k2)?;
+    f(t + c, &x, &mut k2)?;
     let mut out = *state;
     for i in 0..S {
-        out[i] = state[i] + h * k2[i];
+        out[i] = state[i] + increment(k1[i], k2[i]);
     }
     finite_state(out)
 }
