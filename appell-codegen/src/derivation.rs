@@ -54,6 +54,9 @@ pub struct NumericElimination {
     pub rhs: Vec<Id>,
     /// (Ṙ − Ṡ X) [ẏ; 1] (k), the right side for w; contains X and ẏ.
     pub rhs_rate: Vec<Id>,
+    /// The columns j of R that are not identically zero (X_fj = 0 in the
+    /// others, and their symbols occur nowhere).
+    pub columns: Vec<usize>,
     /// Symbols of X (k×(l+1)).
     pub x: Vec<Symbol>,
     /// Symbols of w = Ẋ [ẏ; 1] (k), the dependent acceleration remainder.
@@ -509,66 +512,86 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // Unknowns with safe pivots are eliminated symbolically; the rest (the
     // Schur complement S x_f = R_s) is solved numerically at run time, the
     // free unknowns standing as auxiliary symbols X_f in the expressions.
-    #[allow(clippy::type_complexity)] // (aux symbols, S, R_s) of the numeric part
-    let (x_entries, numeric_part): (Vec<Id>, Option<(Vec<Symbol>, usize, Vec<Id>, Vec<Id>)>) =
-        if k_unknowns == 0 {
-            (Vec::new(), None)
-        } else {
-            match g.eliminate(&dp_m, &rhs_m, &assume) {
-                Ok(part) => {
-                    let k = part.free_cols.len();
-                    let zero = g.int(0)?;
-                    let mut x_entries = vec![zero; k_unknowns * (l + 1)];
-                    let mut syms = Vec::new();
-                    let mut ids = Vec::new();
-                    for f in 0..k {
-                        for j in 0..=l {
-                            let s = g.declare(&format!("__x_{f}_{j}"), SymbolKind::Auxiliary)?;
-                            ids.push(g.sym(s)?);
-                            syms.push(s);
+    let mut vanishing: Vec<Symbol> = Vec::new();
+    #[allow(clippy::type_complexity)] // (aux symbols, their values, k, S, R_s) of the numeric part
+    let (x_entries, numeric_part): (
+        Vec<Id>,
+        Option<(Vec<Symbol>, Vec<Id>, usize, Vec<Id>, Vec<Id>)>,
+    ) = if k_unknowns == 0 {
+        (Vec::new(), None)
+    } else {
+        match g.eliminate(&dp_m, &rhs_m, &assume) {
+            Ok(part) => {
+                let k = part.free_cols.len();
+                let zero = g.int(0)?;
+                let mut x_entries = vec![zero; k_unknowns * (l + 1)];
+                let mut syms = Vec::new();
+                let mut ids = Vec::new();
+                // A column of R that is identically zero has X = 0 there.
+                // A speed column's symbols are replaced by zero at once;
+                // the last column's (from d, zero for a scleronomic
+                // system) stay through the differentiation, because their
+                // rate carries w = Ẋ [ẏ; 1] into the accelerations, and
+                // are set to zero afterwards.
+                let zero_column: Vec<bool> = (0..=l)
+                    .map(|j| (0..k).all(|i| g.is_zero(part.s_rhs[(i, j)])))
+                    .collect();
+                for f in 0..k {
+                    for j in 0..=l {
+                        let s = g.declare(&format!("__x_{f}_{j}"), SymbolKind::Auxiliary)?;
+                        ids.push(if zero_column[j] && j < l {
+                            zero
+                        } else {
+                            g.sym(s)?
+                        });
+                        if zero_column[j] && j == l {
+                            vanishing.push(s);
                         }
-                    }
-                    for (f, &col) in part.free_cols.iter().enumerate() {
-                        for j in 0..=l {
-                            x_entries[col * (l + 1) + j] = ids[f * (l + 1) + j];
-                        }
-                    }
-                    for (i, &col) in part.pivot_cols.iter().enumerate() {
-                        for j in 0..=l {
-                            let mut terms = vec![part.pivot_rhs[(i, j)]];
-                            for f in 0..k {
-                                let t = g.mul(part.pivot_free[(i, f)], ids[f * (l + 1) + j])?;
-                                terms.push(g.neg(t)?);
-                            }
-                            let sum = g.sum(&terms)?;
-                            x_entries[col * (l + 1) + j] = expanded(g, sum)?;
-                        }
-                    }
-                    if k == 0 {
-                        (x_entries, None)
-                    } else {
-                        (
-                            x_entries,
-                            Some((
-                                syms,
-                                k,
-                                part.s.entries().to_vec(),
-                                part.s_rhs.entries().to_vec(),
-                            )),
-                        )
+                        syms.push(s);
                     }
                 }
-                Err(SymbolicError::StructurallySingular { column }) => {
-                    let name = model.coords[dependent[column]].0.to_string();
-                    cx.error_spanned_by(
+                for (f, &col) in part.free_cols.iter().enumerate() {
+                    for j in 0..=l {
+                        x_entries[col * (l + 1) + j] = ids[f * (l + 1) + j];
+                    }
+                }
+                for (i, &col) in part.pivot_cols.iter().enumerate() {
+                    for j in 0..=l {
+                        let mut terms = vec![part.pivot_rhs[(i, j)]];
+                        for f in 0..k {
+                            let t = g.mul(part.pivot_free[(i, f)], ids[f * (l + 1) + j])?;
+                            terms.push(g.neg(t)?);
+                        }
+                        let sum = g.sum(&terms)?;
+                        x_entries[col * (l + 1) + j] = expanded(g, sum)?;
+                    }
+                }
+                if k == 0 {
+                    (x_entries, None)
+                } else {
+                    (
+                        x_entries,
+                        Some((
+                            syms,
+                            ids,
+                            k,
+                            part.s.entries().to_vec(),
+                            part.s_rhs.entries().to_vec(),
+                        )),
+                    )
+                }
+            }
+            Err(SymbolicError::StructurallySingular { column }) => {
+                let name = model.coords[dependent[column]].0.to_string();
+                cx.error_spanned_by(
                     &model.speeds_at,
                     format!("with these privileged speeds the constraints cannot determine the rate of `{name}` (D' is singular after elimination); choose other speeds"),
                 );
-                    return Ok(None);
-                }
-                Err(e) => return Err(e),
+                return Ok(None);
             }
-        };
+            Err(e) => return Err(e),
+        }
+    };
     // 3. C and c.
     let zero = g.int(0)?;
     let one = g.int(1)?;
@@ -607,7 +630,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         reduced = reduced.with(spec.symbol, a);
     }
     let mut elimination = Elimination::Symbolic;
-    if let Some((xs, k, s_mat, s_rhs)) = numeric_part {
+    if let Some((xs, x_ids, k, s_mat, s_rhs)) = numeric_part {
         // The accelerations need Ẋ only in the combination w = Ẋ [ẏ; 1]
         // (the dependent acceleration remainder): every β̄_k is linear in the
         // column X_k, so Σ_k β̄̇_k ẏ_k + β̄̇ sees Σ_k Ẋ_k ẏ_k + Ẋ_l. The rate
@@ -631,8 +654,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             for j in 0..=l {
                 let mut inner = vec![r_rate[i * (l + 1) + j]];
                 for f in 0..k {
-                    let xf = g.sym(xs[f * (l + 1) + j])?;
-                    let t = g.mul(s_rate[i * k + f], xf)?;
+                    let t = g.mul(s_rate[i * k + f], x_ids[f * (l + 1) + j])?;
                     inner.push(g.neg(t)?);
                 }
                 let column = g.sum(&inner)?;
@@ -642,8 +664,14 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             let sum = g.sum(&terms)?;
             rhs_rate.push(expanded(g, sum)?);
         }
+        let columns = (0..=l)
+            .filter(|&j| {
+                (0..k).any(|f| !g.is_zero(x_ids[f * (l + 1) + j])) && !vanishing.contains(&xs[j])
+            })
+            .collect();
         elimination = Elimination::Numeric(NumericElimination {
             k,
+            columns,
             dp: s_mat,
             rhs: s_rhs,
             rhs_rate,
@@ -769,7 +797,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
     }
     // Loads are kept apart (per effect) so scenes can pick them.
-    let inertial_terms = forcing_terms.clone();
+    let mut inertial_terms = forcing_terms.clone();
     let mut load_terms: Vec<(String, Vec<Id>)> = Vec::new();
     for (fi, f) in model.forces.iter().enumerate() {
         let per_k: Vec<Id> = (0..l)
@@ -815,7 +843,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }
     let ke = g.sum(&ke_terms)?;
     let kinetic = g.scale(ke, Number::ratio(1, 2).expect("1/2"))?;
-    let kinetic = expanded(g, kinetic)?;
+    let mut kinetic = expanded(g, kinetic)?;
     // V = −Σ F·r over the gravity effect's (constant) forces.
     let mut v_terms = Vec::new();
     for f in model.forces.iter().filter(|f| f.effect == "gravity") {
@@ -823,7 +851,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         v_terms.push(g.neg(w)?);
     }
     let potential = g.sum(&v_terms)?;
-    let potential = expanded(g, potential)?;
+    let mut potential = expanded(g, potential)?;
     // Power of the loads that depend on an input: F·v_P + L·ω.
     let inputs_set = SymbolSet::from_symbols(model.inputs.iter().map(|(_, s)| *s));
     let mut p_terms = Vec::new();
@@ -845,8 +873,50 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
     }
     let input_power = g.sum(&p_terms)?;
-    let input_power = expanded(g, input_power)?;
+    let mut input_power = expanded(g, input_power)?;
     // 7. Retained and ignorable coordinates.
+    // The zero last column of X has done its work (carrying w): set it to
+    // zero everywhere.
+    if !vanishing.is_empty() {
+        let mut zero_x = Substitution::new();
+        for &s in &vanishing {
+            zero_x.insert(s, zero);
+        }
+        let mut fix = |g: &mut appell_symbolic::Graph, e: &mut Id| -> Result<(), SymbolicError> {
+            *e = zero_x.apply(g, *e)?;
+            Ok(())
+        };
+        for e in c.iter_mut().chain(c0.iter_mut()).chain(qdot.iter_mut()) {
+            fix(g, e)?;
+        }
+        for e in mass.iter_mut().chain(forcing.iter_mut()) {
+            fix(g, e)?;
+        }
+        for e in [&mut kinetic, &mut potential, &mut input_power] {
+            fix(g, e)?;
+        }
+        for e in inertial_terms.iter_mut().flatten() {
+            fix(g, e)?;
+        }
+        for (_, terms) in load_terms.iter_mut() {
+            for e in terms.iter_mut() {
+                fix(g, e)?;
+            }
+        }
+        for (_, e) in power_terms.iter_mut() {
+            fix(g, e)?;
+        }
+        if let Elimination::Numeric(ne) = &mut elimination {
+            for e in ne
+                .dp
+                .iter_mut()
+                .chain(ne.rhs.iter_mut())
+                .chain(ne.rhs_rate.iter_mut())
+            {
+                fix(g, e)?;
+            }
+        }
+    }
     let raw_mass = mass.clone();
     let raw_elimination = elimination.clone();
     let (retained, ignorable, cyclic) = reduce_state(

@@ -24,6 +24,7 @@ fn options(hoist: bool) -> EmitOptions {
         cse: true,
         hoist_parameters: hoist,
         symbol_text: Default::default(),
+        symbol_stage: Default::default(),
     }
 }
 
@@ -34,6 +35,7 @@ fn f64_options() -> EmitOptions {
         cse: true,
         hoist_parameters: false,
         symbol_text: Default::default(),
+        symbol_stage: Default::default(),
     }
 }
 
@@ -198,11 +200,15 @@ impl Emitter<'_> {
             let _ = writeln!(s, "            __x{tag} = __b{tag};");
             s.push_str("        }\n");
         };
-        let _ = writeln!(s, "        let __x0: [[__T; {}]; {m}];", l + 1);
-        stage(&mut s, &ne.rhs, l + 1, "0");
+        let cols = &ne.columns;
+        let _ = writeln!(s, "        let __x0: [[__T; {}]; {m}];", cols.len());
+        let rhs: Vec<Id> = (0..m)
+            .flat_map(|i| cols.iter().map(move |&j| ne.rhs[i * (l + 1) + j]))
+            .collect();
+        stage(&mut s, &rhs, cols.len(), "0");
         for i in 0..m {
-            for j in 0..=l {
-                let _ = writeln!(s, "        let __x_{i}_{j} = __x0[{i}][{j}];");
+            for (c, j) in cols.iter().enumerate() {
+                let _ = writeln!(s, "        let __x_{i}_{j} = __x0[{i}][{c}];");
             }
         }
         if rates {
@@ -213,6 +219,91 @@ impl Emitter<'_> {
             }
         }
         (s, ops)
+    }
+
+    /// The rhs as one program sharing every common subexpression: with a
+    /// numeric elimination, S and R first (stage 0), S factored once and X
+    /// solved, then (Ṙ − Ṡ X)[ẏ; 1] (stage 1) and w from the same factors,
+    /// then `roots` (stage 2). Returns the code (outputs: `roots` only), the
+    /// statements with the solves between the stages, and the solves'
+    /// operation count.
+    fn staged_rhs(&self, roots: &[Id]) -> (RustCode, String, usize) {
+        let d = self.d;
+        let indent = |s: &mut String, v: &[String]| {
+            for st in v {
+                let _ = writeln!(s, "        {st}");
+            }
+        };
+        let Elimination::Numeric(ne) = &d.elimination else {
+            let c = code(d, roots, &options(true));
+            let mut text = String::new();
+            indent(&mut text, &c.body);
+            return (c, text, 0);
+        };
+        let (m, l) = (ne.k, d.l);
+        let cols = &ne.columns;
+        let mut all: Vec<Id> = ne.dp.clone();
+        for i in 0..m {
+            all.extend(cols.iter().map(|&j| ne.rhs[i * (l + 1) + j]));
+        }
+        all.extend(&ne.rhs_rate);
+        let head = all.len();
+        all.extend(roots);
+        let mut o = options(true);
+        for &x in &ne.x {
+            o.symbol_stage.insert(x, 1);
+        }
+        for &w in &ne.w {
+            o.symbol_stage.insert(w, 2);
+        }
+        let mut c = code(d, &all, &o);
+        let eo: Vec<String> = c.outputs.drain(..head).collect();
+        let width = cols.len();
+        let matrix = |offset: usize, w: usize| -> String {
+            let rows: Vec<String> = (0..m)
+                .map(|i| {
+                    let row: Vec<String> = (0..w).map(|j| eo[offset + i * w + j].clone()).collect();
+                    format!("[{}]", row.join(", "))
+                })
+                .collect();
+            rows.join(", ")
+        };
+        let mut s = String::new();
+        indent(&mut s, c.stages.first().map_or(&[], |v| v.as_slice()));
+        let _ = writeln!(
+            s,
+            "        let mut __s: [[__T; {m}]; {m}] = [{}];",
+            matrix(0, m)
+        );
+        let _ = writeln!(
+            s,
+            "        let mut __x0: [[__T; {width}]; {m}] = [{}];",
+            matrix(m * m, width)
+        );
+        let _ = writeln!(
+            s,
+            "        let __swaps = {P}::lu_factor(&mut __s, {P}::max_abs(&__x0))?;"
+        );
+        let _ = writeln!(s, "        {P}::lu_substitute(&__s, &__swaps, &mut __x0);");
+        for i in 0..m {
+            for (k, j) in cols.iter().enumerate() {
+                let _ = writeln!(s, "        let __x_{i}_{j} = __x0[{i}][{k}];");
+            }
+        }
+        indent(&mut s, c.stages.get(1).map_or(&[], |v| v.as_slice()));
+        let _ = writeln!(
+            s,
+            "        let mut __x1: [[__T; 1]; {m}] = [{}];",
+            matrix(m * m + m * width, 1)
+        );
+        let _ = writeln!(s, "        {P}::lu_substitute(&__s, &__swaps, &mut __x1);");
+        for i in 0..m {
+            let _ = writeln!(s, "        let __w_{i} = __x1[{i}][0];");
+        }
+        indent(&mut s, c.stages.get(2).map_or(&[], |v| v.as_slice()));
+        let solve_ops = m * m * m + 2 * m * m * (width + 1);
+        c.body.clear();
+        (c, s, solve_ops)
     }
 
     /// Unrolled LDLᵀ factorization of M (lower triangle given as
@@ -414,7 +505,7 @@ impl Emitter<'_> {
         for &r in &d.retained {
             roots.push(qdot[r]);
         }
-        let rhs = code(d, &roots, &options(true));
+        let (rhs, rhs_text, elim_ops) = self.staged_rhs(&roots);
         let tri = if constant_mass { 0 } else { l * (l + 1) / 2 };
         let f_text: Vec<String> = rhs.outputs[tri..tri + l].to_vec();
         let mut factor_prepare = String::new();
@@ -466,7 +557,6 @@ impl Emitter<'_> {
         let (solve_text, solve_ops) = self.ldlt_solve(&f_text);
         let ldlt = format!("{factor_text}{solve_text}");
         let ldlt_ops = factor_ops + solve_ops;
-        let (elim_rhs, elim_ops) = self.elimination(true);
         let mut bind_state = String::new();
         for (k, &r) in d.retained.iter().enumerate() {
             let _ = writeln!(bind_state, "        let {} = __state[{k}];", self.coord(r));
@@ -667,7 +757,7 @@ impl Emitter<'_> {
     }}
     fn rhs<__T: {P}::Scalar>(&self, __prepared: &[__T; {h}], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_state}{chk_inputs}{chk_dstate}{pos}        let [{hoisted_list}] = *__prepared;
-{params_t}{bind_state}{bind_inputs}{elim_rhs}{rhs_body}{ldlt}{write_out}        if !({finite}) {{ return {P}::Err({P}::ModelError::NonFinite {{ what: "the state derivative" }}); }}
+{params_t}{bind_state}{bind_inputs}{rhs_body}{ldlt}{write_out}        if !({finite}) {{ return {P}::Err({P}::ModelError::NonFinite {{ what: "the state derivative" }}); }}
         {P}::Ok(())
     }}
     fn mass_matrix_and_forcing<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
@@ -752,13 +842,7 @@ impl Emitter<'_> {
             bind_q = self.bind_q("__q"),
             bind_u = self.bind_u("__u"),
             bind_qdot = self.bind_qdot("__qdot"),
-            rhs_body = {
-                let mut s = String::new();
-                for st in &rhs.body {
-                    let _ = writeln!(s, "        {st}");
-                }
-                s
-            },
+            rhs_body = rhs_text,
             mf_body = statements(&mf),
             mf_out = {
                 let mut s = outputs_into(

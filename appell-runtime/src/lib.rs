@@ -33,7 +33,7 @@ pub use scalar::Scalar;
 /// Items the generated code refers to; not a stable API.
 #[doc(hidden)]
 pub mod __private {
-    pub use crate::linalg::{ldlt_solve, lu_solve};
+    pub use crate::linalg::{ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs};
     pub use crate::model::check_len;
     pub use crate::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
     pub use core::result::Result::{self, Err, Ok};

@@ -624,6 +624,13 @@ pub struct EmitOptions {
     pub hoist_parameters: bool,
     /// How each symbol is read (default: its name, as a local binding).
     pub symbol_text: BTreeMap<Symbol, String>,
+    /// The stage at which each symbol becomes available (default 0). A
+    /// statement belongs to the latest stage of the symbols it reads, and
+    /// [`RustCode::stages`] lists the statements stage by stage, so a caller
+    /// can compute some values between stages (e.g. a numeric solve whose
+    /// results are the symbols of the next stage) within one program that
+    /// shares every common subexpression.
+    pub symbol_stage: BTreeMap<Symbol, usize>,
 }
 
 impl Default for EmitOptions {
@@ -634,6 +641,7 @@ impl Default for EmitOptions {
             cse: true,
             hoist_parameters: true,
             symbol_text: BTreeMap::new(),
+            symbol_stage: BTreeMap::new(),
         }
     }
 }
@@ -666,6 +674,10 @@ pub struct RustCode {
     pub hoisted: Vec<String>,
     /// Statements of the per-call body.
     pub body: Vec<String>,
+    /// The same statements split by stage ([`EmitOptions::symbol_stage`]):
+    /// `stages[s]` reads symbols of stages up to `s` only; constants are in
+    /// stage 0. One entry when no symbol has a later stage.
+    pub stages: Vec<Vec<String>>,
     /// One expression per root, valid after `body`.
     pub outputs: Vec<String>,
     /// Operations per call (body and outputs).
@@ -894,6 +906,21 @@ impl<'a> Writer<'a> {
                 depth[i] = d;
             }
         }
+        // The stage of each instruction: the latest of its symbols'.
+        let mut stage = vec![0usize; n];
+        for i in 0..n {
+            stage[i] = match p.insts[i] {
+                Inst::Symbol(s) => self.o.symbol_stage.get(&s).copied().unwrap_or(0),
+                ref other => other
+                    .operands()
+                    .iter()
+                    .map(|&o| stage[o as usize])
+                    .max()
+                    .unwrap_or(0),
+            };
+        }
+        let stage_count = 1 + stage.iter().copied().max().unwrap_or(0);
+        let mut staged: Vec<Vec<String>> = vec![Vec::new(); stage_count];
         let mut prepare = Vec::new();
         let mut body = Vec::new();
         let mut hoisted_names = Vec::new();
@@ -955,9 +982,12 @@ impl<'a> Writer<'a> {
             } else {
                 for c in consts {
                     if const_in_body.insert(c) {
-                        body.push(self.const_stmt(c, &const_names));
+                        let st = self.const_stmt(c, &const_names);
+                        staged[0].push(st.clone());
+                        body.push(st);
                     }
                 }
+                staged[stage[i]].push(format!("let {name} = {text};"));
                 body.push(format!("let {name} = {text};"));
             }
             self.names[i] = Some(name);
@@ -967,7 +997,9 @@ impl<'a> Writer<'a> {
             let o = p.outputs[k] as usize;
             for c in self.constants_of(o, &bind) {
                 if const_in_body.insert(c) {
-                    body.push(self.const_stmt(c, &const_names));
+                    let st = self.const_stmt(c, &const_names);
+                    staged[0].push(st.clone());
+                    body.push(st);
                 }
             }
             outputs.push(self.expr(o).0);
@@ -983,6 +1015,7 @@ impl<'a> Writer<'a> {
             prepare: split(prepare),
             hoisted: hoisted_names,
             body: split(body),
+            stages: staged.into_iter().map(split).collect(),
             outputs,
             ops: body_ops,
             prepare_ops,
@@ -1122,5 +1155,50 @@ impl Graph {
     /// subexpressions computed once (parameter-only work included).
     pub fn op_count(&self, roots: &[Id]) -> Result<OpCount> {
         Ok(Program::lower(self, roots).op_count())
+    }
+}
+
+#[cfg(test)]
+mod stage_tests {
+    use super::*;
+    use crate::graph::SymbolKind;
+
+    #[test]
+    fn statements_are_split_by_the_latest_stage_they_read() {
+        let mut g = Graph::new();
+        let _q = g.coordinate("q").unwrap();
+        let x = g.declare("x", SymbolKind::Auxiliary).unwrap();
+        let w = g.declare("w", SymbolKind::Auxiliary).unwrap();
+        // sin(q)·cos(q) is shared by every stage; x·sin(q)·cos(q) by the
+        // last two; w reads both.
+        let a = g.parse("sin(q)*cos(q) + q").unwrap();
+        let b = g.parse("sin(q)*cos(q)*x + x^2").unwrap();
+        let c = g
+            .parse("(sin(q)*cos(q)*x + x^2)*w + w^2 + sin(q)*cos(q)")
+            .unwrap();
+        let p = Program::lower(&g, &[a, b, c]);
+        let mut o = EmitOptions::default();
+        o.symbol_stage.insert(x, 1);
+        o.symbol_stage.insert(w, 2);
+        let code = p.to_rust(&g, &o);
+        assert_eq!(code.stages.len(), 3);
+        let mut all: Vec<String> = code.stages.concat();
+        let mut body = code.body.clone();
+        all.sort();
+        body.sort();
+        assert_eq!(all, body, "the stages hold exactly the body's statements");
+        let mentions = |v: &[String], name: &str| {
+            v.iter().any(|s| {
+                s.split(|c: char| !c.is_alphanumeric() && c != '_')
+                    .any(|t| t == name)
+            })
+        };
+        assert!(!mentions(&code.stages[0], "x") && !mentions(&code.stages[0], "w"));
+        assert!(!mentions(&code.stages[1], "w"));
+        assert!(mentions(&code.stages[0], "q"));
+        // Without stages, one stage holds everything.
+        let plain = p.to_rust(&g, &EmitOptions::default());
+        assert_eq!(plain.stages.len(), 1);
+        assert_eq!(plain.stages[0], plain.body);
     }
 }
