@@ -1179,7 +1179,7 @@ pub fn derive_scene(
 /// the factored form is kept.
 fn expanded(g: &mut appell_symbolic::Graph, e: Id) -> Result<Id, SymbolicError> {
     const TERM_BUDGET: usize = 48;
-    match g.expand_within(e, TERM_BUDGET) {
+    match g.expand_outside_functions(e, TERM_BUDGET) {
         Ok(x) if x == e => Ok(e),
         Ok(x) => {
             if g.dag_size(&[x]) <= g.dag_size(&[e]) {

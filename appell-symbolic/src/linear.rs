@@ -266,7 +266,7 @@ impl Graph {
                     let inv = self.recip(rows[r][c])?;
                     for x in rows[r].iter_mut() {
                         let t = self.mul(*x, inv)?;
-                        *x = self.expand(t)?;
+                        *x = self.expand_outside_functions(t, self.limits.max_terms)?;
                     }
                     self.clear_column(&mut rows, r, &[c])?;
                     open_rows.retain(|&x| x != r);
@@ -288,12 +288,12 @@ impl Graph {
                 let y = self.mul(a12, old2[k])?;
                 let n1 = self.sub(x, y)?;
                 let n1 = self.mul(n1, inv_det)?;
-                rows[r1][k] = self.expand(n1)?;
+                rows[r1][k] = self.expand_outside_functions(n1, self.limits.max_terms)?;
                 let x = self.mul(a11, old2[k])?;
                 let y = self.mul(a21, old1[k])?;
                 let n2 = self.sub(x, y)?;
                 let n2 = self.mul(n2, inv_det)?;
-                rows[r2][k] = self.expand(n2)?;
+                rows[r2][k] = self.expand_outside_functions(n2, self.limits.max_terms)?;
             }
             self.clear_column(&mut rows, r1, &[c1])?;
             self.clear_column(&mut rows, r2, &[c2])?;
@@ -375,7 +375,7 @@ impl Graph {
                         let p = self.mul(a11, a22)?;
                         let q = self.mul(a12, a21)?;
                         let d = self.sub(p, q)?;
-                        let det = self.expand(d)?;
+                        let det = self.expand_outside_functions(d, self.limits.max_terms)?;
                         let ok = if constant_only {
                             self.as_number(det).is_some_and(|n| !n.is_zero())
                         } else {
@@ -407,7 +407,7 @@ impl Graph {
                 for (x, &pk) in row.iter_mut().zip(&pivot_row) {
                     let t = self.mul(f, pk)?;
                     let d = self.sub(*x, t)?;
-                    *x = self.expand(d)?;
+                    *x = self.expand_outside_functions(d, self.limits.max_terms)?;
                 }
             }
         }
@@ -653,11 +653,11 @@ impl Graph {
             let inv = self.recip(pivot)?;
             for j in col..n {
                 let x = self.mul(a[(col, j)], inv)?;
-                a[(col, j)] = self.expand(x)?;
+                a[(col, j)] = self.expand_outside_functions(x, self.limits.max_terms)?;
             }
             for j in 0..m {
                 let x = self.mul(b[(col, j)], inv)?;
-                b[(col, j)] = self.expand(x)?;
+                b[(col, j)] = self.expand_outside_functions(x, self.limits.max_terms)?;
             }
             for r in 0..n {
                 if r == col || self.is_zero(a[(r, col)]) {
@@ -667,12 +667,12 @@ impl Graph {
                 for j in col..n {
                     let t = self.mul(f, a[(col, j)])?;
                     let x = self.sub(a[(r, j)], t)?;
-                    a[(r, j)] = self.expand(x)?;
+                    a[(r, j)] = self.expand_outside_functions(x, self.limits.max_terms)?;
                 }
                 for j in 0..m {
                     let t = self.mul(f, b[(col, j)])?;
                     let x = self.sub(b[(r, j)], t)?;
-                    b[(r, j)] = self.expand(x)?;
+                    b[(r, j)] = self.expand_outside_functions(x, self.limits.max_terms)?;
                 }
             }
         }

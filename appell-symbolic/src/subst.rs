@@ -146,12 +146,36 @@ impl Graph {
     pub fn expand_within(&mut self, root: Id, max_terms: usize) -> Result<Id> {
         let saved = self.limits.max_terms;
         self.limits.max_terms = max_terms.min(saved);
-        let r = self.expand_inner(root);
+        let r = self.expand_inner(root, true);
         self.limits.max_terms = saved;
         r
     }
 
-    fn expand_inner(&mut self, root: Id) -> Result<Id> {
+    /// [`Graph::expand_within`] at the top level only: function arguments
+    /// (`sqrt(...)`, `sin(...)`, `atan2(...)`) are left as they are, so one
+    /// argument keeps one form wherever it occurs and its function value is
+    /// shared.
+    ///
+    /// ```
+    /// use appell_symbolic::Graph;
+    /// let mut g = Graph::new();
+    /// let e = g.parse("(a + b)*c + sqrt((a + b)*c)").unwrap();
+    /// let x = g.expand_outside_functions(e, 16).unwrap();
+    /// let want = g.parse("a*c + b*c + sqrt((a + b)*c)").unwrap();
+    /// assert_eq!(x, want);
+    /// // `expand` multiplies out inside the square root too.
+    /// let y = g.expand(e).unwrap();
+    /// assert_ne!(y, want);
+    /// ```
+    pub fn expand_outside_functions(&mut self, root: Id, max_terms: usize) -> Result<Id> {
+        let saved = self.limits.max_terms;
+        self.limits.max_terms = max_terms.min(saved);
+        let r = self.expand_inner(root, false);
+        self.limits.max_terms = saved;
+        r
+    }
+
+    fn expand_inner(&mut self, root: Id, inside_functions: bool) -> Result<Id> {
         let mut memo: FxHashMap<Id, Id> = FxHashMap::default();
         let mut stack = vec![(root, false)];
         while let Some((id, expanded)) = stack.pop() {
@@ -159,6 +183,10 @@ impl Graph {
                 continue;
             }
             if !expanded {
+                if !inside_functions && matches!(self.node(id), Node::Fun(..) | Node::Atan2(..)) {
+                    memo.insert(id, id);
+                    continue;
+                }
                 stack.push((id, true));
                 self.node(id).for_each_child(|c| stack.push((c, false)));
                 continue;
