@@ -161,7 +161,7 @@ impl From<ModelError> for CliError {
 /// # use appell_runtime::{ModelInfo, OpCounts};
 /// # let info = ModelInfo {
 /// #     name: "Pendulum", parameters: &[], coordinates: &[], speeds: &[], dependent: &[],
-/// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[],
+/// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[],
 /// #     holonomic: 0, constraints: 0, bodies: &[], force_points: 0, torques: 0,
 /// #     symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
 /// # };
@@ -238,7 +238,7 @@ pub fn run<M: Model>(
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Free", parameters: &["m"], coordinates: &["x"], speeds: &["x"],
 /// #     dependent: &[], cyclic: &[], ignorable: &["x"], retained: &[], inputs: &["f"],
-/// #     effects: &["push"], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+/// #     effects: &["push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
 /// #     torques: 0, symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
 /// #     equations: "x'' = f/m",
@@ -401,7 +401,7 @@ fn eval_stream<M: Model>(
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Spin", parameters: &["i"], coordinates: &["phi"], speeds: &["phi"],
 /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["phi"], inputs: &["tau"],
-/// #     effects: &["motor"], holonomic: 0, constraints: 0,
+/// #     effects: &["motor"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
 /// #     bodies: &[BodyInfo { name: "B", rigid: true }], force_points: 0, torques: 1,
 /// #     symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
