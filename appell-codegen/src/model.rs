@@ -422,9 +422,13 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
                     }
                 }
             } else {
+                let h = hint(
+                    &k,
+                    ["quadrature", "energies", "contact_forces"].map(String::from),
+                );
                 cx.error_spanned_by(
                     kind,
-                    format!("unknown scene output `{kind}`; available: quadrature(coordinates...), energies, contact_forces"),
+                    format!("unknown scene output `{kind}`; available: quadrature(coordinates...), energies, contact_forces{h}"),
                 );
                 ok = false;
             }
