@@ -225,6 +225,12 @@ fn contact_check_scene_reports_its_outputs_on_the_command_line() {
         serde_json::json!(["quadrature"])
     );
     assert_eq!(info["contacts"], serde_json::json!([]));
+    // Same effects as `coasting`: the same reduced equations.
+    assert_eq!(info["scenes"][3]["rhs_ops"], info["scenes"][0]["rhs_ops"]);
+    assert_eq!(
+        info["scenes"][3]["state_len"],
+        info["scenes"][0]["state_len"]
+    );
 
     let line = br#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}, "inputs": {"tau": 0.5}}"#;
     let p = WheelAxle::default();

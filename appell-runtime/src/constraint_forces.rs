@@ -121,8 +121,9 @@ pub enum Friction {
         /// The tangential force's magnitude |F_t|.
         tangential: f64,
     },
-    /// The normal force is not positive: the wheel would lift off (or is
-    /// just touching) and no friction coefficient keeps it rolling.
+    /// The normal force is not positive (or so small that |F_t| / N
+    /// overflows): the wheel would lift off (or is just touching) and no
+    /// friction coefficient keeps it rolling.
     LiftOff {
         /// The normal force (≤ 0).
         normal: f64,
@@ -165,8 +166,14 @@ impl ContactForce {
                 }
                 let t = sub(self.force, scale(direction, dot(self.force, direction)));
                 let tangential = norm(t);
+                let mu = tangential / force;
+                if !mu.is_finite() {
+                    // A normal force so small that no coefficient holds:
+                    // the lift-off limit.
+                    return Friction::LiftOff { normal: force };
+                }
                 Friction::Required {
-                    mu: tangential / force,
+                    mu,
                     normal: force,
                     tangential,
                 }
@@ -657,7 +664,7 @@ fn balance_normals<M: Model>(
     let svd = a.clone().svd(true, true);
     let smax = svd.singular_values.max();
     let smin = svd.singular_values.min();
-    if !(smin > 1e-6 * smax) {
+    if smin.is_nan() || smin <= 1e-6 * smax {
         return Ok(None);
     }
     let Ok(x) = svd.solve(&b, 0.0) else {

@@ -445,7 +445,8 @@ pub trait Model {
     /// and for every velocity constraint row the direction e (N components)
     /// whose velocity component e·v_P it constrains
     /// ([`RowSource::Rolling`]), zero for the other rows. The default serves
-    /// models without rolling contacts.
+    /// models without rolling contacts (it writes zero directions and no
+    /// points); a model that lists contacts must implement it.
     fn contact_geometry<T: Scalar>(
         &self,
         t: T,
