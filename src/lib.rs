@@ -34,6 +34,38 @@
 //! assert!((d[2] - expected).abs() < 1e-12);
 //! ```
 //!
+//! ## Contact forces
+//!
+//! The multipliers of eqs. 69-70 and the reaction at each rolling contact
+//! ([`constraint_forces`]): a thin disc rolling upright in a straight line
+//! at constant speed rests its weight on the ground and needs no friction.
+//!
+//! ```
+//! use appell::constraint_forces::{contact_forces, Friction, Normal};
+//! use appell::Appell;
+//!
+//! #[derive(Appell)]
+//! #[appell(coordinates(yaw, lean, spin, x, y), speeds(yaw, lean, spin), positive(r, m))]
+//! #[appell(frame(A = N.rotate_z(yaw)), frame(B = A.rotate_x(lean)), frame(C = B.rotate_y(spin)))]
+//! #[appell(point(D = O + x * N.x + y * N.y + r * cos(lean) * N.z), point(P = D - r * B.z))]
+//! #[appell(body(disc, center = D, frame = C, mass = m,
+//!               inertia = principal(m * r * r / 4, m * r * r / 2, m * r * r / 4)))]
+//! #[appell(rolls(disc, contact = P))]
+//! #[appell(gravity(-g * N.z))]
+//! struct Disc { r: f64, m: f64, g: f64 }
+//!
+//! let disc = Disc { r: 0.3, m: 2.0, g: 9.81 };
+//! // q = (yaw, lean, spin, x, y), u = (yaw', lean', spin').
+//! let f = contact_forces(&disc, 0.0, &[0.0; 5], &[0.0, 0.0, 4.0], &[]).unwrap();
+//! let contact = &f.contacts[0];
+//! assert!((contact.force[2] - 2.0 * 9.81).abs() < 1e-12); // the weight, on the disc
+//! assert!(matches!(contact.normal, Normal::Available { .. }));
+//! match contact.friction() {
+//!     Friction::Required { mu, .. } => assert!(mu < 1e-12),
+//!     other => panic!("{other:?}"),
+//! }
+//! ```
+//!
 //! The model language is described in `docs/model-language.md`; every
 //! example in `examples/` gets the model command line ([`cli`]) for free.
 #![cfg_attr(not(feature = "std"), no_std)]

@@ -7,7 +7,9 @@ mod wheel_axle;
 
 use appell::Model;
 use common::{close, Rng};
-use wheel_axle::{WheelAxle, WheelAxleCoasting, WheelAxleDriven, WheelAxleTrack};
+use wheel_axle::{
+    WheelAxle, WheelAxleCoasting, WheelAxleContactCheck, WheelAxleDriven, WheelAxleTrack,
+};
 
 #[test]
 fn scenes_are_listed_with_their_states_and_costs() {
@@ -18,7 +20,8 @@ fn scenes_are_listed_with_their_states_and_costs() {
         [
             "WheelAxle::coasting",
             "WheelAxle::driven",
-            "WheelAxle::track"
+            "WheelAxle::track",
+            "WheelAxle::contact_check"
         ]
     );
     for s in scenes {
@@ -194,6 +197,75 @@ fn command_line_lists_scenes_and_evaluates_one() {
         |_| Ok(()),
     );
     assert!(matches!(err, Err(appell::cli::CliError::Usage(_))));
+}
+
+#[test]
+fn contact_check_scene_reports_its_outputs_on_the_command_line() {
+    let args = |v: &[&str]| -> Vec<String> { v.iter().map(|s| s.to_string()).collect() };
+    let run = |argv: &[&str], input: &[u8]| -> serde_json::Value {
+        let mut out = Vec::new();
+        appell::cli::run_with(
+            WheelAxle::default(),
+            &args(argv),
+            &mut &input[..],
+            &mut out,
+            |_| Ok(()),
+        )
+        .unwrap();
+        serde_json::from_slice(&out).unwrap()
+    };
+    let info = run(&["wheel_axle", "info"], b"");
+    assert_eq!(info["scenes"][3]["name"], "WheelAxle::contact_check");
+    assert_eq!(
+        info["scenes"][3]["outputs"],
+        serde_json::json!(["contact_forces", "energies"])
+    );
+    assert_eq!(
+        info["scenes"][2]["outputs"],
+        serde_json::json!(["quadrature"])
+    );
+    assert_eq!(info["contacts"], serde_json::json!([]));
+    // Same effects as `coasting`: the same reduced equations.
+    assert_eq!(info["scenes"][3]["rhs_ops"], info["scenes"][0]["rhs_ops"]);
+    assert_eq!(
+        info["scenes"][3]["state_len"],
+        info["scenes"][0]["state_len"]
+    );
+
+    let line = br#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}, "inputs": {"tau": 0.5}}"#;
+    let p = WheelAxle::default();
+    let scene = WheelAxleContactCheck(p.clone());
+    let q = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.2];
+    let u = [0.1, 2.0];
+    let expected = appell::constraint_forces::contact_forces(&scene, 0.0, &q, &u, &[0.5]).unwrap();
+    let energies = appell::energy::energies(&scene, 0.0, &q, &u, &[0.5]).unwrap();
+    // `eval --scene contact_check`: rates plus the two outputs.
+    let v = run(&["wheel_axle", "eval", "--scene", "contact_check"], line);
+    assert!(v["udot"]["phi"].is_f64());
+    let lambda: Vec<f64> = v["contact_forces"]["multipliers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(lambda, expected.multipliers);
+    assert_eq!(v["contact_forces"]["rows"][4]["source"], "nonholonomic 4");
+    assert_eq!(v["energies"]["kinetic"].as_f64().unwrap(), energies.kinetic);
+    // Other scenes and the full model answer with the rates only.
+    let v = run(&["wheel_axle", "eval", "--scene", "coasting"], line);
+    assert!(v.get("contact_forces").is_none() && v.get("energies").is_none());
+    // `contacts` works on any model or scene; the coasting scene's
+    // multipliers are those of contact_check (same effects).
+    let v = run(&["wheel_axle", "contacts", "--scene", "coasting"], line);
+    let lambda: Vec<f64> = v["multipliers"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|x| x.as_f64().unwrap())
+        .collect();
+    assert_eq!(lambda, expected.multipliers);
+    let v = run(&["wheel_axle", "contacts"], line);
+    assert_eq!(v["multipliers"].as_array().unwrap().len(), 5);
 }
 
 #[test]

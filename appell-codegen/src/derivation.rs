@@ -89,6 +89,8 @@ pub struct Derivation {
     pub dependent: Vec<usize>,
     /// Constraint rows D (m×n) and d (m).
     pub d_rows: Vec<Id>,
+    /// Where each row of D comes from (for the constraint-force outputs).
+    pub row_sources: Vec<RowSource>,
     /// d.
     pub d0: Vec<Id>,
     /// Holonomic residuals f(q, t).
@@ -160,6 +162,7 @@ struct Parts {
     l: usize,
     dependent: Vec<usize>,
     d_rows: Vec<Id>,
+    row_sources: Vec<RowSource>,
     d0: Vec<Id>,
     holonomic: Vec<Id>,
     c: Vec<Id>,
@@ -194,6 +197,7 @@ impl Parts {
             l: self.l,
             dependent: self.dependent,
             d_rows: self.d_rows,
+            row_sources: self.row_sources,
             d0: self.d0,
             holonomic: self.holonomic,
             c: self.c,
@@ -230,8 +234,9 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let rules = RateRules::coordinates();
     // 1. Velocity constraint rows.
     let mut rows: Vec<(Id, proc_macro2::TokenStream, bool)> = Vec::new();
+    let mut origins: Vec<RowSource> = Vec::new();
     let mut holonomic = Vec::new();
-    for c in &model.holonomic {
+    for (index, c) in model.holonomic.iter().enumerate() {
         holonomic.push(c.residual);
         let bad: Vec<String> = model
             .g
@@ -250,15 +255,19 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             continue;
         }
         match model.g.time_derivative(c.residual, &rules) {
-            Ok(r) => rows.push((r, c.at.clone(), true)),
+            Ok(r) => {
+                rows.push((r, c.at.clone(), true));
+                origins.push(RowSource::Holonomic(index));
+            }
             Err(e) => cx.error_spanned_by(&c.at, e),
         }
     }
-    for c in &model.nonholonomic {
+    for (index, c) in model.nonholonomic.iter().enumerate() {
         rows.push((c.residual, c.at.clone(), false));
+        origins.push(RowSource::Nonholonomic(index));
     }
     // Rolling: v(material point at P) = v(centre) + ω × (P − centre) = 0.
-    for r in &model.rolling {
+    for (contact, r) in model.rolling.iter().enumerate() {
         let body = &model.bodies[r.body];
         let omega = model.frames[body.frame.expect("rigid")].omega;
         let g = &mut model.g;
@@ -289,6 +298,10 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 continue;
             }
             rows.push((c, r.at.clone(), false));
+            origins.push(RowSource::Rolling {
+                contact,
+                direction: k,
+            });
         }
         if rows.len() == before && r.along.is_none() {
             cx.error_spanned_by(&r.at, "this rolling contact constrains nothing: the contact point's velocity is identically zero");
@@ -297,7 +310,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let mut d_rows = Vec::new();
     let mut d0 = Vec::new();
     let mut row_sources = Vec::new();
-    for (row, span, holo) in &rows {
+    let mut kept_sources = Vec::new();
+    for ((row, span, holo), origin) in rows.iter().zip(&origins) {
         let bad: Vec<String> = model
             .g
             .dependencies(*row)
@@ -329,6 +343,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 d_rows.extend(form.coefficients);
                 d0.push(form.remainder);
                 row_sources.push(span.clone());
+                kept_sources.push(*origin);
             }
             Err(SymbolicError::NonLinear { symbol, .. }) => {
                 let what = if *holo {
@@ -944,6 +959,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         l,
         dependent,
         d_rows,
+        row_sources: kept_sources,
         d0,
         holonomic,
         c,
@@ -1132,6 +1148,7 @@ pub fn derive_scene(
             l,
             dependent: full.dependent.clone(),
             d_rows: full.d_rows.clone(),
+            row_sources: full.row_sources.clone(),
             d0: full.d0.clone(),
             holonomic: full.holonomic.clone(),
             c: full.c.clone(),
@@ -1170,6 +1187,23 @@ pub fn derive_scene(
             None
         }
     }
+}
+
+/// Where a velocity constraint row comes from.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowSource {
+    /// The time derivative of the i-th `holonomic(...)`.
+    Holonomic(usize),
+    /// The i-th `nonholonomic(...)`.
+    Nonholonomic(usize),
+    /// A component of the i-th `rolls(...)`: `direction` indexes N.x, N.y,
+    /// N.z, or the `along` list.
+    Rolling {
+        /// Index into `Model::rolling`.
+        contact: usize,
+        /// The component.
+        direction: usize,
+    },
 }
 
 /// Multiplies out products of sums when that makes the expression no

@@ -13,7 +13,7 @@ use std::str::FromStr;
 use appell_symbolic::{EmitOptions, Id, Program, RustCode};
 use proc_macro2::TokenStream;
 
-use crate::derivation::{Derivation, Elimination};
+use crate::derivation::{Derivation, Elimination, RowSource};
 
 const P: &str = "::appell::__private";
 
@@ -62,7 +62,7 @@ struct Emitter<'a> {
     info_ident: String,
     /// The scene infos the full model lists (empty for a scene).
     scene_infos: String,
-    /// The full model's `scene_rhs` (empty for a scene).
+    /// The full model's `scene_rhs` and `visit_scene` (empty for a scene).
     scene_rhs: String,
 }
 
@@ -442,8 +442,11 @@ impl Emitter<'_> {
             retained: {retained},
             inputs: {inputs},
             effects: {effects},
+            outputs: {outputs},
             holonomic: {holo},
             constraints: {m},
+            row_sources: &[{row_sources}],
+            contacts: &[{contacts}],
             bodies: &[{bodies}],
             force_points: {nf},
             torques: {nt},
@@ -461,6 +464,32 @@ impl Emitter<'_> {
             retained = coords(&d.retained),
             inputs = list(model.inputs.iter().map(|(i, _)| i.to_string()).collect()),
             effects = list(model.effects.clone()),
+            outputs = list(model.outputs.clone()),
+            row_sources = d
+                .row_sources
+                .iter()
+                .map(|r| match r {
+                    RowSource::Holonomic(i) => format!("{P}::RowSource::Holonomic {{ index: {i} }}"),
+                    RowSource::Nonholonomic(i) => {
+                        format!("{P}::RowSource::Nonholonomic {{ index: {i} }}")
+                    }
+                    RowSource::Rolling { contact, direction } => format!(
+                        "{P}::RowSource::Rolling {{ contact: {contact}, direction: {direction} }}"
+                    ),
+                })
+                .collect::<Vec<_>>()
+                .join(", "),
+            contacts = model
+                .rolling
+                .iter()
+                .map(|r| format!(
+                    "{P}::ContactInfo {{ body: {}, point: {:?}, along: {} }}",
+                    r.body,
+                    r.point,
+                    r.along.is_some()
+                ))
+                .collect::<Vec<_>>()
+                .join(", "),
             holo = d.holonomic.len(),
             m = d.m,
             bodies = bodies.join(", "),
@@ -669,6 +698,22 @@ impl Emitter<'_> {
             load_roots.extend(t.vector);
         }
         let loads = code(d, &load_roots, &options(false));
+        // Contact points, then the direction of every rolling row.
+        let nc = model.rolling.len();
+        let mut contact_roots = Vec::new();
+        for r in &model.rolling {
+            contact_roots.extend(r.contact);
+        }
+        for src in &d.row_sources {
+            match *src {
+                RowSource::Rolling { contact, direction } => match &model.rolling[contact].along {
+                    Some(dirs) => contact_roots.extend(dirs[direction]),
+                    None => contact_roots.extend(identity[direction]),
+                },
+                _ => contact_roots.extend([zero; 3]),
+            }
+        }
+        let contacts = code(d, &contact_roots, &options(false));
 
         let outputs_into = |c: &RustCode, target: &str| -> String {
             let mut s = String::new();
@@ -796,6 +841,9 @@ impl Emitter<'_> {
     fn load_geometry<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __frames: &mut [[__T; 9]]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_q}{chk_points}{chk_frames}{params_t}{bind_q}{geo_body}{geo_points}{geo_frames}        {P}::Ok(())
     }}
+    fn contact_geometry<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __directions: &mut [[__T; 3]]) -> {P}::Result<(), {P}::ModelError> {{
+{chk_q}{chk_cpoints}{chk_dirs}{params_t}{bind_q}{contacts_body}{contacts_points}{contacts_dirs}        {P}::Ok(())
+    }}
     fn load_values<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __inputs: &[__T], __forces: &mut [[__T; 3]], __torques: &mut [[__T; 3]]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_q}{chk_qdot_in}{chk_inputs}{chk_forces}{chk_torques}{params_t}{bind_q}{bind_qdot}{bind_inputs}{loads_body}{loads_forces}{loads_torques}        {P}::Ok(())
     }}
@@ -904,6 +952,11 @@ impl Emitter<'_> {
             geo_body = statements(&geo),
             geo_points = triples_into(&geo, "__points", 0, nf, 3),
             geo_frames = triples_into(&geo, "__frames", nf * 3, nt, 9),
+            chk_cpoints = self.check("__points", nc),
+            chk_dirs = self.check("__directions", m),
+            contacts_body = statements(&contacts),
+            contacts_points = triples_into(&contacts, "__points", 0, nc, 3),
+            contacts_dirs = triples_into(&contacts, "__directions", nc * 3, m, 3),
             loads_body = statements(&loads),
             loads_forces = triples_into(&loads, "__forces", 0, nf, 3),
             loads_torques = triples_into(&loads, "__torques", nf * 3, nt, 3),
@@ -947,9 +1000,20 @@ pub fn emit(
                         )
                     })
                     .collect();
+                let visits: Vec<String> = scenes
+                    .iter()
+                    .enumerate()
+                    .map(|(i, (n, _))| {
+                        format!(
+                            "            {i} => {P}::Ok({P}::SceneVisitor::visit(__visitor, {}::from_ref(self))),",
+                            scene_type(n)
+                        )
+                    })
+                    .collect();
                 format!(
-                    "    fn scene_rhs(&self, __scene: usize, t: f64, __state: &[f64], __inputs: &[f64], __dstate: &mut [f64]) -> {P}::Result<(), {P}::ModelError> {{\n        match __scene {{\n{}\n            _ => {P}::Err({P}::ModelError::UnknownScene {{ index: __scene }}),\n        }}\n    }}\n",
-                    arms.join("\n")
+                    "    fn scene_rhs(&self, __scene: usize, t: f64, __state: &[f64], __inputs: &[f64], __dstate: &mut [f64]) -> {P}::Result<(), {P}::ModelError> {{\n        match __scene {{\n{}\n            _ => {P}::Err({P}::ModelError::UnknownScene {{ index: __scene }}),\n        }}\n    }}\n    fn visit_scene<__V: {P}::SceneVisitor>(&self, __scene: usize, __visitor: __V) -> {P}::Result<__V::Output, {P}::ModelError> {{\n        match __scene {{\n{}\n            _ => {P}::Err({P}::ModelError::UnknownScene {{ index: __scene }}),\n        }}\n    }}\n",
+                    arms.join("\n"),
+                    visits.join("\n")
                 )
             },
         }
@@ -1023,7 +1087,8 @@ pub fn stub(name: &syn::Ident, scenes: &[syn::Ident], vis: &syn::Visibility) -> 
 const _: () = {{
     static __INFO: {P}::ModelInfo = {P}::ModelInfo {{
         name: "{name}", parameters: &[], coordinates: &[], speeds: &[], dependent: &[], cyclic: &[],
-        ignorable: &[], retained: &[], inputs: &[], effects: &[], holonomic: 0, constraints: 0,
+        ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], holonomic: 0, constraints: 0,
+        row_sources: &[], contacts: &[],
         bodies: &[], force_points: 0, torques: 0, symbolic_elimination: true,
         rhs_ops: {P}::OpCounts {{ add: 0, mul: 0, div: 0, calls: 0, total: 0 }}, equations: "",
     }};

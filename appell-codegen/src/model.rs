@@ -89,6 +89,8 @@ pub struct Rolling {
     pub contact: Vec3,
     /// Directions constrained (None: N.x, N.y, N.z, zero rows dropped).
     pub along: Option<Vec<Vec3>>,
+    /// The contact point's name.
+    pub point: String,
     /// The item's tokens, for errors.
     pub at: proc_macro2::TokenStream,
 }
@@ -104,6 +106,9 @@ pub struct Scene {
     /// Coordinates integrated by quadrature beside the reduced state
     /// (`outputs(quadrature(x1, y1))`).
     pub quadrature: Vec<usize>,
+    /// The outputs asked for, by kind (`quadrature`, `energies`,
+    /// `contact_forces`), in declaration order.
+    pub outputs: Vec<String>,
 }
 
 /// One privileged speed ẏ_k.
@@ -175,6 +180,8 @@ pub struct Model {
     /// Coordinates forced into the reduced state (a scene's quadrature
     /// outputs); empty for the full model.
     pub quadrature: Vec<usize>,
+    /// A scene's outputs (see [`Scene::outputs`]); empty for the full model.
+    pub outputs: Vec<String>,
     /// The name the generated `ModelInfo` carries.
     pub info_name: String,
 }
@@ -347,6 +354,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             body: bi,
             contact,
             along,
+            point: r.contact.to_string(),
             at: r.at.clone(),
         });
     }
@@ -369,8 +377,36 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             }
         }
         let mut quadrature = Vec::new();
+        let mut outputs: Vec<String> = Vec::new();
         for (kind, args) in &sc.outputs {
-            if kind == "quadrature" {
+            let k = kind.to_string();
+            if outputs.contains(&k) {
+                cx.error_spanned_by(kind, format!("scene output `{k}` is listed twice"));
+                ok = false;
+                continue;
+            }
+            outputs.push(k.clone());
+            if k == "energies" || k == "contact_forces" {
+                if let Some(a) = args.first() {
+                    cx.error_spanned_by(a, format!("`{k}` takes no arguments"));
+                    ok = false;
+                }
+                if k == "contact_forces"
+                    && ast.holonomic.is_empty()
+                    && ast.nonholonomic.is_empty()
+                    && ast.rolls.is_empty()
+                {
+                    cx.error_spanned_by(
+                        kind,
+                        "`contact_forces` needs constraints (`rolls`, `holonomic` or `nonholonomic`), and the model has none",
+                    );
+                    ok = false;
+                }
+            } else if k == "quadrature" {
+                if args.is_empty() {
+                    cx.error_spanned_by(kind, "`quadrature(...)` needs the coordinates to keep");
+                    ok = false;
+                }
                 for a in args {
                     match b.coords.iter().position(|(c, _)| c == a) {
                         Some(i) => quadrature.push(i),
@@ -386,9 +422,13 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
                     }
                 }
             } else {
+                let h = hint(
+                    &k,
+                    ["quadrature", "energies", "contact_forces"].map(String::from),
+                );
                 cx.error_spanned_by(
                     kind,
-                    format!("unknown scene output `{kind}`; available: quadrature(coordinates...)"),
+                    format!("unknown scene output `{kind}`; available: quadrature(coordinates...), energies, contact_forces{h}"),
                 );
                 ok = false;
             }
@@ -402,6 +442,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
                 name: sc.name.clone(),
                 effects: sc.effects.iter().map(|e| e.to_string()).collect(),
                 quadrature,
+                outputs,
             });
         }
     }
@@ -435,6 +476,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         effects,
         scenes,
         quadrature: Vec::new(),
+        outputs: Vec::new(),
         info_name: ast.name.to_string(),
     })
 }
@@ -447,6 +489,7 @@ pub fn scene_model(full: &Model, scene: &Scene) -> Model {
     m.torques.retain(|t| scene.effects.contains(&t.effect));
     m.effects.retain(|e| scene.effects.contains(e));
     m.quadrature = scene.quadrature.clone();
+    m.outputs = scene.outputs.clone();
     m.info_name = format!("{}::{}", full.name, scene.name);
     m.scenes = Vec::new();
     m

@@ -299,6 +299,26 @@ fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
     })
 }
 
+/// One scene output: `energies`, `contact_forces` or `quadrature(x1, y1)`.
+struct OutputItem {
+    name: Ident,
+    args: Vec<Ident>,
+}
+
+impl syn::parse::Parse for OutputItem {
+    fn parse(input: ParseStream) -> syn::Result<OutputItem> {
+        let name: Ident = input.parse()?;
+        let args = if input.peek(syn::token::Paren) {
+            let content;
+            syn::parenthesized!(content in input);
+            ident_list(content.parse()?)?
+        } else {
+            Vec::new()
+        };
+        Ok(OutputItem { name, args })
+    }
+}
+
 fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
     let name: Ident = s.parse()?;
     let mut effects = Vec::new();
@@ -313,11 +333,11 @@ fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
             "effects" => effects.extend(ident_list(item.content)?),
             "outputs" => {
                 let list = Parser::parse2(
-                    Punctuated::<Item, Token![,]>::parse_terminated,
+                    Punctuated::<OutputItem, Token![,]>::parse_terminated,
                     item.content,
                 )?;
                 for o in list {
-                    outputs.push((o.name.clone(), ident_list(o.content)?));
+                    outputs.push((o.name, o.args));
                 }
             }
             other => {

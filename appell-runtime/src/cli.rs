@@ -4,6 +4,9 @@
 //! ```text
 //! <program>              run the example's own default action
 //! <program> eval         JSON states on stdin (one per line) -> rates on stdout
+//! <program> eval --scene NAME      the same for a scene, plus its outputs
+//! <program> contacts     the same states -> multipliers and contact forces
+//! <program> contacts --scene NAME  the same for a scene (its loads only)
 //! <program> info         the model's metadata as JSON
 //! <program> equations    the derived reduced equations, as text
 //! <program> bench        time the generated rhs against the oracle, as JSON
@@ -58,6 +61,26 @@
 //! where `qdot` comes from [`Model::coordinate_rates`] and `udot` from
 //! [`Model::rhs`] (after [`Model::prepare`]).
 //!
+//! With `--scene NAME` the scene's reduced equations answer, and the
+//! outputs its `outputs(...)` asked for are added: `"energies"`
+//! (`{"kinetic", "potential", "rate", "input_power"}`, see
+//! [`crate::energy::energies`]) and `"contact_forces"` (as `contacts`
+//! answers). The full model declares no outputs.
+//!
+//! # `contacts`
+//!
+//! The same input lines, answered by [`crate::constraint_forces`]:
+//!
+//! ```text
+//! {"multipliers": [λ..], "rows": [{"source": "rolls at P, N.x", "multiplier": λ}, ..],
+//!  "contacts": [{"point": "P", "body": "disc", "position": [..], "force": [..],
+//!                "normal": {"force": N, "direction": [..], "source": "momentum balance"}
+//!                          or {"unavailable": "NoDirection"},
+//!                "friction": {"mu": μ} or {"lift_off": N} or {"unavailable": ".."}}]}
+//! ```
+//!
+//! Forces are on the body, from the ground, in N components.
+//!
 //! # `info`
 //!
 //! One JSON object: `name`, `parameters` (a list of `{"name", "value"}` in
@@ -65,7 +88,9 @@
 //! `speeds`, `dependent`, `cyclic`, `ignorable`, `retained`, `state` (the
 //! retained names then the speeds' names suffixed `_dot`), `inputs`,
 //! `effects`, `bodies` (a list of `{"name", "rigid"}`), `holonomic`,
-//! `constraints`, `force_points`, `torques`, `symbolic_elimination` and
+//! `constraints`, `contacts` (a list of `{"point", "body", "along"}`),
+//! `scenes` (a list of `{"name", "effects", "retained", "state_len",
+//! "rhs_ops", "outputs"}`), `force_points`, `torques`, `symbolic_elimination` and
 //! `rhs_ops` (`{"add", "mul", "div", "calls", "total"}`). See [`info_json`].
 //!
 //! # `bench`
@@ -94,7 +119,8 @@
 //! status 1. States up to [`ACCURACY_MAX_STATE`] entries. See [`accuracy()`].
 
 use crate::accuracy::{standard_methods, Problem};
-use crate::model::{Model, ModelError, ModelInfo};
+use crate::constraint_forces::{contact_forces, Friction, Normal, NormalSource};
+use crate::model::{Model, ModelError, ModelInfo, RowSource, SceneVisitor};
 use serde_json::{json, Map, Value};
 use std::error::Error;
 use std::hint::black_box;
@@ -161,17 +187,17 @@ impl From<ModelError> for CliError {
 /// # use appell_runtime::{ModelInfo, OpCounts};
 /// # let info = ModelInfo {
 /// #     name: "Pendulum", parameters: &[], coordinates: &[], speeds: &[], dependent: &[],
-/// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[],
+/// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[],
 /// #     holonomic: 0, constraints: 0, bodies: &[], force_points: 0, torques: 0,
 /// #     symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
 /// # };
 /// let text = appell_runtime::cli::usage("pendulum", &info);
-/// assert!(text.starts_with("usage: pendulum [eval|info|equations|bench|accuracy|help]"));
+/// assert!(text.starts_with("usage: pendulum [eval|contacts|info|equations|bench|accuracy|help]"));
 /// assert!(text.contains("Pendulum"));
 /// ```
 pub fn usage(program: &str, info: &ModelInfo) -> String {
     format!(
-        "usage: {program} [eval|info|equations|bench|accuracy|help]\n\
+        "usage: {program} [eval|contacts|info|equations|bench|accuracy|help]\n\
          \n\
          Model `{name}`.\n\
          \n\
@@ -181,6 +207,9 @@ pub fn usage(program: &str, info: &ModelInfo) -> String {
          \x20             {{\"t\": 0, \"params\": {{..}}, \"q\": {{coordinate: value}},\n\
          \x20              \"u\": {{speed coordinate: value}}, \"inputs\": {{..}}}}\n\
          \x20             -> {{\"qdot\": {{..}}, \"udot\": {{..}}}} or {{\"error\": \"..\"}}\n\
+         \x20             (`eval --scene NAME`: a scene, plus the outputs it asks for)\n\
+         \x20 contacts    the same input -> constraint multipliers, contact forces and\n\
+         \x20             the friction rolling needs (`contacts --scene NAME` too)\n\
          \x20 info        print the model's metadata as JSON\n\
          \x20 equations   print the derived equations\n\
          \x20 bench       time the generated rhs against the oracle, print JSON\n\
@@ -238,7 +267,7 @@ pub fn run<M: Model>(
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Free", parameters: &["m"], coordinates: &["x"], speeds: &["x"],
 /// #     dependent: &[], cyclic: &[], ignorable: &["x"], retained: &[], inputs: &["f"],
-/// #     effects: &["push"], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+/// #     effects: &["push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
 /// #     torques: 0, symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
 /// #     equations: "x'' = f/m",
@@ -300,8 +329,9 @@ pub fn run_with<M: Model>(
     let program = args.first().map(String::as_str).unwrap_or(info.name);
     let rest = args.get(1..).unwrap_or(&[]);
     if let [command, flag, name] = rest {
-        if command == "eval" && flag == "--scene" {
+        if (command == "eval" || command == "contacts") && flag == "--scene" {
             let mut evaluator = Evaluator::with_scene(model, name)?;
+            evaluator.contacts = command == "contacts";
             return eval_stream(&mut evaluator, stdin, stdout);
         }
     }
@@ -318,6 +348,11 @@ pub fn run_with<M: Model>(
     match command {
         "eval" => {
             let mut evaluator = Evaluator::new(model)?;
+            eval_stream(&mut evaluator, stdin, stdout)
+        }
+        "contacts" => {
+            let mut evaluator = Evaluator::new(model)?;
+            evaluator.contacts = true;
             eval_stream(&mut evaluator, stdin, stdout)
         }
         "info" => {
@@ -401,7 +436,7 @@ fn eval_stream<M: Model>(
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Spin", parameters: &["i"], coordinates: &["phi"], speeds: &["phi"],
 /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["phi"], inputs: &["tau"],
-/// #     effects: &["motor"], holonomic: 0, constraints: 0,
+/// #     effects: &["motor"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
 /// #     bodies: &[BodyInfo { name: "B", rigid: true }], force_points: 0, torques: 1,
 /// #     symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
@@ -465,6 +500,7 @@ pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
                 "retained": s.retained,
                 "state_len": s.state_len(),
                 "rhs_ops": s.rhs_ops.total,
+                "outputs": s.outputs,
             })
         })
         .collect();
@@ -484,6 +520,15 @@ pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
         "bodies": bodies,
         "holonomic": info.holonomic,
         "constraints": info.constraints,
+        "contacts": info
+            .contacts
+            .iter()
+            .map(|c| json!({
+                "point": c.point,
+                "body": info.bodies.get(c.body).map(|b| b.name),
+                "along": c.along,
+            }))
+            .collect::<Vec<_>>(),
         "force_points": info.force_points,
         "torques": info.torques,
         "symbolic_elimination": info.symbolic_elimination,
@@ -512,6 +557,8 @@ pub struct Evaluator<M: Model> {
     model: M,
     defaults: Vec<f64>,
     scene: Option<usize>,
+    /// Answer with the constraint forces instead of the rates (`contacts`).
+    contacts: bool,
 }
 
 impl<M: Model> Evaluator<M> {
@@ -523,6 +570,7 @@ impl<M: Model> Evaluator<M> {
             model,
             defaults,
             scene: None,
+            contacts: false,
         })
     }
 
@@ -581,6 +629,27 @@ impl<M: Model> Evaluator<M> {
         };
         let point = self.parse_point(&obj, &[])?;
         let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);
+        let outputs = |energies: bool, contacts: bool| {
+            let visitor = Outputs {
+                t,
+                q: &q,
+                u: &u,
+                inputs: &inputs,
+                energies,
+                contacts,
+            };
+            match self.scene {
+                Some(i) => self
+                    .model
+                    .visit_scene(i, visitor)
+                    .map_err(|e| e.to_string())?,
+                None => visitor.visit(&self.model),
+            }
+        };
+        if self.contacts {
+            let mut out = outputs(false, true)?;
+            return Ok(out.remove("contact_forces").unwrap_or(Value::Null));
+        }
         let mut dstate = vec![0.0; info.state_len()];
         match self.scene {
             Some(i) => self.model.scene_rhs(i, t, &state, &inputs, &mut dstate),
@@ -604,7 +673,17 @@ impl<M: Model> Evaluator<M> {
         for (name, v) in info.speeds.iter().zip(udot) {
             udot_out.insert(name.to_string(), result_number(*v, name)?);
         }
-        Ok(json!({ "qdot": qdot_out, "udot": udot_out }))
+        let mut answer = Map::new();
+        answer.insert("qdot".into(), Value::Object(qdot_out));
+        answer.insert("udot".into(), Value::Object(udot_out));
+        let (energies, contacts) = (
+            info.has_output("energies"),
+            info.has_output("contact_forces"),
+        );
+        if energies || contacts {
+            answer.extend(outputs(energies, contacts)?);
+        }
+        Ok(Value::Object(answer))
     }
 
     /// Reads `t`, `params`, `q`, `u` and `inputs` of a JSON object (fields
@@ -673,6 +752,126 @@ impl<M: Model> Evaluator<M> {
             state,
         })
     }
+}
+
+/// The outputs a scene asks for (or the `contacts` answer), computed on
+/// the scene's own type.
+struct Outputs<'a> {
+    t: f64,
+    q: &'a [f64],
+    u: &'a [f64],
+    inputs: &'a [f64],
+    energies: bool,
+    contacts: bool,
+}
+
+impl SceneVisitor for Outputs<'_> {
+    type Output = Result<Map<String, Value>, String>;
+
+    fn visit<S: Model>(self, model: &S) -> Self::Output {
+        let mut out = Map::new();
+        if self.energies {
+            let e = crate::energy::energies(model, self.t, self.q, self.u, self.inputs)
+                .map_err(|e| e.to_string())?;
+            out.insert(
+                "energies".into(),
+                json!({
+                    "kinetic": finite_or_null(e.kinetic),
+                    "potential": finite_or_null(e.potential),
+                    "rate": finite_or_null(e.rate),
+                    "input_power": finite_or_null(e.input_power),
+                }),
+            );
+        }
+        if self.contacts {
+            out.insert(
+                "contact_forces".into(),
+                contact_forces_json(model, self.t, self.q, self.u, self.inputs)?,
+            );
+        }
+        Ok(out)
+    }
+}
+
+/// `{"multipliers": [..], "rows": [{"source", "multiplier"}], "contacts":
+/// [{"point", "body", "position", "force", "normal", "friction"}]}`.
+fn contact_forces_json<S: Model>(
+    model: &S,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+) -> Result<Value, String> {
+    let info = S::info();
+    let f = contact_forces(model, t, q, u, inputs).map_err(|e| e.to_string())?;
+    let v3 = |v: [f64; 3]| {
+        json!([
+            finite_or_null(v[0]),
+            finite_or_null(v[1]),
+            finite_or_null(v[2])
+        ])
+    };
+    let rows: Vec<Value> = f
+        .rows
+        .iter()
+        .map(|r| {
+            let source = match r.source {
+                RowSource::Holonomic { index } => format!("holonomic {index}"),
+                RowSource::Nonholonomic { index } => format!("nonholonomic {index}"),
+                RowSource::Rolling { contact, direction } => {
+                    let point = info.contacts.get(contact).map_or("?", |c| c.point);
+                    match info.contacts.get(contact) {
+                        Some(c) if !c.along => {
+                            format!("rolls at {point}, N.{}", ["x", "y", "z"][direction.min(2)])
+                        }
+                        _ => format!("rolls at {point}, along {direction}"),
+                    }
+                }
+            };
+            json!({ "source": source, "multiplier": finite_or_null(r.multiplier) })
+        })
+        .collect();
+    let contacts: Vec<Value> = f
+        .contacts
+        .iter()
+        .map(|c| {
+            let normal = match c.normal {
+                Normal::Available {
+                    direction,
+                    force,
+                    source,
+                } => json!({
+                    "force": finite_or_null(force),
+                    "direction": v3(direction),
+                    "source": match source {
+                        NormalSource::HolonomicRow { index } => format!("holonomic {index}"),
+                        NormalSource::MomentumBalance => "momentum balance".to_string(),
+                    },
+                }),
+                Normal::Unavailable(why) => json!({ "unavailable": format!("{why:?}") }),
+            };
+            let friction = match c.friction() {
+                Friction::Required { mu, .. } => json!({ "mu": finite_or_null(mu) }),
+                Friction::LiftOff { normal } => json!({ "lift_off": finite_or_null(normal) }),
+                Friction::NormalUnavailable(why) => {
+                    json!({ "unavailable": format!("{why:?}") })
+                }
+            };
+            json!({
+                "point": c.point,
+                "body": info.bodies.get(c.body).map(|b| b.name),
+                "position": v3(c.position),
+                "force": v3(c.force),
+                "normal": normal,
+                "friction": friction,
+            })
+        })
+        .collect();
+    Ok(json!({
+        "multipliers": f.multipliers.iter().map(|x| finite_or_null(*x)).collect::<Vec<_>>(),
+        "rows": rows,
+        "contacts": contacts,
+    }))
 }
 
 /// A parsed `eval` object.

@@ -17,6 +17,8 @@ pub mod accuracy;
 #[cfg(feature = "std")]
 pub mod cli;
 #[cfg(feature = "std")]
+pub mod constraint_forces;
+#[cfg(feature = "std")]
 pub mod energy;
 pub mod integrate;
 pub mod linalg;
@@ -27,7 +29,10 @@ mod model;
 pub mod oracle;
 mod scalar;
 
-pub use model::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts};
+pub use model::{
+    check_len, BodyInfo, ContactInfo, Model, ModelError, ModelInfo, OpCounts, RowSource,
+    SceneVisitor,
+};
 pub use scalar::Scalar;
 
 /// Items the generated code refers to; not a stable API.
@@ -35,6 +40,9 @@ pub use scalar::Scalar;
 pub mod __private {
     pub use crate::linalg::{ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs};
     pub use crate::model::check_len;
-    pub use crate::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+    pub use crate::{
+        BodyInfo, ContactInfo, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar,
+        SceneVisitor,
+    };
     pub use core::result::Result::{self, Err, Ok};
 }

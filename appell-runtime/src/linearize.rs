@@ -30,7 +30,7 @@
 //! # static INFO: ModelInfo = ModelInfo {
 //! #     name: "Ring", parameters: &["m", "l", "g"], coordinates: &["x", "y"],
 //! #     speeds: &["x"], dependent: &["y"], cyclic: &[], ignorable: &[],
-//! #     retained: &["x", "y"], inputs: &["f"], effects: &["gravity", "push"], holonomic: 1,
+//! #     retained: &["x", "y"], inputs: &["f"], effects: &["gravity", "push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 //! #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
 //! #     force_points: 1, torques: 0, symbolic_elimination: true,
 //! #     rhs_ops: OpCounts { add: 5, mul: 9, div: 3, calls: 0, total: 18 },
@@ -670,7 +670,7 @@ pub fn holonomic_unknowns<M: Model>(
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Ring", parameters: &["l"], coordinates: &["x", "y"],
 /// #     speeds: &["x"], dependent: &["y"], cyclic: &[], ignorable: &[],
-/// #     retained: &["x", "y"], inputs: &[], effects: &[], holonomic: 1,
+/// #     retained: &["x", "y"], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
 /// #     force_points: 0, torques: 0, symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",

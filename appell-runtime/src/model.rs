@@ -39,6 +39,46 @@ pub struct BodyInfo {
     pub rigid: bool,
 }
 
+/// Where a velocity constraint row (a row of D in D q̇ + d = 0) comes from.
+///
+/// Rows are ordered: the differentiated `holonomic(...)` constraints, then
+/// the `nonholonomic(...)` ones, then the components of each `rolls(...)`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum RowSource {
+    /// The time derivative of the `index`-th `holonomic(...)` constraint.
+    Holonomic {
+        /// Declaration index among the holonomic constraints.
+        index: usize,
+    },
+    /// The `index`-th `nonholonomic(...)` constraint.
+    Nonholonomic {
+        /// Declaration index among the nonholonomic constraints.
+        index: usize,
+    },
+    /// The velocity component e·v of the body's material point at a rolling
+    /// contact along one direction e ([`Model::contact_geometry`] gives e).
+    Rolling {
+        /// Index into [`ModelInfo::contacts`].
+        contact: usize,
+        /// 0, 1, 2 for N.x, N.y, N.z (a contact without `along`), or the
+        /// index into the contact's `along = [...]` list.
+        direction: usize,
+    },
+}
+
+/// A `rolls(...)` contact of the model.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ContactInfo {
+    /// Index of the rolling body in [`ModelInfo::bodies`].
+    pub body: usize,
+    /// The name of the contact point.
+    pub point: &'static str,
+    /// True when the contact constrains only the `along = [...]`
+    /// directions; false when it constrains the N components (rows that
+    /// are identically zero dropped).
+    pub along: bool,
+}
+
 /// Everything about a model that does not depend on numbers.
 #[derive(Clone, Copy, Debug)]
 pub struct ModelInfo {
@@ -67,11 +107,20 @@ pub struct ModelInfo {
     pub inputs: &'static [&'static str],
     /// Names of the load effects.
     pub effects: &'static [&'static str],
+    /// Outputs the scene asked for in `outputs(...)` (`"quadrature"`,
+    /// `"energies"`, `"contact_forces"`), in declaration order; empty for a
+    /// full model. Tools (the command line's `eval --scene`) report these
+    /// beside the state; the library functions compute them for any model.
+    pub outputs: &'static [&'static str],
     /// Number of holonomic constraints (configuration level).
     pub holonomic: usize,
     /// Number of velocity constraint rows (holonomic ones differentiated
     /// plus nonholonomic ones): m.
     pub constraints: usize,
+    /// The source of each velocity constraint row, one per row.
+    pub row_sources: &'static [RowSource],
+    /// The rolling contacts, in declaration order.
+    pub contacts: &'static [ContactInfo],
     /// Bodies and particles, in declaration order.
     pub bodies: &'static [BodyInfo],
     /// Number of force application points.
@@ -91,6 +140,11 @@ impl ModelInfo {
     /// Length of the reduced state.
     pub fn state_len(&self) -> usize {
         self.retained.len() + self.speeds.len()
+    }
+
+    /// Whether the scene asked for an output (`outputs(...)`), by name.
+    pub fn has_output(&self, name: &str) -> bool {
+        self.outputs.contains(&name)
     }
 
     /// The index of a coordinate by name.
@@ -386,6 +440,43 @@ pub trait Model {
         frames: &mut [[T; 9]],
     ) -> Result<(), ModelError>;
 
+    /// The rolling contacts' geometry at `(q, t)`: the position (N
+    /// components) of every contact point in [`ModelInfo::contacts`] order,
+    /// and for every velocity constraint row the direction e (N components)
+    /// whose velocity component e·v_P it constrains
+    /// ([`RowSource::Rolling`]), zero for the other rows. The default serves
+    /// models without rolling contacts (it writes zero directions and no
+    /// points); a model that lists contacts must implement it.
+    fn contact_geometry<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        points: &mut [[T; 3]],
+        directions: &mut [[T; 3]],
+    ) -> Result<(), ModelError> {
+        let _ = t;
+        let info = Self::info();
+        check_len("q", q, info.coordinates.len())?;
+        check_len("points", points, info.contacts.len())?;
+        check_len("directions", directions, info.constraints)?;
+        for d in directions.iter_mut() {
+            *d = [T::zero(); 3];
+        }
+        Ok(())
+    }
+
+    /// Calls `visitor` with scene `scene` (an index into
+    /// [`Model::scene_infos`]) as its own [`Model`] type, so tools that pick
+    /// a scene by name at run time can use any generic function on it.
+    fn visit_scene<V: SceneVisitor>(
+        &self,
+        scene: usize,
+        visitor: V,
+    ) -> Result<V::Output, ModelError> {
+        let _ = visitor;
+        Err(ModelError::UnknownScene { index: scene })
+    }
+
     /// Load values (N components) at `(q, q̇, t)` and inputs.
     fn load_values<T: Scalar>(
         &self,
@@ -396,4 +487,12 @@ pub trait Model {
         forces: &mut [[T; 3]],
         torques: &mut [[T; 3]],
     ) -> Result<(), ModelError>;
+}
+
+/// A generic operation on a scene, for [`Model::visit_scene`].
+pub trait SceneVisitor {
+    /// What the operation returns.
+    type Output;
+    /// Runs the operation on the scene's model.
+    fn visit<S: Model>(self, scene: &S) -> Self::Output;
 }

@@ -52,7 +52,7 @@
 //! # static INFO: ModelInfo = ModelInfo {
 //! #     name: "Pendulum", parameters: &["m", "l", "g"], coordinates: &["theta"],
 //! #     speeds: &["theta"], dependent: &[], cyclic: &[], ignorable: &[],
-//! #     retained: &["theta"], inputs: &[], effects: &["gravity"], holonomic: 0,
+//! #     retained: &["theta"], inputs: &[], effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0,
 //! #     constraints: 0, bodies: &[BodyInfo { name: "P", rigid: false }],
 //! #     force_points: 1, torques: 0, symbolic_elimination: true,
 //! #     rhs_ops: OpCounts { add: 0, mul: 1, div: 1, calls: 1, total: 4 },

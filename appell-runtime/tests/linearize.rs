@@ -198,6 +198,9 @@ const BASE_INFO: ModelInfo = ModelInfo {
     retained: &[],
     inputs: &[],
     effects: &[],
+    outputs: &[],
+    row_sources: &[],
+    contacts: &[],
     holonomic: 0,
     constraints: 0,
     bodies: &[BodyInfo {

@@ -11,7 +11,9 @@ use appell::Appell;
 ///
 /// Scenes: `WheelAxleCoasting` (gravity only), `WheelAxleDriven` (the drive
 /// torque only: on level ground the heading drops out of the state) and
-/// `WheelAxleTrack` (everything, plus the track of wheel 1 by quadrature).
+/// `WheelAxleTrack` (everything, plus the track of wheel 1 by quadrature),
+/// `WheelAxleContactCheck` (coasting, reporting the constraint reactions
+/// and the energies).
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(coordinates(x1, y1, psi1, x2, y2, psi2, phi))]
 #[appell(speeds(phi, psi1))]
@@ -37,6 +39,7 @@ use appell::Appell;
 #[appell(scene(coasting, effects(gravity)))]
 #[appell(scene(driven, effects(motor)))]
 #[appell(scene(track, effects(gravity, motor), outputs(quadrature(x1, y1))))]
+#[appell(scene(contact_check, effects(gravity), outputs(contact_forces, energies)))]
 pub struct WheelAxle {
     /// Wheel radius a [m].
     pub a: f64,

@@ -637,7 +637,7 @@ impl TrBdf2 {
     /// # static INFO: ModelInfo = ModelInfo {
     /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
     /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
     /// #     equations: "x'' = -w^2 x",
@@ -707,7 +707,7 @@ impl TrBdf2 {
     /// # static INFO: ModelInfo = ModelInfo {
     /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
     /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
     /// #     equations: "x'' = -w^2 x",

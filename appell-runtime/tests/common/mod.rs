@@ -59,6 +59,9 @@ pub static PENDULUM_INFO: ModelInfo = ModelInfo {
     retained: &["theta"],
     inputs: &[],
     effects: &["gravity"],
+    outputs: &[],
+    row_sources: &[],
+    contacts: &[],
     holonomic: 0,
     constraints: 0,
     bodies: &[BodyInfo {
@@ -288,6 +291,9 @@ pub static ROD_INFO: ModelInfo = ModelInfo {
     retained: &["theta"],
     inputs: &[],
     effects: &["gravity", "damper"],
+    outputs: &[],
+    row_sources: &[],
+    contacts: &[],
     holonomic: 0,
     constraints: 0,
     bodies: &[BodyInfo {
@@ -545,6 +551,9 @@ pub static KNIFE_INFO: ModelInfo = ModelInfo {
     retained: &["phi"],
     inputs: &["tau"],
     effects: &["field", "drag", "motor"],
+    outputs: &[],
+    row_sources: &[],
+    contacts: &[],
     holonomic: 0,
     constraints: 1,
     bodies: &[BodyInfo {
@@ -831,6 +840,9 @@ pub static CARTESIAN_INFO: ModelInfo = ModelInfo {
     retained: &["x", "y"],
     inputs: &[],
     effects: &["gravity"],
+    outputs: &[],
+    row_sources: &[],
+    contacts: &[],
     holonomic: 1,
     constraints: 1,
     bodies: &[BodyInfo {
@@ -1193,6 +1205,9 @@ pub static GYRO_INFO: ModelInfo = ModelInfo {
     retained: &["psi", "theta", "phi"],
     inputs: &["lx", "ly", "lz"],
     effects: &["pull", "motor"],
+    outputs: &[],
+    row_sources: &[],
+    contacts: &[],
     holonomic: 0,
     constraints: 0,
     bodies: &[BodyInfo {
