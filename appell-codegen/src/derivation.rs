@@ -1295,7 +1295,7 @@ fn mat_vec(g: &mut appell_symbolic::Graph, m: &Mat3, v: Vec3) -> Result<Vec3, Sy
 
 /// A value in [0.5, 1.5] for parameters and [−1, 1] for everything else,
 /// fixed by the symbol and the trial number.
-fn pseudo_value(g: &appell_symbolic::Graph, s: Symbol, trial: u64) -> f64 {
+pub(crate) fn pseudo_value(g: &appell_symbolic::Graph, s: Symbol, trial: u64) -> f64 {
     let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
         ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     h ^= h >> 31;

@@ -692,6 +692,20 @@ impl Builder<'_> {
                 RotationAxis::Parent(k) => self.parent_axis_rotation(*k, angle, rot, omega),
                 RotationAxis::Vector(v) => {
                     let Some(u) = self.vector(v) else { return };
+                    match self.fixed_in(u, &rot) {
+                        Ok(true) => {}
+                        Ok(false) => {
+                            self.cx.error_at(
+                                v.span(),
+                                "the axis of `rotate(axis, angle)` must be fixed in the frame it rotates from (write it with that frame's unit vectors and constants); this one turns relative to it as the coordinates change",
+                            );
+                            return;
+                        }
+                        Err(e) => {
+                            engine_error(self.cx, v.span(), e);
+                            return;
+                        }
+                    }
                     self.axis_rotation(u, angle, rot, omega)
                 }
             };
@@ -711,6 +725,38 @@ impl Builder<'_> {
             rot,
             omega,
         });
+    }
+
+    /// Whether the vector `u` (N components) is fixed in the frame with
+    /// rotation `rot`: its components there do not change with time, checked
+    /// at three pseudo-random configurations and rates (any failure to
+    /// evaluate counts as not fixed).
+    fn fixed_in(&mut self, u: Vec3, rot: &Mat3) -> Result<bool, SymbolicError> {
+        let g = &mut self.g;
+        let local = mat_vec3(g, rot, u, true)?;
+        let rules = RateRules::coordinates();
+        let rates = [
+            g.time_derivative(local[0], &rules)?,
+            g.time_derivative(local[1], &rules)?,
+            g.time_derivative(local[2], &rules)?,
+        ];
+        if rates.iter().all(|&r| g.is_zero(r)) {
+            return Ok(true);
+        }
+        let mut roots = rates.to_vec();
+        roots.extend(local);
+        let tape = appell_symbolic::Tape::new(g, &roots);
+        for trial in 0..3u64 {
+            let env = |s: Symbol| Some(crate::derivation::pseudo_value(g, s, trial));
+            let Ok(v) = tape.eval(&env) else {
+                return Ok(false);
+            };
+            let scale = 1.0 + v[3..].iter().fold(0.0f64, |a, x| a.max(x.abs()));
+            if v[..3].iter().any(|r| !(r.abs() <= 1e-9 * scale)) {
+                return Ok(false);
+            }
+        }
+        Ok(true)
     }
 
     /// Rotation about the parent's axis `k`: R = R_parent Rk(θ),
@@ -1414,4 +1460,19 @@ pub fn cross(g: &mut Graph, a: Vec3, b: Vec3) -> Result<Vec3, SymbolicError> {
 /// Whether a symbol is of a kind that may appear in a parameter-only value.
 pub fn is_parameter(g: &Graph, s: Symbol) -> bool {
     g.symbol_kind(s) == SymbolKind::Parameter
+}
+
+/// `m v`, or `mᵀ v` when `transpose`.
+fn mat_vec3(g: &mut Graph, m: &Mat3, v: Vec3, transpose: bool) -> Result<Vec3, SymbolicError> {
+    let mut out = v;
+    for i in 0..3 {
+        let t: Vec<Id> = (0..3)
+            .map(|k| {
+                let e = if transpose { m[k][i] } else { m[i][k] };
+                g.mul(e, v[k])
+            })
+            .collect::<Result<_, _>>()?;
+        out[i] = g.sum(&t)?;
+    }
+    Ok(out)
 }
