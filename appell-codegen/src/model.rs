@@ -752,7 +752,7 @@ impl Builder<'_> {
                 return Ok(false);
             };
             let scale = 1.0 + v[3..].iter().fold(0.0f64, |a, x| a.max(x.abs()));
-            if v[..3].iter().any(|r| !(r.abs() <= 1e-9 * scale)) {
+            if v[..3].iter().any(|r| r.is_nan() || r.abs() > 1e-9 * scale) {
                 return Ok(false);
             }
         }
