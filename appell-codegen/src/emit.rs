@@ -137,6 +137,43 @@ impl Emitter<'_> {
         s
     }
 
+    /// Statements returning `NonFinite` naming the first state component,
+    /// input or parameter of the rhs that is NaN or infinite.
+    fn non_finite_diagnosis(&self) -> String {
+        let d = self.d;
+        let model = &d.model;
+        let mut s = String::new();
+        let mut names: Vec<String> = d.retained.iter().map(|&r| self.coord(r)).collect();
+        names.extend(model.speed_specs.iter().map(|sp| {
+            let name = d.model.g.symbol_name(sp.symbol).to_string();
+            match sp.coordinate {
+                Some(_) => name,
+                None => sp.name.clone(),
+            }
+        }));
+        for (k, name) in names.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "                if !{P}::Scalar::re(__state[{k}]).is_finite() {{ return {P}::Err({P}::ModelError::NonFinite {{ what: \"state component `{name}`\" }}); }}"
+            );
+        }
+        for (k, (name, _)) in model.inputs.iter().enumerate() {
+            let _ = writeln!(
+                s,
+                "                if !{P}::Scalar::re(__inputs[{k}]).is_finite() {{ return {P}::Err({P}::ModelError::NonFinite {{ what: \"input `{name}`\" }}); }}"
+            );
+        }
+        for p in &model.params {
+            let f = &p.ident;
+            let _ = writeln!(
+                s,
+                "                if !{this}.{f}.is_finite() {{ return {P}::Err({P}::ModelError::NonFinite {{ what: \"parameter `{f}`\" }}); }}",
+                this = self.this
+            );
+        }
+        s
+    }
+
     fn check(&self, arg: &str, len: usize) -> String {
         format!("        {P}::check_len(\"{arg}\", {arg}, {len})?;\n")
     }
@@ -802,8 +839,18 @@ impl Emitter<'_> {
     }}
     fn rhs<__T: {P}::Scalar>(&self, __prepared: &[__T; {h}], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_state}{chk_inputs}{chk_dstate}{pos}        let [{hoisted_list}] = *__prepared;
+        let __result: {P}::Result<(), {P}::ModelError> = (|| {{
 {params_t}{bind_state}{bind_inputs}{rhs_body}{ldlt}{write_out}        if !({finite}) {{ return {P}::Err({P}::ModelError::NonFinite {{ what: "the state derivative" }}); }}
         {P}::Ok(())
+        }})();
+        match __result {{
+            {P}::Ok(()) => {P}::Ok(()),
+            // On the cold path only: a NaN or infinite state, input or
+            // parameter is named rather than the symptom it caused.
+            {P}::Err(__e) => {{
+{diagnose}                {P}::Err(__e)
+            }}
+        }}
     }}
     fn mass_matrix_and_forcing<__T: {P}::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
 {chk_q}{chk_u}{chk_inputs}{chk_m}{chk_f}{pos}{params_t}{bind_q}{bind_u}{bind_inputs}{elim_full}{mf_body}{mf_out}        {P}::Ok(())
@@ -891,6 +938,7 @@ impl Emitter<'_> {
             bind_u = self.bind_u("__u"),
             bind_qdot = self.bind_qdot("__qdot"),
             rhs_body = rhs_text,
+            diagnose = self.non_finite_diagnosis(),
             mf_body = statements(&mf),
             mf_out = {
                 let mut s = outputs_into(

@@ -1,0 +1,44 @@
+//! The hard-case catalogue at the published horizons: one row per check,
+//! with its criterion, the measured figure and pass or fail. The same cases
+//! run at shorter horizons in `cargo test --test hard_cases`.
+//!
+//! Run: `cargo run --release --example hard_cases`.
+
+#[path = "../tests/hard_cases/cases.rs"]
+mod cases;
+
+use std::process::ExitCode;
+use std::time::Instant;
+
+fn main() -> ExitCode {
+    let started = Instant::now();
+    let mut rows = Vec::new();
+    rows.extend(cases::a01_long_horizon(2000.0));
+    rows.extend(cases::singular_dependent_block());
+    rows.extend(cases::disc_steady_circle());
+    rows.extend(cases::bicycle_self_stability(10.0));
+    rows.extend(cases::bad_states());
+    println!("| case | criterion | measured | result |");
+    println!("| --- | --- | --- | --- |");
+    for r in &rows {
+        println!(
+            "| {} | {} | {} | {} |",
+            r.case,
+            r.criterion,
+            r.measured,
+            if r.pass { "pass" } else { "FAIL" }
+        );
+    }
+    let failed = rows.iter().filter(|r| !r.pass).count();
+    println!(
+        "\n{} checks, {} failed, {:.1} s",
+        rows.len(),
+        failed,
+        started.elapsed().as_secs_f64()
+    );
+    if failed == 0 {
+        ExitCode::SUCCESS
+    } else {
+        ExitCode::FAILURE
+    }
+}

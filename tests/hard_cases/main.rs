@@ -1,0 +1,65 @@
+//! The hard-case catalogue, as tests (`cargo run --release --example
+//! hard_cases` prints the same checks as a table).
+
+mod cases;
+
+fn check(rows: Vec<cases::CaseResult>) {
+    for r in &rows {
+        println!(
+            "{} | {} | {} | {}",
+            r.case,
+            r.criterion,
+            r.measured,
+            if r.pass { "pass" } else { "FAIL" }
+        );
+    }
+    for r in &rows {
+        assert!(
+            r.pass,
+            "{}: {} — measured {}",
+            r.case, r.criterion, r.measured
+        );
+    }
+}
+
+#[test]
+fn a01_pendulum_2000_s() {
+    // The published horizon: about a million rhs calls, well under a
+    // second even in the test profile.
+    check(cases::a01_long_horizon(2000.0));
+}
+
+#[test]
+fn singular_dependent_blocks_are_typed_errors() {
+    check(cases::singular_dependent_block());
+}
+
+#[test]
+fn disc_rolls_a_steady_circle() {
+    check(cases::disc_steady_circle());
+}
+
+#[test]
+fn bicycle_self_stability_matches_its_eigenvalues() {
+    check(cases::bicycle_self_stability(10.0));
+}
+
+#[test]
+fn bad_states_are_named() {
+    check(cases::bad_states());
+}
+
+#[test]
+fn elliptic_functions_match_known_values() {
+    // K(0) = π/2; sn(u | 0) = sin u; sn(u | 1) = tanh u (up to the
+    // AGM's limit); K(1/2) = 1.854074677301372.
+    assert!((cases::elliptic_k(0.0) - std::f64::consts::FRAC_PI_2).abs() < 1e-15);
+    assert!((cases::elliptic_k(0.5) - 1.854074677301372).abs() < 1e-14);
+    for u in [0.1, 0.7, 2.0, 5.0] {
+        assert!((cases::jacobi_sn(u, 0.0) - f64::sin(u)).abs() < 1e-14);
+    }
+    // The small-amplitude pendulum is harmonic.
+    let t = 1.3;
+    let th = cases::pendulum_exact(1e-4, 9.81, 1.0, t);
+    assert!((th - 1e-4 * (9.81f64.sqrt() * t).cos()).abs() < 1e-12);
+}
