@@ -45,6 +45,21 @@ fn bicycle_self_stability_matches_its_eigenvalues() {
 }
 
 #[test]
+fn bicycle_pitch_drift_is_removed_by_projection() {
+    check(cases::bicycle_pitch_drift(10_000));
+}
+
+#[test]
+fn stiff_spring_pendulum_completes() {
+    check(cases::stiff_spring(1.0));
+}
+
+#[test]
+fn mass_ratio_chain_factorization_stays_accurate() {
+    check(cases::mass_ratio_chain());
+}
+
+#[test]
 fn bad_states_are_named() {
     check(cases::bad_states());
 }
