@@ -27,6 +27,7 @@ pub mod linearize;
 mod model;
 #[cfg(feature = "std")]
 pub mod oracle;
+pub mod precision;
 mod scalar;
 
 pub use model::{
