@@ -6,6 +6,8 @@
 
 #[path = "../tests/hard_cases/cases.rs"]
 mod cases;
+#[path = "../tests/hard_cases/precision.rs"]
+mod precision;
 
 use std::process::ExitCode;
 use std::time::Instant;
@@ -21,6 +23,8 @@ fn main() -> ExitCode {
     rows.extend(cases::stiff_spring(1.0));
     rows.extend(cases::mass_ratio_chain());
     rows.extend(cases::bad_states());
+    rows.extend(precision::round_off_all(10_000));
+    rows.extend(precision::double_pendulum_chaos(1000.0));
     println!("| case | criterion | measured | result |");
     println!("| --- | --- | --- | --- |");
     for r in &rows {

@@ -2,6 +2,7 @@
 //! hard_cases` prints the same checks as a table).
 
 mod cases;
+mod precision;
 
 fn check(rows: Vec<cases::CaseResult>) {
     for r in &rows {
@@ -77,4 +78,17 @@ fn elliptic_functions_match_known_values() {
     let t = 1.3;
     let th = cases::pendulum_exact(1e-4, 9.81, 1.0, t);
     assert!((th - 1e-4 * (9.81f64.sqrt() * t).cos()).abs() < 1e-12);
+}
+
+#[test]
+fn generated_code_round_off_is_bounded() {
+    // Item 7 on 10,000 random states per model.
+    check(precision::round_off_all(10_000));
+}
+
+#[test]
+fn double_pendulum_separates_when_its_lyapunov_exponent_says() {
+    // Item 8 with the exponent averaged over 200 s (1,000 s in the
+    // example).
+    check(precision::double_pendulum_chaos(200.0));
 }
