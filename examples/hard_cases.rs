@@ -16,6 +16,18 @@ fn main() -> ExitCode {
     let started = Instant::now();
     let mut rows = Vec::new();
     rows.extend(cases::a01_long_horizon(2000.0));
+    let two = cases::FourBar2 {
+        a: 1.0,
+        m: 1.0,
+        g: 9.81,
+    };
+    rows.extend(cases::four_bar_singular_positions(&two, 2, 10.0, 1e-3));
+    let forty = cases::FourBar40 {
+        a: 1.0,
+        m: 1.0,
+        g: 9.81,
+    };
+    rows.extend(cases::four_bar_singular_positions(&forty, 40, 20.0, 5e-3));
     rows.extend(cases::singular_dependent_block());
     rows.extend(cases::disc_steady_circle());
     rows.extend(cases::bicycle_self_stability(10.0));

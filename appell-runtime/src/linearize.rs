@@ -212,6 +212,15 @@ pub enum LinearizeError {
         /// The tolerance it exceeded.
         tolerance: f64,
     },
+    /// A state violates one holonomic constraint ([`check_holonomic`]).
+    HolonomicViolated {
+        /// The constraint, in declaration order.
+        index: usize,
+        /// Its residual f(q, t).
+        residual: f64,
+        /// The tolerance it exceeded.
+        tolerance: f64,
+    },
     /// An iterative matrix decomposition (Schur, SVD) did not converge.
     DecompositionFailed {
         /// Which decomposition.
@@ -259,6 +268,14 @@ impl core::fmt::Display for LinearizeError {
             } => write!(
                 f,
                 "the configuration violates the holonomic constraints: residual {residual:e} above {tolerance:e}"
+            ),
+            LinearizeError::HolonomicViolated {
+                index,
+                residual,
+                tolerance,
+            } => write!(
+                f,
+                "holonomic constraint {index} is violated: residual {residual:e} above {tolerance:e}"
             ),
             LinearizeError::DecompositionFailed { what } => {
                 write!(f, "the {what} decomposition did not converge")
@@ -749,6 +766,88 @@ pub fn project_holonomic<M: Model>(
         state[k] = q[i];
     }
     Ok((r.norm(), steps))
+}
+
+/// Checks a reduced state (retained coordinates, then speeds, as
+/// [`Model::rhs`] takes it) against the holonomic constraints: their
+/// residuals f(q, t) with the ignorable coordinates at zero (they do not
+/// enter the reduced equations). Returns the residuals when every one is
+/// within `tol`, and [`LinearizeError::HolonomicViolated`] naming the first
+/// one that is not, so a caller can refuse (or project, with
+/// [`project_holonomic`]) a state the reduced equations were not derived
+/// for. Errors also for wrong lengths and non-finite values.
+///
+/// ```
+/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Ring { l: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Ring", parameters: &["l"], coordinates: &["x", "y"], speeds: &["x"],
+/// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
+/// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1, constraints: 1, bodies: &[], force_points: 0,
+/// #     torques: 0, symbolic_elimination: false,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Ring {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.l; Ok(()) }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, q: &[T], _: &[T], h: &mut [T], _: &mut [T]) -> Result<(), ModelError> {
+/// #         let l = T::from_f64(self.l);
+/// #         h[0] = q[0] * q[0] + q[1] * q[1] - l * l;
+/// #         Ok(())
+/// #     }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// use appell_runtime::linearize::{check_holonomic, LinearizeError};
+/// // A particle on a circle of radius 1, state (x, y, ẋ).
+/// assert!(check_holonomic(&Ring { l: 1.0 }, 0.0, &[0.6, -0.8, 0.3], 1e-12).is_ok());
+/// assert!(matches!(
+///     check_holonomic(&Ring { l: 1.0 }, 0.0, &[0.6, -0.81, 0.3], 1e-12),
+///     Err(LinearizeError::HolonomicViolated { index: 0, .. })
+/// ));
+/// ```
+pub fn check_holonomic<M: Model>(
+    model: &M,
+    t: f64,
+    state: &[f64],
+    tol: f64,
+) -> Result<Vec<f64>, LinearizeError> {
+    let info = M::info();
+    check_len("state", state, info.state_len())?;
+    finite(state, "state")?;
+    if tol.is_nan() || tol < 0.0 {
+        return Err(LinearizeError::InvalidArgument(format!(
+            "the tolerance must be non-negative, not {tol}"
+        )));
+    }
+    let retained = indices(info, info.retained, "retained")?;
+    let n = info.coordinates.len();
+    let mut q = vec![0.0; n];
+    for (k, &i) in retained.iter().enumerate() {
+        q[i] = state[k];
+    }
+    let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
+    model.constraint_residuals(t, &q, &vec![0.0; n], &mut h, &mut v)?;
+    if let Some((index, &residual)) = h.iter().enumerate().find(|(_, r)| r.is_nan() || r.abs() > tol) {
+        return Err(LinearizeError::HolonomicViolated {
+            index,
+            residual,
+            tolerance: tol,
+        });
+    }
+    Ok(h)
 }
 
 /// The linearization in a minimal state at a full configuration `q_full`

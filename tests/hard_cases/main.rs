@@ -61,6 +61,27 @@ fn mass_ratio_chain_factorization_stays_accurate() {
 }
 
 #[test]
+fn four_bar_passes_its_singular_positions() {
+    let p = cases::FourBar2 {
+        a: 1.0,
+        m: 1.0,
+        g: 9.81,
+    };
+    check(cases::four_bar_singular_positions(&p, 2, 10.0, 1e-3));
+}
+
+#[test]
+#[ignore = "N = 40 over 20 s: about a minute in release; run with --ignored or the example"]
+fn four_bar_40_passes_its_singular_positions() {
+    let p = cases::FourBar40 {
+        a: 1.0,
+        m: 1.0,
+        g: 9.81,
+    };
+    check(cases::four_bar_singular_positions(&p, 40, 20.0, 5e-3));
+}
+
+#[test]
 fn bad_states_are_named() {
     check(cases::bad_states());
 }
