@@ -32,6 +32,7 @@ fn main() -> ExitCode {
     rows.extend(cases::disc_steady_circle());
     rows.extend(cases::bicycle_self_stability(10.0));
     rows.extend(cases::bicycle_pitch_drift(10_000));
+    rows.extend(cases::four_bar_drift(10_000));
     rows.extend(cases::stiff_spring(1.0));
     rows.extend(cases::mass_ratio_chain());
     rows.extend(cases::bad_states());

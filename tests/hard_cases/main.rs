@@ -82,6 +82,11 @@ fn four_bar_40_passes_its_singular_positions() {
 }
 
 #[test]
+fn four_bar_drift_is_removed_by_projection() {
+    check(cases::four_bar_drift(10_000));
+}
+
+#[test]
 fn bad_states_are_named() {
     check(cases::bad_states());
 }
