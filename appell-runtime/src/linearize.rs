@@ -840,7 +840,11 @@ pub fn check_holonomic<M: Model>(
     }
     let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
     model.constraint_residuals(t, &q, &vec![0.0; n], &mut h, &mut v)?;
-    if let Some((index, &residual)) = h.iter().enumerate().find(|(_, r)| r.is_nan() || r.abs() > tol) {
+    if let Some((index, &residual)) = h
+        .iter()
+        .enumerate()
+        .find(|(_, r)| r.is_nan() || r.abs() > tol)
+    {
         return Err(LinearizeError::HolonomicViolated {
             index,
             residual,
