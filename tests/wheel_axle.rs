@@ -220,10 +220,11 @@ fn bad_calls_are_typed_errors() {
         bad.rhs(&bad.prepare::<f64>(), 0.0, &[0.0; 3], &[0.0], &mut d),
         Err(appell::ModelError::NonPositiveParameter { name: "a", .. })
     ));
+    // A NaN in the state is named, not just its effect on the result.
     assert_eq!(
         p.rhs(&prepared, 0.0, &[f64::NAN, 0.0, 0.0], &[0.0], &mut d),
         Err(appell::ModelError::NonFinite {
-            what: "the state derivative"
+            what: "state component `phi`"
         })
     );
 }

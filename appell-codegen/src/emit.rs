@@ -10,7 +10,7 @@
 use std::fmt::Write;
 use std::str::FromStr;
 
-use appell_symbolic::{EmitOptions, Id, Program, RustCode};
+use appell_symbolic::{EmitOptions, Id, Program, RustCode, Symbol, SymbolKind};
 use proc_macro2::TokenStream;
 
 use crate::derivation::{Derivation, Elimination, RowSource};
@@ -170,6 +170,49 @@ impl Emitter<'_> {
                 "                if !{this}.{f}.is_finite() {{ return {P}::Err({P}::ModelError::NonFinite {{ what: \"parameter `{f}`\" }}); }}",
                 this = self.this
             );
+        }
+        // A zero-length `norm`/`unit` argument, where it depends on the
+        // retained coordinates and the parameters only (so the state
+        // determines it).
+        let g = &model.g;
+        let retained: Vec<Symbol> = d.retained.iter().map(|&r| model.coords[r].1.q).collect();
+        let checked: Vec<&(Id, String)> = model
+            .norms
+            .iter()
+            .filter(|(n2, _)| {
+                g.dependencies(*n2)
+                    .iter()
+                    .all(|sym| match g.symbol_kind(sym) {
+                        SymbolKind::Parameter | SymbolKind::Time => true,
+                        SymbolKind::Coordinate => retained.contains(&sym),
+                        _ => false,
+                    })
+                    && !g.is_parameter_only(*n2)
+            })
+            .collect();
+        if !checked.is_empty() {
+            let roots: Vec<Id> = checked.iter().map(|(n2, _)| *n2).collect();
+            let c = code(d, &roots, &options(false));
+            s.push_str("                {\n");
+            s.push_str(
+                &self
+                    .params_as(true)
+                    .replace("        let ", "                let "),
+            );
+            for (k, &r) in d.retained.iter().enumerate() {
+                let _ = writeln!(s, "                let {} = __state[{k}];", self.coord(r));
+            }
+            for st in c.prepare.iter().chain(&c.body) {
+                let _ = writeln!(s, "                {st}");
+            }
+            for (k, (_, label)) in checked.iter().enumerate() {
+                let _ = writeln!(
+                    s,
+                    "                if !({P}::Scalar::re({}) > 1e-20) {{ return {P}::Err({P}::ModelError::NonFinite {{ what: \"{label} has zero length\" }}); }}",
+                    c.outputs[k]
+                );
+            }
+            s.push_str("                }\n");
         }
         s
     }

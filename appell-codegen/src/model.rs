@@ -184,6 +184,10 @@ pub struct Model {
     pub outputs: Vec<String>,
     /// The name the generated `ModelInfo` carries.
     pub info_name: String,
+    /// The squared length of every `norm(...)` and `unit(...)` argument, with
+    /// where it occurs, so that the generated code can name a zero-length
+    /// one at run time.
+    pub norms: Vec<(Id, String)>,
 }
 
 #[derive(Clone, Copy)]
@@ -205,6 +209,9 @@ struct Builder<'a> {
     /// Frames and points whose definition failed: references to them are
     /// not reported again.
     poisoned: Vec<String>,
+    /// The definition being evaluated (for `norms`).
+    context: String,
+    norms: Vec<(Id, String)>,
 }
 
 fn engine_error(cx: &Ctxt, span: Span, e: SymbolicError) {
@@ -225,6 +232,8 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         frames: Vec::new(),
         points: Vec::new(),
         poisoned: Vec::new(),
+        context: String::new(),
+        norms: Vec::new(),
     };
     b.declare_symbols(ast);
     let zero = b.g.int(0).ok()?;
@@ -478,6 +487,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         quadrature: Vec::new(),
         outputs: Vec::new(),
         info_name: ast.name.to_string(),
+        norms: b.norms,
     })
 }
 
@@ -678,6 +688,7 @@ impl Builder<'_> {
     }
 
     fn add_frame(&mut self, f: &FrameDef) {
+        self.context = format!("frame `{}`", f.name);
         let Some(pi) = self.frame_named(&f.parent) else {
             return;
         };
@@ -837,6 +848,7 @@ impl Builder<'_> {
     }
 
     fn add_point(&mut self, p: &PointDef) {
+        self.context = format!("point `{}`", p.name);
         match self.eval(&p.location) {
             Some(Val::Point(pos)) => self.points.push(Point {
                 name: p.name.to_string(),
@@ -887,6 +899,7 @@ impl Builder<'_> {
     }
 
     fn constraint(&mut self, c: &ConstraintDef) -> Option<Constraint> {
+        self.context = "a constraint".to_string();
         let l = self.scalar(&c.lhs)?;
         let r = self.scalar(&c.rhs)?;
         match self.g.sub(l, r) {
@@ -1379,6 +1392,10 @@ impl Builder<'_> {
                     );
                     return Ok(None);
                 }
+                self.norms.push((
+                    n2,
+                    format!("the argument of `{name}(...)` in {}", self.context),
+                ));
                 let n = self.g.sqrt(n2)?;
                 if name == "norm" {
                     Ok(Some(Val::Scalar(n)))

@@ -390,10 +390,9 @@ pub fn bicycle_self_stability(t_end: f64) -> Vec<CaseResult> {
 /// bicycle lying on its side (the front contact's `unit(...)` has a zero
 /// argument there), a bicycle state whose pitch violates the holonomic
 /// constraint, and Euler angles at gimbal lock. Criterion: a typed error
-/// naming the offending state component, input, parameter or constraint
-/// (the non-finite constraint matrix for the zero-length `unit`, the
-/// singular block for gimbal lock), never a panic and never NaN in the
-/// output.
+/// naming the offending state component, input, parameter, `unit(...)`
+/// argument or constraint (the singular block for gimbal lock), never a
+/// panic and never NaN in the output.
 pub fn bad_states() -> Vec<CaseResult> {
     let mut rows = Vec::new();
     let p = WhippleBicycle::default();
@@ -441,9 +440,12 @@ pub fn bad_states() -> Vec<CaseResult> {
     let e = p.rhs(&prepared, 0.0, &side, &[0.0], &mut d);
     rows.push(result(
         "bicycle on its side: unit() of a zero vector",
-        "a typed error, no NaN",
+        "NonFinite naming the zero-length unit() argument",
         format!("{e:?}"),
-        e.is_err(),
+        named(
+            &e,
+            "the argument of `unit(...)` in point `Q` has zero length",
+        ),
     ));
     // A pitch that does not match the roll and steer.
     let mut off = good;
