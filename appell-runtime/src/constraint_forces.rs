@@ -43,8 +43,8 @@
 //!
 //! Anything else is reported as [`Normal::Unavailable`], never guessed.
 
-use crate::model::{Model, ModelError, ModelInfo, RowSource};
-use crate::oracle::{self, OracleError};
+use crate::model::{Model, ModelInfo, RowSource};
+use crate::oracle::{self, finite_all as finite, mul, mul_bt, vee, OracleError};
 use crate::scalar::Scalar;
 use nalgebra::{DMatrix, DVector};
 use num_dual::{Dual2_64, Dual64};
@@ -233,43 +233,6 @@ fn mat_vec(a: &[f64; 9], v: [f64; 3]) -> [f64; 3] {
         a[6] * v[0] + a[7] * v[1] + a[8] * v[2],
     ]
 }
-/// `a bᵀ` for row-major 3×3 matrices.
-fn mul_bt(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
-    let mut out = [0.0; 9];
-    for i in 0..3 {
-        for j in 0..3 {
-            out[3 * i + j] = (0..3).map(|k| a[3 * i + k] * b[3 * j + k]).sum();
-        }
-    }
-    out
-}
-/// `a b` for row-major 3×3 matrices.
-fn mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
-    let mut out = [0.0; 9];
-    for i in 0..3 {
-        for j in 0..3 {
-            out[3 * i + j] = (0..3).map(|k| a[3 * i + k] * b[3 * k + j]).sum();
-        }
-    }
-    out
-}
-/// The axial vector of the skew-symmetric part of `s`.
-fn vee(s: &[f64; 9]) -> [f64; 3] {
-    [
-        0.5 * (s[7] - s[5]),
-        0.5 * (s[2] - s[6]),
-        0.5 * (s[3] - s[1]),
-    ]
-}
-
-fn finite(xs: impl IntoIterator<Item = f64>, what: &'static str) -> Result<(), OracleError> {
-    if xs.into_iter().all(f64::is_finite) {
-        Ok(())
-    } else {
-        Err(ModelError::NonFinite { what }.into())
-    }
-}
-
 /// Mass-centre acceleration, angular velocity and angular acceleration of
 /// every body along the motion (q̇, q̈), by second-order dual numbers.
 pub(crate) struct BodyMotion {

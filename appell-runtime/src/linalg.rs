@@ -34,71 +34,10 @@ pub fn lu_solve<T: Scalar, const N: usize, const M: usize>(
     a: &mut [[T; N]; N],
     b: &mut [[T; M]; N],
 ) -> Result<(), ModelError> {
-    let mut scale = 0.0f64;
-    for row in a.iter() {
-        for x in row {
-            let v = x.re().abs();
-            if !v.is_finite() {
-                return Err(ModelError::NonFinite {
-                    what: "the constraint matrix",
-                });
-            }
-            scale = scale.max(v);
-        }
-    }
-    for row in b.iter() {
-        for x in row {
-            let v = x.re().abs();
-            if v.is_finite() {
-                scale = scale.max(v);
-            }
-        }
-    }
-    let tol = 1e-12 * scale;
-    for col in 0..N {
-        let mut p = col;
-        let mut best = a[col][col].re().abs();
-        for r in col + 1..N {
-            let v = a[r][col].re().abs();
-            if v > best {
-                best = v;
-                p = r;
-            }
-        }
-        if best <= tol || best == 0.0 {
-            return Err(ModelError::SingularConstraints {
-                column: col,
-                pivot: best,
-            });
-        }
-        a.swap(p, col);
-        b.swap(p, col);
-        let inv = T::one() / a[col][col];
-        for r in col + 1..N {
-            let f = a[r][col] * inv;
-            if f.re() == 0.0 {
-                continue;
-            }
-            for j in col..N {
-                let t = a[col][j];
-                a[r][j] -= f * t;
-            }
-            for j in 0..M {
-                let t = b[col][j];
-                b[r][j] -= f * t;
-            }
-        }
-    }
-    for col in (0..N).rev() {
-        let inv = T::one() / a[col][col];
-        for j in 0..M {
-            let mut s = b[col][j];
-            for k in col + 1..N {
-                s -= a[col][k] * b[k][j];
-            }
-            b[col][j] = s * inv;
-        }
-    }
+    // The same arithmetic as eliminating `b` along with `a`: every row of
+    // `b` gets the same updates in the same order.
+    let swaps = lu_factor(a, max_abs(b))?;
+    lu_substitute(a, &swaps, b);
     Ok(())
 }
 

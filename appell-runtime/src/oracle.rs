@@ -317,7 +317,7 @@ impl<T: Scalar> Geometry<T> {
     }
 }
 
-fn finite_all(xs: impl IntoIterator<Item = f64>, what: &'static str) -> Result<(), OracleError> {
+pub(crate) fn finite_all(xs: impl IntoIterator<Item = f64>, what: &'static str) -> Result<(), OracleError> {
     for x in xs {
         if !x.is_finite() {
             return Err(ModelError::NonFinite { what }.into());
@@ -327,7 +327,7 @@ fn finite_all(xs: impl IntoIterator<Item = f64>, what: &'static str) -> Result<(
 }
 
 /// `a bᵀ` for row-major 3×3 matrices.
-fn mul_bt(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
+pub(crate) fn mul_bt(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
     let mut out = [0.0; 9];
     for i in 0..3 {
         for j in 0..3 {
@@ -338,7 +338,7 @@ fn mul_bt(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
 }
 
 /// `a b` for row-major 3×3 matrices.
-fn mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
+pub(crate) fn mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
     let mut out = [0.0; 9];
     for i in 0..3 {
         for j in 0..3 {
@@ -349,7 +349,7 @@ fn mul(a: &[f64; 9], b: &[f64; 9]) -> [f64; 9] {
 }
 
 /// The axial vector of the skew-symmetric part of `s`.
-fn vee(s: &[f64; 9]) -> [f64; 3] {
+pub(crate) fn vee(s: &[f64; 9]) -> [f64; 3] {
     [
         0.5 * (s[7] - s[5]),
         0.5 * (s[2] - s[6]),
