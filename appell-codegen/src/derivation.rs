@@ -767,8 +767,11 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     let y = g.sym(speed_rates[k])?;
                     terms.push(g.mul(d[k * 3 + i], y)?);
                 }
-                let sum = g.sum(&terms)?;
-                out[i] = expanded(g, sum)?;
+                // Left factored: a remainder enters f only through dot
+                // products with the partial velocities, and multiplying it
+                // out first costs more than it cancels (the bicycle's rhs
+                // 2,462 -> 2,414 ops; the other examples unchanged).
+                out[i] = g.sum(&terms)?;
             }
             Ok(out)
         };

@@ -317,7 +317,10 @@ impl<T: Scalar> Geometry<T> {
     }
 }
 
-pub(crate) fn finite_all(xs: impl IntoIterator<Item = f64>, what: &'static str) -> Result<(), OracleError> {
+pub(crate) fn finite_all(
+    xs: impl IntoIterator<Item = f64>,
+    what: &'static str,
+) -> Result<(), OracleError> {
     for x in xs {
         if !x.is_finite() {
             return Err(ModelError::NonFinite { what }.into());
