@@ -164,6 +164,59 @@ fn cholesky(a: DMatrix<f64>) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, O
 /// documentation). Errors: those of [`full_dynamics`], and
 /// [`OracleError::SingularKkt`] when M + α DᵀD is not positive definite
 /// (some motion carries no mass).
+///
+/// ```
+/// use appell_runtime::augmented::{accelerations, Settings};
+/// # use appell_runtime::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # // A particle on the unit circle in (x, y) coordinates, with gravity:
+/// # // the holonomic constraint x² + y² − 1 = 0.
+/// # struct Ring { g: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Ring", parameters: &["g"], coordinates: &["x", "y"], speeds: &["x"],
+/// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
+/// #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
+/// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
+/// #     torques: 0, symbolic_elimination: false,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Ring {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.g; Ok(()) }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, q: &[T], qd: &[T], h: &mut [T], v: &mut [T]) -> Result<(), ModelError> {
+/// #         h[0] = q[0] * q[0] + q[1] * q[1] - T::one();
+/// #         v[0] = T::from_f64(2.0) * (q[0] * qd[0] + q[1] * qd[1]);
+/// #         Ok(())
+/// #     }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, m: &mut [f64], i: &mut [[f64; 9]]) -> Result<(), ModelError> { m[0] = 1.0; i[0] = [0.0; 9]; Ok(()) }
+/// #     fn body_poses<T: Scalar>(&self, _: T, q: &[T], p: &mut [[T; 3]], r: &mut [[T; 9]]) -> Result<(), ModelError> {
+/// #         p[0] = [q[0], q[1], T::zero()];
+/// #         r[0] = [T::one(), T::zero(), T::zero(), T::zero(), T::one(), T::zero(), T::zero(), T::zero(), T::one()];
+/// #         Ok(())
+/// #     }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, q: &[T], d: &mut [T], d0: &mut [T]) -> Result<(), ModelError> {
+/// #         d[0] = T::from_f64(2.0) * q[0]; d[1] = T::from_f64(2.0) * q[1]; d0[0] = T::zero(); Ok(())
+/// #     }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, q: &[T], p: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> {
+/// #         p[0] = [q[0], q[1], T::zero()]; Ok(())
+/// #     }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], f: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> {
+/// #         f[0] = [T::zero(), T::from_f64(-self.g), T::zero()]; Ok(())
+/// #     }
+/// # }
+/// // A bead at rest at the side of a unit hoop under gravity: it starts to
+/// // fall straight down, q̈ = (0, −g).
+/// let a = accelerations(&Ring { g: 9.81 }, 0.0, &[1.0, 0.0], &[0.0, 0.0], &[], &Settings::default()).unwrap();
+/// assert!(a[0].abs() < 1e-9 && (a[1] + 9.81).abs() < 1e-9);
+/// ```
 pub fn accelerations<M: Model>(
     model: &M,
     t: f64,
@@ -202,6 +255,60 @@ pub fn accelerations<M: Model>(
 /// metric (module documentation). Errors: those of [`full_dynamics`],
 /// [`OracleError::SingularKkt`] as for [`accelerations`], and
 /// [`ModelError::NonFinite`] when a correction is not finite.
+///
+/// ```
+/// use appell_runtime::augmented::{project, Settings};
+/// # use appell_runtime::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # // A particle on the unit circle in (x, y) coordinates, with gravity:
+/// # // the holonomic constraint x² + y² − 1 = 0.
+/// # struct Ring { g: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Ring", parameters: &["g"], coordinates: &["x", "y"], speeds: &["x"],
+/// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
+/// #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
+/// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
+/// #     torques: 0, symbolic_elimination: false,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Ring {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.g; Ok(()) }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, q: &[T], qd: &[T], h: &mut [T], v: &mut [T]) -> Result<(), ModelError> {
+/// #         h[0] = q[0] * q[0] + q[1] * q[1] - T::one();
+/// #         v[0] = T::from_f64(2.0) * (q[0] * qd[0] + q[1] * qd[1]);
+/// #         Ok(())
+/// #     }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, m: &mut [f64], i: &mut [[f64; 9]]) -> Result<(), ModelError> { m[0] = 1.0; i[0] = [0.0; 9]; Ok(()) }
+/// #     fn body_poses<T: Scalar>(&self, _: T, q: &[T], p: &mut [[T; 3]], r: &mut [[T; 9]]) -> Result<(), ModelError> {
+/// #         p[0] = [q[0], q[1], T::zero()];
+/// #         r[0] = [T::one(), T::zero(), T::zero(), T::zero(), T::one(), T::zero(), T::zero(), T::zero(), T::one()];
+/// #         Ok(())
+/// #     }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, q: &[T], d: &mut [T], d0: &mut [T]) -> Result<(), ModelError> {
+/// #         d[0] = T::from_f64(2.0) * q[0]; d[1] = T::from_f64(2.0) * q[1]; d0[0] = T::zero(); Ok(())
+/// #     }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, q: &[T], p: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> {
+/// #         p[0] = [q[0], q[1], T::zero()]; Ok(())
+/// #     }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], f: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> {
+/// #         f[0] = [T::zero(), T::from_f64(-self.g), T::zero()]; Ok(())
+/// #     }
+/// # }
+/// // Off the hoop and moving across it: back onto it, moving along it.
+/// let (mut q, mut qdot) = ([0.9, 0.1], [0.3, 1.0]);
+/// let p = project(&Ring { g: 9.81 }, 0.0, &mut q, &mut qdot, &[], &Settings::default()).unwrap();
+/// assert!(p.position.0 > 0.1 && p.position.1 < 1e-14 && p.velocity.1 < 1e-12);
+/// assert!((q[0] * qdot[0] + q[1] * qdot[1]).abs() < 1e-12);
+/// ```
 pub fn project<M: Model>(
     model: &M,
     t: f64,
