@@ -7,10 +7,10 @@
 //! parallelogram four-bar whose cranks are horizontal: the loop-closure
 //! Jacobian loses rank and the mechanism has extra instantaneous degrees of
 //! freedom) the generated rhs reports
-//! [`ModelError::SingularConstraints`](crate::ModelError::SingularConstraints)
+//! [`ModelError::SingularConstraints`]
 //! instead of producing NaN. This module continues through such
 //! configurations. It uses only the model's kinematic description, through
-//! [`oracle::full_dynamics`]:
+//! [`full_dynamics`]:
 //!
 //! * **accelerations**: with all coordinates q and their rates q̇ as the
 //!   state, q̈ solves (M + α DᵀD) q̈ = Q − h − Dᵀλ* − α Dᵀ(Ḋq̇ + ḋ), with the
