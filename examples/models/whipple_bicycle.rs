@@ -14,7 +14,7 @@ use appell::Appell;
 /// `WhippleBicycleRidden` (gravity and steer torque).
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(coordinates(q1, q2, q3, q4, q5, q6, q7, q8), speeds(q4, q6, q7))]
-#[appell(positive(rf, rr))]
+#[appell(positive(rf, rr, mc, md, me, mf))]
 #[appell(frame(A = N.rotate_z(q3)), frame(B = A.rotate_x(q4)), frame(C = B.rotate_y(q5)))]
 #[appell(frame(D = C.rotate_y(q6)), frame(E = C.rotate_z(q7)), frame(F = E.rotate_y(q8)))]
 #[appell(point(P = O + q1 * N.x + q2 * N.y), point(Do = P - rr * B.z))]
