@@ -233,7 +233,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
     let rules = RateRules::coordinates();
     // 1. Velocity constraint rows.
-    let mut rows: Vec<(Id, proc_macro2::TokenStream, bool)> = Vec::new();
+    // (row, its tokens, holonomic, the same row before expansion)
+    let mut rows: Vec<(Id, proc_macro2::TokenStream, bool, Id)> = Vec::new();
     let mut origins: Vec<RowSource> = Vec::new();
     let mut holonomic = Vec::new();
     for (index, c) in model.holonomic.iter().enumerate() {
@@ -256,14 +257,14 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
         match model.g.time_derivative(c.residual, &rules) {
             Ok(r) => {
-                rows.push((r, c.at.clone(), true));
+                rows.push((r, c.at.clone(), true, r));
                 origins.push(RowSource::Holonomic(index));
             }
             Err(e) => cx.error_spanned_by(&c.at, e),
         }
     }
     for (index, c) in model.nonholonomic.iter().enumerate() {
-        rows.push((c.residual, c.at.clone(), false));
+        rows.push((c.residual, c.at.clone(), false, c.residual));
         origins.push(RowSource::Nonholonomic(index));
     }
     // Rolling: v(material point at P) = v(centre) + ω × (P − centre) = 0.
@@ -278,26 +279,31 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             arm[i] = g.sub(r.contact[i], body.center[i])?;
         }
         let w = cross(g, omega, arm)?;
+        let mut raw_v = v;
         for i in 0..3 {
-            let sum = g.add(v[i], w[i])?;
-            v[i] = expanded(g, sum)?;
+            raw_v[i] = g.add(v[i], w[i])?;
+            v[i] = expanded(g, raw_v[i])?;
         }
-        let components: Vec<Id> = match &r.along {
-            Some(dirs) => dirs
-                .iter()
-                .map(|d| dot(g, v, *d).and_then(|e| expanded(g, e)))
-                .collect::<Result<_, _>>()?,
-            None => v.to_vec(),
+        let (components, raw): (Vec<Id>, Vec<Id>) = match &r.along {
+            Some(dirs) => (
+                dirs.iter()
+                    .map(|d| dot(g, v, *d).and_then(|e| expanded(g, e)))
+                    .collect::<Result<_, _>>()?,
+                dirs.iter()
+                    .map(|d| dot(g, raw_v, *d))
+                    .collect::<Result<_, _>>()?,
+            ),
+            None => (v.to_vec(), raw_v.to_vec()),
         };
         let before = rows.len();
-        for (k, c) in components.into_iter().enumerate() {
+        for (k, (c, raw_c)) in components.into_iter().zip(raw).enumerate() {
             if g.is_zero(c) {
                 if r.along.is_some() {
                     cx.error_spanned_by(&r.at, format!("the velocity component along direction {} is identically zero: that direction constrains nothing", k + 1));
                 }
                 continue;
             }
-            rows.push((c, r.at.clone(), false));
+            rows.push((c, r.at.clone(), false, raw_c));
             origins.push(RowSource::Rolling {
                 contact,
                 direction: k,
@@ -311,7 +317,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let mut d0 = Vec::new();
     let mut row_sources = Vec::new();
     let mut kept_sources = Vec::new();
-    for ((row, span, holo), origin) in rows.iter().zip(&origins) {
+    let mut raw_rows = Vec::new();
+    for ((row, span, holo, raw_row), origin) in rows.iter().zip(&origins) {
         let bad: Vec<String> = model
             .g
             .dependencies(*row)
@@ -342,6 +349,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 }
                 d_rows.extend(form.coefficients);
                 d0.push(form.remainder);
+                raw_rows.push(*raw_row);
                 row_sources.push(span.clone());
                 kept_sources.push(*origin);
             }
@@ -523,7 +531,19 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
     }
     let dp_m = SymMatrix::from_rows(k_unknowns, k_unknowns, dp.clone())?;
-    let rhs_m = SymMatrix::from_rows(k_unknowns, l + 1, rhs.clone())?;
+    // Without quasi-velocities the rows are the constraint rows themselves:
+    // an identity block carried beside the right sides records the row
+    // operations T of the elimination (S x_f − R_s [ẏ; 1] = T (D q̇ + d)).
+    let track = !quasi;
+    let width = if track { l + 1 + k_unknowns } else { l + 1 };
+    let mut rhs_aug = Vec::with_capacity(k_unknowns * width);
+    for r in 0..k_unknowns {
+        rhs_aug.extend(&rhs[r * (l + 1)..(r + 1) * (l + 1)]);
+        if track {
+            rhs_aug.extend((0..k_unknowns).map(|c| if c == r { one } else { zero }));
+        }
+    }
+    let rhs_m = SymMatrix::from_rows(k_unknowns, width, rhs_aug)?;
     // Unknowns with safe pivots are eliminated symbolically; the rest (the
     // Schur complement S x_f = R_s) is solved numerically at run time, the
     // free unknowns standing as auxiliary symbols X_f in the expressions.
@@ -532,7 +552,15 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // (aux symbols, their values, k, S, R_s, free columns) of the numeric part
     let (x_entries, numeric_part): (
         Vec<Id>,
-        Option<(Vec<Symbol>, Vec<Id>, usize, Vec<Id>, Vec<Id>, Vec<usize>)>,
+        Option<(
+            Vec<Symbol>,
+            Vec<Id>,
+            usize,
+            Vec<Id>,
+            Vec<Id>,
+            Vec<usize>,
+            Vec<Id>,
+        )>,
     ) = if k_unknowns == 0 {
         (Vec::new(), None)
     } else {
@@ -592,8 +620,19 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                             ids,
                             k,
                             part.s.entries().to_vec(),
-                            part.s_rhs.entries().to_vec(),
+                            (0..k)
+                                .flat_map(|i| (0..=l).map(move |j| (i, j)))
+                                .map(|(i, j)| part.s_rhs[(i, j)])
+                                .collect(),
                             part.free_cols.clone(),
+                            if track {
+                                (0..k)
+                                    .flat_map(|i| (0..k_unknowns).map(move |j| (i, j)))
+                                    .map(|(i, j)| part.s_rhs[(i, l + 1 + j)])
+                                    .collect()
+                            } else {
+                                Vec::new()
+                            },
                         )),
                     )
                 }
@@ -657,7 +696,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         fixed_rates.insert(model.coords[r].1.rate, qdot[r]);
     }
     let mut elimination = Elimination::Symbolic;
-    if let Some((xs, x_ids, k, s_mat, s_rhs, free_cols)) = numeric_part {
+    if let Some((xs, x_ids, k, s_mat, s_rhs, free_cols, row_ops)) = numeric_part {
         // The accelerations need Ẋ only in the combination w = Ẋ [ẏ; 1]
         // (the dependent acceleration remainder): every β̄_k is linear in the
         // column X_k, so Σ_k β̄̇_k ẏ_k + β̄̇ sees Σ_k Ẋ_k ẏ_k + Ẋ_l. The rate
@@ -676,15 +715,39 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         // Differentiating S ż_f = R [ẏ; 1] gives S w = (Ṙ − Ṡ X) [ẏ; 1]:
         // minus the rate of the row S q̇_f − R [ẏ; 1] taken with the
         // rates held fixed (a directional derivative along q̇), the rates
-        // then replaced by their values. One derivative of a short row is
-        // cheaper than Ṡ and Ṙ entry by entry (the bicycle's rhs 2,120 ->
-        // 2,086 ops).
+        // then replaced by their values (the bicycle's rhs 2,120 -> 2,086
+        // ops against Ṡ and Ṙ entry by entry). Those rows are T (D q̇ + d),
+        // and D q̇ + d vanishes at the rates used, so the rate of T drops
+        // out: S w = −T ∂(D q̇ + d), with each constraint row differentiated
+        // as the model wrote it (a rolling contact's (v + ω × r)·e, not
+        // multiplied out), which shares its work with the bodies'
+        // remainders (1,805 -> 1,572 ops). With quasi-velocities the rows
+        // include the speeds' definitions and the Schur rows are used.
         let mut rhs_rate = Vec::with_capacity(k);
         let free_rates: Vec<Id> = free_cols
             .iter()
             .map(|&c| g.sym(model.coords[dependent[c]].1.rate))
             .collect::<Result<_, _>>()?;
+        let mut raw_rates = Vec::new();
+        if !row_ops.is_empty() {
+            for &row in &raw_rows {
+                let rate = g.time_derivative(row, &along_rates)?;
+                raw_rates.push(fixed_rates.apply(g, rate)?);
+            }
+        }
         for i in 0..k {
+            if !raw_rates.is_empty() {
+                let mut terms = Vec::new();
+                for (j, &rate) in raw_rates.iter().enumerate() {
+                    let t = row_ops[i * k_unknowns + j];
+                    if !g.is_zero(t) {
+                        terms.push(g.mul(t, rate)?);
+                    }
+                }
+                let sum = g.sum(&terms)?;
+                rhs_rate.push(g.neg(sum)?);
+                continue;
+            }
             let mut terms = Vec::new();
             for f in 0..k {
                 terms.push(g.mul(s_mat[i * k + f], free_rates[f])?);
@@ -728,22 +791,72 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
         split_linear(g, v, &speed_rates)
     };
+    // β̄_k = Σ_r C_rk J_r and β̄ = J_t + Σ_r c_r J_r from the partial
+    // velocities J_r = ∂v/∂q̇_r, each a function of q alone and expanded on
+    // its own: C (with the numeric elimination's X) is not multiplied into
+    // them, so each β̄_k costs one short sum per component (the bicycle's
+    // rhs 1,962 -> 1,849 ops). Loads keep the expanded form, which is
+    // shorter for a constant force's few components.
+    let through_c = |g: &mut appell_symbolic::Graph,
+                     parts: &[Vec3],
+                     rest: Vec3|
+     -> Result<(Vec<Vec3>, Vec3), SymbolicError> {
+        let mut beta = vec![[zero; 3]; l];
+        let mut beta0 = rest;
+        for i in 0..3 {
+            for (k, b) in beta.iter_mut().enumerate() {
+                let mut terms = Vec::new();
+                for (r, part) in parts.iter().enumerate() {
+                    let coef = c[r * l + k];
+                    if g.is_zero(coef) || g.is_zero(part[i]) {
+                        continue;
+                    }
+                    terms.push(g.mul(coef, part[i])?);
+                }
+                b[i] = g.sum(&terms)?;
+            }
+            let mut terms = vec![rest[i]];
+            for (r, part) in parts.iter().enumerate() {
+                if g.is_zero(c0[r]) || g.is_zero(part[i]) {
+                    continue;
+                }
+                terms.push(g.mul(c0[r], part[i])?);
+            }
+            beta0[i] = g.sum(&terms)?;
+        }
+        Ok((beta, beta0))
+    };
+    let raw_parts =
+        |g: &mut appell_symbolic::Graph, v: Vec3| -> Result<(Vec<Vec3>, Vec3), SymbolicError> {
+            let (parts, rest) = split_linear(g, v, &rates)?;
+            let parts = parts
+                .into_iter()
+                .map(|p| expanded3(g, p))
+                .collect::<Result<Vec<_>, _>>()?;
+            Ok((parts, expanded3(g, rest)?))
+        };
     let mut body_terms = Vec::new();
     let mut rotations = Vec::new();
     for b in &model.bodies {
-        let (beta, beta0) = vel(g, &mut sub, b.center)?;
+        let mut v = [zero; 3];
+        for i in 0..3 {
+            v[i] = g.time_derivative(b.center[i], &rules)?;
+        }
+        let (parts, rest) = raw_parts(g, v)?;
+        let (beta, beta0) = through_c(g, &parts, rest)?;
         let (gamma_b, omega_b, rotation) = match b.frame {
             Some(fi) => {
                 let frame = &model.frames[fi];
                 let rot = frame.rot;
-                let (gamma, gamma0) = split_omega(g, frame.omega, &mut sub, &speed_rates)?;
-                let gamma_b: Vec<Vec3> = gamma
+                let (parts, rest) = split_linear(g, frame.omega, &rates)?;
+                let parts = parts
                     .iter()
                     .map(|v| mat_t_vec(g, &rot, *v).and_then(|x| expanded3(g, x)))
-                    .collect::<Result<_, _>>()?;
-                let omega_n = combine(g, &gamma, gamma0, &speed_rates)?;
-                let omega_b = mat_t_vec(g, &rot, omega_n)?;
-                let omega_b = expanded3(g, omega_b)?;
+                    .collect::<Result<Vec<_>, _>>()?;
+                let rest = mat_t_vec(g, &rot, rest)?;
+                let rest = expanded3(g, rest)?;
+                let (gamma_b, gamma0_b) = through_c(g, &parts, rest)?;
+                let omega_b = combine(g, &gamma_b, gamma0_b, &speed_rates)?;
                 (gamma_b, omega_b, Some(rot))
             }
             None => (vec![[zero; 3]; l], [zero; 3], None),
@@ -832,7 +945,12 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                             *e = g.add(*e, extra_inertia[r][c])?;
                         }
                     }
-                    let (beta, _) = vel(g, &mut sub, *center)?;
+                    let mut v = [zero; 3];
+                    for i in 0..3 {
+                        v[i] = g.time_derivative(center[i], &rules)?;
+                    }
+                    let (parts, rest) = raw_parts(g, v)?;
+                    let (beta, _) = through_c(g, &parts, rest)?;
                     Some((*total, beta, *center))
                 }
             };
