@@ -1005,8 +1005,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // long (the bicycle's wheels: 2,086 -> 1,964 ops) and not in small
     // models, whose fully expanded terms collect better body by body: the
     // variant with fewer operations is kept.
-    let alone: Vec<Composite> = (0..model.bodies.len()).map(|_| Composite::Alone).collect();
-    let (mut mass, mut forcing_terms) = assemble(g, &alone)?;
+    let mut chosen: Vec<Composite> = (0..model.bodies.len()).map(|_| Composite::Alone).collect();
+    let (mut mass, mut forcing_terms) = assemble(g, &chosen)?;
     let composites = composite_bodies(g, &model.bodies, &rotations, &assume)?;
     if composites.iter().any(|c| !matches!(c, Composite::Alone)) {
         let candidate = assemble(g, &composites)?;
@@ -1014,15 +1014,48 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
         {
             (mass, forcing_terms) = candidate;
+            chosen = composites;
         }
     }
-    // Loads are kept apart (per effect) so scenes can pick them.
+    // Loads are kept apart (per effect) so scenes can pick them. The
+    // weights of a composite's members act as one at its mass centre:
+    // Σ mᵢ g·β̄ᵢ = M g·β̄_G.
     let mut inertial_terms = forcing_terms.clone();
     let mut load_terms: Vec<(String, Vec<Id>)> = Vec::new();
     for (fi, f) in model.forces.iter().enumerate() {
-        let per_k: Vec<Id> = (0..l)
-            .map(|k| dot(g, f.vector, force_beta[fi][k]))
-            .collect::<Result<_, _>>()?;
+        let weight = match (f.weight_of.map(|b| &chosen[b]), model.gravity) {
+            (Some(Composite::Member), _) => Some(None),
+            (
+                Some(Composite::Leader {
+                    mass: total,
+                    center,
+                    ..
+                }),
+                Some(gvec),
+            ) => {
+                let mut v = [zero; 3];
+                for i in 0..3 {
+                    v[i] = g.time_derivative(center[i], &rules)?;
+                }
+                let (parts, rest) = raw_parts(g, v)?;
+                let (beta, _) = through_c(g, &parts, rest)?;
+                let mut w = gvec;
+                for x in w.iter_mut() {
+                    *x = g.mul(*x, *total)?;
+                }
+                Some(Some((w, beta)))
+            }
+            _ => None,
+        };
+        let per_k: Vec<Id> = match weight {
+            Some(None) => vec![zero; l],
+            Some(Some((w, beta))) => (0..l)
+                .map(|k| dot(g, w, beta[k]))
+                .collect::<Result<_, _>>()?,
+            None => (0..l)
+                .map(|k| dot(g, f.vector, force_beta[fi][k]))
+                .collect::<Result<_, _>>()?,
+        };
         for k in 0..l {
             forcing_terms[k].push(per_k[k]);
         }

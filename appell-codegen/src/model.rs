@@ -77,6 +77,8 @@ pub struct Load {
     pub vector: Vec3,
     /// Effect name.
     pub effect: String,
+    /// For a body's weight (`gravity(...)`): the body's index.
+    pub weight_of: Option<usize>,
 }
 
 /// `rolls(...)`: the material point of a body at a contact point has zero
@@ -184,6 +186,8 @@ pub struct Model {
     pub outputs: Vec<String>,
     /// The name the generated `ModelInfo` carries.
     pub info_name: String,
+    /// The `gravity(...)` acceleration (N components), if declared.
+    pub gravity: Option<Vec3>,
     /// The squared length of every `norm(...)` and `unit(...)` argument, with
     /// where it occurs, so that the generated code can name a zero-length
     /// one at run time.
@@ -275,9 +279,11 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
     let mut effects = Vec::new();
     let mut forces = Vec::new();
     let mut torques = Vec::new();
+    let mut gravity = None;
     if let Some(gvec) = &ast.gravity {
         if let Some(v) = b.vector(gvec) {
-            for body in &bodies {
+            gravity = Some(v);
+            for (index, body) in bodies.iter().enumerate() {
                 let f = b.scale3(v, body.mass);
                 if let Some(f) = f {
                     forces.push(Load {
@@ -285,6 +291,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
                         frame: 0,
                         vector: f,
                         effect: "gravity".into(),
+                        weight_of: Some(index),
                     });
                 }
             }
@@ -307,6 +314,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             frame: 0,
             vector: v,
             effect,
+            weight_of: None,
         });
     }
     for l in &ast.torques {
@@ -325,6 +333,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
             frame: fi,
             vector: v,
             effect,
+            weight_of: None,
         });
     }
     let mut rolling = Vec::new();
@@ -487,6 +496,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         quadrature: Vec::new(),
         outputs: Vec::new(),
         info_name: ast.name.to_string(),
+        gravity,
         norms: b.norms,
     })
 }
