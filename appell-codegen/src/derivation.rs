@@ -139,6 +139,9 @@ pub struct Derivation {
     pub load_terms: Vec<(String, Vec<Id>)>,
     /// The power of each input-dependent load, with its effect (for scenes).
     pub power_terms: Vec<(String, Id)>,
+    /// Bodies whose terms were folded together (composites and rotors), as
+    /// readable lines.
+    pub folded: Vec<String>,
 }
 
 /// Runs the derivation; errors go to `cx`.
@@ -186,6 +189,7 @@ struct Parts {
     inertial_terms: Vec<Vec<Id>>,
     load_terms: Vec<(String, Vec<Id>)>,
     power_terms: Vec<(String, Id)>,
+    folded: Vec<String>,
 }
 
 impl Parts {
@@ -222,6 +226,7 @@ impl Parts {
             inertial_terms: self.inertial_terms,
             load_terms: self.load_terms,
             power_terms: self.power_terms,
+            folded: self.folded,
         };
         d.text = equations_text(&d);
         d
@@ -921,8 +926,22 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         Ok(out)
     };
     // 6. Appell's equations.
+    // α in each rigid body's frame.
+    let mut alphas: Vec<Option<Vec3>> = Vec::new();
+    for (bi, b) in model.bodies.iter().enumerate() {
+        alphas.push(match &rotations[bi] {
+            Some(rot) => {
+                let omega = model.frames[b.frame.expect("rigid")].omega;
+                let alpha_n = remainder(g, &mut fixed_rates, omega)?;
+                let alpha_b = mat_t_vec(g, rot, alpha_n)?;
+                Some(expanded3(g, alpha_b)?)
+            }
+            None => None,
+        });
+    }
     let mut assemble = |g: &mut appell_symbolic::Graph,
-                        composites: &[Composite]|
+                        composites: &[Composite],
+                        rotors: &[Option<Rotor>]|
      -> Result<(Vec<Id>, Vec<Vec<Id>>), SymbolicError> {
         let mut mass = vec![zero; l * l];
         let mut forcing_terms: Vec<Vec<Id>> = vec![Vec::new(); l];
@@ -930,10 +949,50 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             let t = &body_terms[bi];
             // The translational terms of a composite's members are its
             // leader's, at the composite mass centre; the leader's inertia
-            // gains the members' parallel-axis terms.
+            // gains the members' parallel-axis terms, and a carrier its
+            // rotors' inertia.
             let mut inertia = b.inertia;
+            for (ri, r) in rotors.iter().enumerate() {
+                if r.is_some_and(|r| r.carrier == bi) {
+                    for (row, rotor_row) in inertia.iter_mut().zip(&model.bodies[ri].inertia) {
+                        for (e, x) in row.iter_mut().zip(rotor_row) {
+                            *e = g.add(*e, *x)?;
+                        }
+                    }
+                }
+            }
+            if let Some(r) = rotors[bi] {
+                let c_t = &body_terms[r.carrier];
+                let a = r.axis;
+                let s: Vec<Id> = (0..l).map(|k| c[r.coordinate * l + k]).collect();
+                let spin = qdot[r.coordinate];
+                let spin_rate = g.time_derivative(spin, &reduced)?;
+                let spin_rate = zero_accels.apply(g, spin_rate)?;
+                let alpha = alphas[r.carrier].expect("rigid");
+                let mut axis = [zero; 3];
+                axis[a] = g.int(1)?;
+                let w_cross_a = cross(g, c_t.omega_b, axis)?;
+                for k in 0..l {
+                    for j in k..l {
+                        let x = g.mul(s[k], c_t.gamma_b[j][a])?;
+                        let y = g.mul(s[j], c_t.gamma_b[k][a])?;
+                        let z = g.mul(s[k], s[j])?;
+                        let sum = g.sum(&[x, y, z])?;
+                        let e = g.mul(r.axial, sum)?;
+                        mass[k * l + j] = g.add(mass[k * l + j], e)?;
+                    }
+                    let x = g.mul(spin_rate, c_t.gamma_b[k][a])?;
+                    let y = dot(g, c_t.gamma_b[k], w_cross_a)?;
+                    let y = g.mul(spin, y)?;
+                    let z = g.add(alpha[a], spin_rate)?;
+                    let z = g.mul(s[k], z)?;
+                    let sum = g.sum(&[x, y, z])?;
+                    let e = g.mul(r.axial, sum)?;
+                    forcing_terms[k].push(g.neg(e)?);
+                }
+            }
             let translational = match &composites[bi] {
-                Composite::Member => None,
+                Composite::Member(_) => None,
                 Composite::Alone => Some((b.mass, t.beta.clone(), b.center)),
                 Composite::Leader {
                     mass: total,
@@ -973,7 +1032,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                         let bb = dot(g, beta[k], beta[j])?;
                         e = g.mul(*m_total, bb)?;
                     }
-                    if b.frame.is_some() {
+                    if b.frame.is_some() && rotors[bi].is_none() {
                         let ig = mat_vec(g, &inertia, t.gamma_b[j])?;
                         let rot = dot(g, t.gamma_b[k], ig)?;
                         e = g.add(e, rot)?;
@@ -981,11 +1040,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     mass[k * l + j] = g.add(mass[k * l + j], e)?;
                 }
             }
-            if let Some(rot) = &rotations[bi] {
-                let omega = model.frames[b.frame.expect("rigid")].omega;
-                let alpha_n = remainder(g, &mut fixed_rates, omega)?;
-                let alpha_b = mat_t_vec(g, rot, alpha_n)?;
-                let alpha_b = expanded3(g, alpha_b)?;
+            if let (Some(alpha_b), None) = (alphas[bi], rotors[bi]) {
                 let i_alpha = mat_vec(g, &inertia, alpha_b)?;
                 let i_omega = mat_vec(g, &inertia, t.omega_b)?;
                 let gyro = cross(g, t.omega_b, i_omega)?;
@@ -1005,16 +1060,54 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // long (the bicycle's wheels: 2,086 -> 1,964 ops) and not in small
     // models, whose fully expanded terms collect better body by body: the
     // variant with fewer operations is kept.
+    let no_rotors: Vec<Option<Rotor>> = vec![None; model.bodies.len()];
     let mut chosen: Vec<Composite> = (0..model.bodies.len()).map(|_| Composite::Alone).collect();
-    let (mut mass, mut forcing_terms) = assemble(g, &chosen)?;
+    let (mut mass, mut forcing_terms) = assemble(g, &chosen, &no_rotors)?;
     let composites = composite_bodies(g, &model.bodies, &rotations, &assume)?;
     if composites.iter().any(|c| !matches!(c, Composite::Alone)) {
-        let candidate = assemble(g, &composites)?;
+        let candidate = assemble(g, &composites, &no_rotors)?;
         if assembled_ops(g, &candidate, l)?
             < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
         {
             (mass, forcing_terms) = candidate;
             chosen = composites;
+        }
+    }
+    let mut folded = Vec::new();
+    for (bi, c) in chosen.iter().enumerate() {
+        if matches!(c, Composite::Leader { .. }) {
+            let members: Vec<String> = chosen
+                .iter()
+                .enumerate()
+                .filter(|(_, m)| matches!(m, Composite::Member(leader) if *leader == bi))
+                .map(|(i, _)| format!("`{}`", model.bodies[i].name))
+                .collect();
+            folded.push(format!(
+                "composite: `{}` with {} (one translational term at their mass centre)",
+                model.bodies[bi].name,
+                members.join(", ")
+            ));
+        }
+    }
+    // Rotors folded into their carriers, kept when that costs fewer
+    // operations.
+    let found = rotors(g, &model.bodies, &model.frames, &model.coords)?;
+    if found.iter().any(Option::is_some) {
+        let candidate = assemble(g, &chosen, &found)?;
+        if assembled_ops(g, &candidate, l)?
+            < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
+        {
+            (mass, forcing_terms) = candidate;
+            for (bi, r) in found.iter().enumerate() {
+                if let Some(r) = r {
+                    folded.push(format!(
+                        "rotor: `{}` spins about axis {} of `{}` (its rotational terms folded into the carrier's)",
+                        model.bodies[bi].name,
+                        ["x", "y", "z"][r.axis],
+                        model.bodies[r.carrier].name
+                    ));
+                }
+            }
         }
     }
     // Loads are kept apart (per effect) so scenes can pick them. The
@@ -1024,7 +1117,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let mut load_terms: Vec<(String, Vec<Id>)> = Vec::new();
     for (fi, f) in model.forces.iter().enumerate() {
         let weight = match (f.weight_of.map(|b| &chosen[b]), model.gravity) {
-            (Some(Composite::Member), _) => Some(None),
+            (Some(Composite::Member(_)), _) => Some(None),
             (
                 Some(Composite::Leader {
                     mass: total,
@@ -1221,6 +1314,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         inertial_terms,
         load_terms,
         power_terms,
+        folded,
     }))
 }
 
@@ -1411,6 +1505,7 @@ pub fn derive_scene(
             inertial_terms: full.inertial_terms.clone(),
             load_terms: Vec::new(),
             power_terms: Vec::new(),
+            folded: full.folded.clone(),
         };
         d.text = equations_text(&d);
         Ok(d)
@@ -1463,6 +1558,100 @@ fn assembled_ops(
     Ok(g.op_count(&roots)?.total())
 }
 
+/// An axisymmetric body turning about its symmetry axis, which is fixed in
+/// another body's frame (a wheel on its axle; see [`rotors`]).
+#[derive(Clone, Copy)]
+struct Rotor {
+    /// The body whose frame carries the axis.
+    carrier: usize,
+    /// The axis: 0, 1 or 2 of the carrier's (and the rotor's) frame.
+    axis: usize,
+    /// The coordinate whose rate is the spin rate.
+    coordinate: usize,
+    /// The moment of inertia about the axis.
+    axial: Id,
+}
+
+/// Finds rotors: a rigid body whose frame is a carrier body's frame turned
+/// about one of its axes by a coordinate, with an inertia symmetric about
+/// that axis. Its inertia is then the same matrix in the carrier's frame,
+/// so its rotational terms fold into the carrier's: with a the axis, λ the
+/// axial inertia, θ the spin angle and s_k = ∂θ̇/∂ẏ_k,
+/// γ̄_k·I γ̄_j adds λ (s_k γ̄ᶜ_j·a + s_j γ̄ᶜ_k·a + s_k s_j) to the carrier's,
+/// and γ̄_k·(I α + ω × I ω) adds
+/// λ (θ̈ γ̄ᶜ_k·a + θ̇ γ̄ᶜ_k·(ωᶜ × a) + s_k (αᶜ·a + θ̈)), θ̈ the remainder of
+/// the spin acceleration.
+fn rotors(
+    g: &mut appell_symbolic::Graph,
+    bodies: &[crate::model::Body],
+    frames: &[crate::model::Frame],
+    coords: &[(syn::Ident, appell_symbolic::Coordinate)],
+) -> Result<Vec<Option<Rotor>>, SymbolicError> {
+    let nb = bodies.len();
+    let mut out: Vec<Option<Rotor>> = vec![None; nb];
+    for b in 0..nb {
+        let Some(fb) = bodies[b].frame else { continue };
+        let inertia = bodies[b].inertia;
+        for p in 0..nb {
+            let Some(fp) = bodies[p].frame else { continue };
+            if p == b || fp == fb || out[p].is_some() {
+                continue;
+            }
+            if out.iter().flatten().any(|r| r.carrier == b) {
+                break;
+            }
+            let (rb, rp) = (frames[fb].rot, frames[fp].rot);
+            // The relative rotation, carrier to rotor, and the relative
+            // angular velocity in the carrier's frame.
+            let mut rel = [[g.int(0)?; 3]; 3];
+            for (i, row) in rel.iter_mut().enumerate() {
+                for (j, e) in row.iter_mut().enumerate() {
+                    let d = dot(
+                        g,
+                        [rp[0][i], rp[1][i], rp[2][i]],
+                        [rb[0][j], rb[1][j], rb[2][j]],
+                    )?;
+                    *e = expanded(g, d)?;
+                }
+            }
+            let mut dw = [g.int(0)?; 3];
+            for i in 0..3 {
+                dw[i] = g.sub(frames[fb].omega[i], frames[fp].omega[i])?;
+            }
+            let dw = mat_t_vec(g, &rp, dw)?;
+            let dw = expanded3(g, dw)?;
+            let one = g.int(1)?;
+            for k in 0..3 {
+                let others = [(k + 1) % 3, (k + 2) % 3];
+                let axis_fixed = rel[k][k] == one
+                    && others
+                        .iter()
+                        .all(|&i| g.is_zero(rel[i][k]) && g.is_zero(rel[k][i]));
+                let symmetric = (0..3).all(|i| (0..3).all(|j| i == j || g.is_zero(inertia[i][j])))
+                    && inertia[others[0]][others[0]] == inertia[others[1]][others[1]];
+                let spin = coords
+                    .iter()
+                    .position(|(_, c)| g.sym(c.rate).is_ok_and(|r| r == dw[k]));
+                if axis_fixed && symmetric && others.iter().all(|&i| g.is_zero(dw[i])) {
+                    if let Some(coordinate) = spin {
+                        out[b] = Some(Rotor {
+                            carrier: p,
+                            axis: k,
+                            coordinate,
+                            axial: inertia[k][k],
+                        });
+                        break;
+                    }
+                }
+            }
+            if out[b].is_some() {
+                break;
+            }
+        }
+    }
+    Ok(out)
+}
+
 /// A body's part in a composite (see [`composite_bodies`]).
 enum Composite {
     /// Its translational terms are its own.
@@ -1475,8 +1664,9 @@ enum Composite {
         center: Vec3,
         extra_inertia: Mat3,
     },
-    /// Its translational terms are carried by its group's leader.
-    Member,
+    /// Its translational terms are carried by its group's leader (the
+    /// index).
+    Member(usize),
 }
 
 /// Groups bodies whose mass centres are fixed in a rigid body's frame (a
@@ -1567,7 +1757,7 @@ fn composite_bodies(
         }
         for (b, _) in &members {
             taken[*b] = true;
-            out[*b] = Composite::Member;
+            out[*b] = Composite::Member(a);
         }
         out[a] = Composite::Leader {
             mass: total,
@@ -1866,6 +2056,9 @@ fn equations_text(d: &Derivation) -> String {
             v.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ")
         }
     };
+    for line in &d.folded {
+        let _ = writeln!(s, "{line}");
+    }
     let _ = writeln!(s, "cyclic coordinates: {}", list(&d.cyclic));
     let _ = writeln!(
         s,

@@ -2,6 +2,8 @@
 
 #![allow(dead_code)] // each test file uses a subset
 
+use appell::Model;
+
 /// A small deterministic generator (xorshift64*), so failures reproduce.
 pub struct Rng(pub u64);
 
@@ -44,4 +46,37 @@ pub fn double_pendulum_accelerations(
             + w2 * w2 * l2 * m2 * (t1 - t2).cos())
         / (l2 * den);
     (a1, a2)
+}
+
+/// Compares generated and oracle reduced rhs at `count` random states;
+/// returns the largest relative difference seen.
+pub fn agree<M: Model>(model: &M, rng: &mut Rng, count: usize, q_range: f64) -> f64 {
+    let info = M::info();
+    let prepared = model.prepare::<f64>();
+    let n = info.coordinates.len();
+    let l = info.speeds.len();
+    let mut worst: f64 = 0.0;
+    for _ in 0..count {
+        let q: Vec<f64> = (0..n).map(|_| rng.uniform(-q_range, q_range)).collect();
+        let u: Vec<f64> = (0..l).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let inputs: Vec<f64> = info.inputs.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let mut state: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|c| q[info.coordinate_index(c).unwrap()])
+            .collect();
+        state.extend(&u);
+        let mut d = vec![0.0; state.len()];
+        model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
+        let o = appell::oracle::reduced_rhs(model, 0.0, &q, &u, &inputs).unwrap();
+        for (a, b) in d.iter().zip(&o) {
+            let rel = (a - b).abs() / (1.0 + a.abs().max(b.abs()));
+            worst = worst.max(rel);
+        }
+    }
+    println!(
+        "{}: largest relative difference over {count} states: {worst:.2e}",
+        info.name
+    );
+    worst
 }
