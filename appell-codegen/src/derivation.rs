@@ -237,6 +237,14 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let n = model.coords.len();
     let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
     let rules = RateRules::coordinates();
+    // The twin (direction cosines as symbols) is used where expressions are
+    // differentiated along q̇ and not expanded: the constraint rows' rates
+    // and the acceleration remainders. `uncut` puts the values back.
+    let twin = model.twin.take();
+    let twin_rules = twin.as_ref().map(|t| t.rate_rules());
+    let mut uncut = twin
+        .as_ref()
+        .map_or_else(Substitution::new, |t| t.uncut_substitution());
     // 1. Velocity constraint rows.
     // (row, its tokens, holonomic, the same row before expansion)
     let mut rows: Vec<(Id, proc_macro2::TokenStream, bool, Id)> = Vec::new();
@@ -260,16 +268,23 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             cx.error_spanned_by(&c.at, format!("a holonomic constraint relates coordinates, parameters and time only; it uses {}", bad.join(", ")));
             continue;
         }
-        match model.g.time_derivative(c.residual, &rules) {
-            Ok(r) => {
-                rows.push((r, c.at.clone(), true, r));
+        let raw = match (&twin, &twin_rules) {
+            (Some(t), Some(tr)) => model.g.time_derivative(t.holonomic[index].residual, tr),
+            _ => model.g.time_derivative(c.residual, &rules),
+        };
+        match (model.g.time_derivative(c.residual, &rules), raw) {
+            (Ok(r), Ok(raw)) => {
+                rows.push((r, c.at.clone(), true, raw));
                 origins.push(RowSource::Holonomic(index));
             }
-            Err(e) => cx.error_spanned_by(&c.at, e),
+            (Err(e), _) | (_, Err(e)) => cx.error_spanned_by(&c.at, e),
         }
     }
     for (index, c) in model.nonholonomic.iter().enumerate() {
-        rows.push((c.residual, c.at.clone(), false, c.residual));
+        let raw = twin
+            .as_ref()
+            .map_or(c.residual, |t| t.nonholonomic[index].residual);
+        rows.push((c.residual, c.at.clone(), false, raw));
         origins.push(RowSource::Nonholonomic(index));
     }
     // Rolling: v(material point at P) = v(centre) + ω × (P − centre) = 0.
@@ -284,21 +299,32 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             arm[i] = g.sub(r.contact[i], body.center[i])?;
         }
         let w = cross(g, omega, arm)?;
-        let mut raw_v = v;
         for i in 0..3 {
-            raw_v[i] = g.add(v[i], w[i])?;
-            v[i] = expanded(g, raw_v[i])?;
+            let sum = g.add(v[i], w[i])?;
+            v[i] = expanded(g, sum)?;
         }
-        let (components, raw): (Vec<Id>, Vec<Id>) = match &r.along {
-            Some(dirs) => (
-                dirs.iter()
-                    .map(|d| dot(g, v, *d).and_then(|e| expanded(g, e)))
-                    .collect::<Result<_, _>>()?,
-                dirs.iter()
-                    .map(|d| dot(g, raw_v, *d))
-                    .collect::<Result<_, _>>()?,
-            ),
-            None => (v.to_vec(), raw_v.to_vec()),
+        let components: Vec<Id> = match &r.along {
+            Some(dirs) => dirs
+                .iter()
+                .map(|d| dot(g, v, *d).and_then(|e| expanded(g, e)))
+                .collect::<Result<_, _>>()?,
+            None => v.to_vec(),
+        };
+        // The same rows as written (not multiplied out), from the twin.
+        let raw: Vec<Id> = match (&twin, &twin_rules) {
+            (Some(t), Some(tr)) => {
+                let tb = &t.bodies[r.body];
+                let tr_roll = &t.rolling[contact];
+                rolling_components(
+                    g,
+                    tb.center,
+                    t.frames[tb.frame.expect("rigid")].omega,
+                    tr_roll.contact,
+                    tr_roll.along.as_deref(),
+                    tr,
+                )?
+            }
+            _ => rolling_components(g, body.center, omega, r.contact, r.along.as_deref(), &rules)?,
         };
         let before = rows.len();
         for (k, (c, raw_c)) in components.into_iter().zip(raw).enumerate() {
@@ -696,6 +722,11 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     for &r in rates.iter().chain(&speed_rates) {
         along_rates = along_rates.constant(r);
     }
+    if let Some(t) = &twin {
+        for c in &t.cuts {
+            along_rates = along_rates.with(c.symbol, c.rate);
+        }
+    }
     let mut fixed_rates = Substitution::new();
     for &r in &dependent {
         fixed_rates.insert(model.coords[r].1.rate, qdot[r]);
@@ -737,7 +768,16 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         if !row_ops.is_empty() {
             for &row in &raw_rows {
                 let rate = g.time_derivative(row, &along_rates)?;
+                let rate = uncut.apply(g, rate)?;
                 raw_rates.push(fixed_rates.apply(g, rate)?);
+            }
+            if std::env::var("APPELL_PARTS").is_ok() {
+                for (i, &r) in raw_rates.iter().enumerate() {
+                    eprintln!("raw rate {i}: {}  row {}", g.op_count(&[r])?.total(), g.op_count(&[raw_rows[i]])?.total());
+                }
+                eprintln!("all raw rates: {}", g.op_count(&raw_rates)?.total());
+                let t: Vec<Id> = row_ops.iter().copied().filter(|e| !g.is_zero(*e)).collect();
+                eprintln!("T entries {}: {}", t.len(), g.op_count(&t)?.total());
             }
         }
         for i in 0..k {
@@ -906,16 +946,20 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         let e = zero_accels.apply(g, e)?;
         dependent_remainders.push((model.coords[d].1.rate, e));
     }
+    // `v` is the twin's when there is one (see `uncut`).
     let remainder = |g: &mut appell_symbolic::Graph,
                      fixed_rates: &mut Substitution,
+                     uncut: &mut Substitution,
                      v: Vec3|
      -> Result<Vec3, SymbolicError> {
         let mut out = [zero; 3];
         for i in 0..3 {
             let along = g.time_derivative(v[i], &along_rates)?;
+            let along = uncut.apply(g, along)?;
             let mut terms = vec![fixed_rates.apply(g, along)?];
             for &(rate, r) in &dependent_remainders {
                 let c = g.diff(v[i], rate)?;
+                let c = uncut.apply(g, c)?;
                 let c = fixed_rates.apply(g, c)?;
                 terms.push(g.mul(c, r)?);
             }
@@ -931,8 +975,11 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     for (bi, b) in model.bodies.iter().enumerate() {
         alphas.push(match &rotations[bi] {
             Some(rot) => {
-                let omega = model.frames[b.frame.expect("rigid")].omega;
-                let alpha_n = remainder(g, &mut fixed_rates, omega)?;
+                let f = b.frame.expect("rigid");
+                let omega = twin
+                    .as_ref()
+                    .map_or(model.frames[f].omega, |t| t.frames[f].omega);
+                let alpha_n = remainder(g, &mut fixed_rates, &mut uncut, omega)?;
                 let alpha_b = mat_t_vec(g, rot, alpha_n)?;
                 Some(expanded3(g, alpha_b)?)
             }
@@ -991,12 +1038,18 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     forcing_terms[k].push(g.neg(e)?);
                 }
             }
+            // (mass, β̄_k, the centre in the twin or the model)
             let translational = match &composites[bi] {
                 Composite::Member(_) => None,
-                Composite::Alone => Some((b.mass, t.beta.clone(), b.center)),
+                Composite::Alone => Some((
+                    b.mass,
+                    t.beta.clone(),
+                    twin.as_ref().map_or(b.center, |t| t.bodies[bi].center),
+                )),
                 Composite::Leader {
                     mass: total,
                     center,
+                    shift,
                     extra_inertia,
                 } => {
                     for (r, row) in inertia.iter_mut().enumerate() {
@@ -1010,15 +1063,31 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     }
                     let (parts, rest) = raw_parts(g, v)?;
                     let (beta, _) = through_c(g, &parts, rest)?;
-                    Some((*total, beta, *center))
+                    let twin_center = match &twin {
+                        Some(t) => {
+                            let rot = t.frames[b.frame.expect("rigid")].rot;
+                            let mut c = t.bodies[bi].center;
+                            for (i, c) in c.iter_mut().enumerate() {
+                                let mut terms = vec![*c];
+                                for (j, sh) in shift.iter().enumerate() {
+                                    terms.push(g.mul(rot[i][j], *sh)?);
+                                }
+                                *c = g.sum(&terms)?;
+                            }
+                            c
+                        }
+                        None => *center,
+                    };
+                    Some((*total, beta, twin_center))
                 }
             };
             if let Some((m_total, beta, center)) = &translational {
+                let center_rules = twin_rules.as_ref().unwrap_or(&rules);
                 let mut v = [zero; 3];
                 for i in 0..3 {
-                    v[i] = g.time_derivative(center[i], &rules)?;
+                    v[i] = g.time_derivative(center[i], center_rules)?;
                 }
-                let a_rem = remainder(g, &mut fixed_rates, v)?;
+                let a_rem = remainder(g, &mut fixed_rates, &mut uncut, v)?;
                 for k in 0..l {
                     let ab = dot(g, a_rem, beta[k])?;
                     let inertial = g.mul(*m_total, ab)?;
@@ -1275,6 +1344,31 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         &qdot,
         &dependent,
     )?;
+    if std::env::var("APPELL_PARTS").is_ok() {
+        let mut sets: Vec<(&str, Vec<Id>)> = Vec::new();
+        if let Elimination::Numeric(ne) = &elimination {
+            let mut a = ne.dp.clone();
+            a.extend(&ne.rhs);
+            sets.push(("S,R", a.clone()));
+            a.extend(&ne.rhs_rate);
+            sets.push(("+rate", a.clone()));
+            let mut b = a.clone();
+            b.extend(&mass);
+            sets.push(("+M", b));
+            let mut b = a.clone();
+            b.extend(&forcing);
+            sets.push(("+f", b));
+            let mut b = a.clone();
+            b.extend(&mass);
+            b.extend(&forcing);
+            sets.push(("+M+f", b));
+        }
+        sets.push(("M", mass.clone()));
+        sets.push(("f", forcing.clone()));
+        for (name, roots) in sets {
+            eprintln!("{name}: {}", g.op_count(&roots)?.total());
+        }
+    }
     let mut velocity_residuals = Vec::with_capacity(m);
     for i in 0..m {
         let mut terms = vec![d0[i]];
@@ -1539,6 +1633,32 @@ pub enum RowSource {
     },
 }
 
+/// The components of a rolling contact's velocity, (v + ω × (P − centre))
+/// along each direction (or in N), as written: not multiplied out.
+fn rolling_components(
+    g: &mut appell_symbolic::Graph,
+    center: Vec3,
+    omega: Vec3,
+    contact: Vec3,
+    along: Option<&[Vec3]>,
+    rules: &RateRules,
+) -> Result<Vec<Id>, SymbolicError> {
+    let mut v = center;
+    let mut arm = center;
+    for i in 0..3 {
+        v[i] = g.time_derivative(center[i], rules)?;
+        arm[i] = g.sub(contact[i], center[i])?;
+    }
+    let w = cross(g, omega, arm)?;
+    for i in 0..3 {
+        v[i] = g.add(v[i], w[i])?;
+    }
+    match along {
+        Some(dirs) => dirs.iter().map(|d| dot(g, v, *d)).collect(),
+        None => Ok(v.to_vec()),
+    }
+}
+
 /// Operations of M (upper triangle) and f, expanded as they will be.
 fn assembled_ops(
     g: &mut appell_symbolic::Graph,
@@ -1662,6 +1782,7 @@ enum Composite {
     Leader {
         mass: Id,
         center: Vec3,
+        shift: Vec3,
         extra_inertia: Mat3,
     },
     /// Its translational terms are carried by its group's leader (the
@@ -1762,6 +1883,7 @@ fn composite_bodies(
         out[a] = Composite::Leader {
             mass: total,
             center,
+            shift,
             extra_inertia: extra,
         };
     }

@@ -192,6 +192,46 @@ pub struct Model {
     /// where it occurs, so that the generated code can name a zero-length
     /// one at run time.
     pub norms: Vec<(Id, String)>,
+    /// The same kinematics with each frame's direction cosines standing as
+    /// symbols (see [`Cut`]), in the same graph; `None` inside the twin.
+    pub twin: Option<Box<Model>>,
+    /// The twin's direction-cosine symbols (empty in the model itself).
+    pub cuts: Vec<Cut>,
+}
+
+/// A direction cosine standing as a symbol in the twin model: its rate is a
+/// component of ω × column, so a derivative through nested rotations stays
+/// a few cross products instead of the product rule over every factor of
+/// every direction cosine. [`Model::uncut_substitution`] puts the values
+/// (the model's own direction cosines) back.
+#[derive(Clone, Copy)]
+pub struct Cut {
+    /// The symbol.
+    pub symbol: Symbol,
+    /// Its value: the model's entry of the frame's matrix.
+    pub value: Id,
+    /// Its rate, linear in the coordinate rates.
+    pub rate: Id,
+}
+
+impl Model {
+    /// Rate rules for the coordinates and the direction-cosine symbols.
+    pub fn rate_rules(&self) -> RateRules {
+        let mut r = RateRules::coordinates();
+        for c in &self.cuts {
+            r = r.with(c.symbol, c.rate);
+        }
+        r
+    }
+
+    /// The substitution of every direction-cosine symbol by its value.
+    pub fn uncut_substitution(&self) -> appell_symbolic::Substitution {
+        let mut s = appell_symbolic::Substitution::new();
+        for c in &self.cuts {
+            s.insert(c.symbol, c.value);
+        }
+        s
+    }
 }
 
 #[derive(Clone, Copy)]
@@ -216,6 +256,11 @@ struct Builder<'a> {
     /// The definition being evaluated (for `norms`).
     context: String,
     norms: Vec<(Id, String)>,
+    /// When building the twin: the model's frame matrices, whose entries
+    /// become symbols.
+    cut_from: Option<Vec<Mat3>>,
+    cuts: Vec<Cut>,
+    rules: RateRules,
 }
 
 fn engine_error(cx: &Ctxt, span: Span, e: SymbolicError) {
@@ -224,7 +269,22 @@ fn engine_error(cx: &Ctxt, span: Span, e: SymbolicError) {
 
 /// Resolves names and builds kinematics; `None` when errors were recorded.
 pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
-    let mut g = Graph::new();
+    let mut model = build_in(cx, ast, Graph::new(), None)?;
+    // The twin, built again in the same graph with direction cosines as
+    // symbols; the first build found every error there is.
+    let scratch = Ctxt::new();
+    let frames: Vec<Mat3> = model.frames.iter().map(|f| f.rot).collect();
+    let twin = build_in(&scratch, ast, model.g.clone(), Some(frames));
+    if scratch.check().is_ok() {
+        if let Some(mut twin) = twin {
+            model.g = std::mem::replace(&mut twin.g, Graph::new());
+            model.twin = Some(Box::new(twin));
+        }
+    }
+    Some(model)
+}
+
+fn build_in(cx: &Ctxt, ast: &ModelAst, mut g: Graph, cut_from: Option<Vec<Mat3>>) -> Option<Model> {
     let time = g.time().expect("fresh graph");
     let mut b = Builder {
         cx,
@@ -238,6 +298,9 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         poisoned: Vec::new(),
         context: String::new(),
         norms: Vec::new(),
+        cut_from,
+        cuts: Vec::new(),
+        rules: RateRules::coordinates(),
     };
     b.declare_symbols(ast);
     let zero = b.g.int(0).ok()?;
@@ -498,6 +561,8 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Model> {
         info_name: ast.name.to_string(),
         gravity,
         norms: b.norms,
+        twin: None,
+        cuts: b.cuts,
     })
 }
 
@@ -713,7 +778,14 @@ impl Builder<'_> {
                 RotationAxis::Parent(k) => self.parent_axis_rotation(*k, angle, rot, omega),
                 RotationAxis::Vector(v) => {
                     let Some(u) = self.vector(v) else { return };
-                    match self.fixed_in(u, &rot) {
+                    // The twin's matrices are symbols; the model's build
+                    // has checked the axis.
+                    let checked = if self.cut_from.is_some() {
+                        Ok(true)
+                    } else {
+                        self.fixed_in(u, &rot)
+                    };
+                    match checked {
                         Ok(true) => {}
                         Ok(false) => {
                             self.cx.error_at(
@@ -741,11 +813,62 @@ impl Builder<'_> {
                 }
             }
         }
+        if let Some(values) = &self.cut_from {
+            let index = self.frames.len();
+            let values = values[index];
+            match self.cut_rotation(index, rot, omega, values) {
+                Ok(r) => rot = r,
+                Err(e) => {
+                    engine_error(self.cx, f.name.span(), e);
+                    return;
+                }
+            }
+        }
         self.frames.push(Frame {
             name: f.name.to_string(),
             rot,
             omega,
         });
+    }
+
+    /// In the twin: replaces the entries of a frame's matrix that depend on
+    /// the coordinates by symbols (see [`Cut`]) whose values are the
+    /// model's entries.
+    fn cut_rotation(
+        &mut self,
+        index: usize,
+        rot: Mat3,
+        omega: Vec3,
+        values: Mat3,
+    ) -> Result<Mat3, SymbolicError> {
+        let g = &mut self.g;
+        let mut out = rot;
+        let mut symbols = [[None; 3]; 3];
+        for i in 0..3 {
+            for j in 0..3 {
+                if g.is_parameter_only(rot[i][j]) {
+                    continue;
+                }
+                let s = g.declare(&format!("__r{index}_{i}{j}"), SymbolKind::Auxiliary)?;
+                symbols[i][j] = Some(s);
+                out[i][j] = g.sym(s)?;
+            }
+        }
+        for j in 0..3 {
+            let column = [out[0][j], out[1][j], out[2][j]];
+            let rate = cross(g, omega, column)?;
+            for i in 0..3 {
+                if let Some(s) = symbols[i][j] {
+                    self.rules = std::mem::take(&mut self.rules).with(s, rate[i]);
+                    self.cuts.push(Cut {
+                        symbol: s,
+                        value: values[i][j],
+                        rate: rate[i],
+                    });
+                }
+            }
+        }
+        Ok(out)
     }
 
     /// Whether the vector `u` (N components) is fixed in the frame with
@@ -1283,7 +1406,7 @@ impl Builder<'_> {
                 let Some(x) = self.scalar(&args[0]) else {
                     return Ok(None);
                 };
-                let d = self.g.time_derivative(x, &RateRules::coordinates())?;
+                let d = self.g.time_derivative(x, &self.rules)?;
                 Ok(Some(Val::Scalar(d)))
             }
             "sin" | "cos" | "tan" | "exp" | "ln" | "sqrt" | "abs" => {
@@ -1358,11 +1481,10 @@ impl Builder<'_> {
                     let Some(p) = self.point_named(target) else {
                         return Ok(None);
                     };
-                    let rules = RateRules::coordinates();
                     let v = [
-                        self.g.time_derivative(p[0], &rules)?,
-                        self.g.time_derivative(p[1], &rules)?,
-                        self.g.time_derivative(p[2], &rules)?,
+                        self.g.time_derivative(p[0], &self.rules)?,
+                        self.g.time_derivative(p[1], &self.rules)?,
+                        self.g.time_derivative(p[2], &self.rules)?,
                     ];
                     Ok(Some(Val::Vector(v)))
                 }
