@@ -771,14 +771,6 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 let rate = uncut.apply(g, rate)?;
                 raw_rates.push(fixed_rates.apply(g, rate)?);
             }
-            if std::env::var("APPELL_PARTS").is_ok() {
-                for (i, &r) in raw_rates.iter().enumerate() {
-                    eprintln!("raw rate {i}: {}  row {}", g.op_count(&[r])?.total(), g.op_count(&[raw_rows[i]])?.total());
-                }
-                eprintln!("all raw rates: {}", g.op_count(&raw_rates)?.total());
-                let t: Vec<Id> = row_ops.iter().copied().filter(|e| !g.is_zero(*e)).collect();
-                eprintln!("T entries {}: {}", t.len(), g.op_count(&t)?.total());
-            }
         }
         for i in 0..k {
             if !raw_rates.is_empty() {
@@ -1344,31 +1336,6 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         &qdot,
         &dependent,
     )?;
-    if std::env::var("APPELL_PARTS").is_ok() {
-        let mut sets: Vec<(&str, Vec<Id>)> = Vec::new();
-        if let Elimination::Numeric(ne) = &elimination {
-            let mut a = ne.dp.clone();
-            a.extend(&ne.rhs);
-            sets.push(("S,R", a.clone()));
-            a.extend(&ne.rhs_rate);
-            sets.push(("+rate", a.clone()));
-            let mut b = a.clone();
-            b.extend(&mass);
-            sets.push(("+M", b));
-            let mut b = a.clone();
-            b.extend(&forcing);
-            sets.push(("+f", b));
-            let mut b = a.clone();
-            b.extend(&mass);
-            b.extend(&forcing);
-            sets.push(("+M+f", b));
-        }
-        sets.push(("M", mass.clone()));
-        sets.push(("f", forcing.clone()));
-        for (name, roots) in sets {
-            eprintln!("{name}: {}", g.op_count(&roots)?.total());
-        }
-    }
     let mut velocity_residuals = Vec::with_capacity(m);
     for i in 0..m {
         let mut terms = vec![d0[i]];

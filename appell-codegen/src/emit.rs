@@ -381,7 +381,15 @@ impl Emitter<'_> {
             let _ = writeln!(s, "        let __w_{i} = __x1[{i}][0];");
         }
         indent(&mut s, c.stages.get(2).map_or(&[], |v| v.as_slice()));
-        let solve_ops = m * m * m + 2 * m * m * (width + 1);
+        // As `lu_factor` and `lu_substitute` count them: the factorization
+        // (a reciprocal per column, a multiplier and a multiply-subtract per
+        // entry below and right of the pivot), then m + k(2m² − m) for k
+        // right-hand columns (X's, then w's).
+        let factor_ops: usize = (0..m)
+            .map(|c| 1 + (m - c - 1) * (1 + 2 * (m - c - 1)))
+            .sum();
+        let substitute_ops = |k: usize| m + k * (2 * m * m - m);
+        let solve_ops = factor_ops + substitute_ops(width) + substitute_ops(1);
         c.body.clear();
         (c, s, solve_ops)
     }
