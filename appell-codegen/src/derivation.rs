@@ -1125,8 +1125,9 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let composites = composite_bodies(g, &model.bodies, &rotations, &assume)?;
     if composites.iter().any(|c| !matches!(c, Composite::Alone)) {
         let candidate = assemble(g, &composites, &no_rotors)?;
-        if assembled_ops(g, &candidate, l)?
-            < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
+        if model.fold_always
+            || assembled_ops(g, &candidate, l)?
+                < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
         {
             (mass, forcing_terms) = candidate;
             chosen = composites;
@@ -1153,8 +1154,9 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let found = rotors(g, &model.bodies, &model.frames, &model.coords)?;
     if found.iter().any(Option::is_some) {
         let candidate = assemble(g, &chosen, &found)?;
-        if assembled_ops(g, &candidate, l)?
-            < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
+        if model.fold_always
+            || assembled_ops(g, &candidate, l)?
+                < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
         {
             (mass, forcing_terms) = candidate;
             for (bi, r) in found.iter().enumerate() {
@@ -1943,8 +1945,19 @@ fn mat_vec(g: &mut appell_symbolic::Graph, m: &Mat3, v: Vec3) -> Result<Vec3, Sy
 }
 
 /// A value in [0.5, 1.5] for parameters and [−1, 1] for everything else,
-/// fixed by the symbol and the trial number.
-pub(crate) fn pseudo_value(g: &appell_symbolic::Graph, s: Symbol, trial: u64) -> f64 {
+/// fixed by the symbol and the trial number (the numeric rank and
+/// independence checks evaluate at such points).
+///
+/// ```
+/// use appell_codegen::derivation::pseudo_value;
+/// let mut g = appell_symbolic::Graph::new();
+/// let m = g.parameter("m").unwrap();
+/// let q = g.coordinate("q").unwrap().q;
+/// assert!((0.5..=1.5).contains(&pseudo_value(&g, m, 0)));
+/// assert!((-1.0..=1.0).contains(&pseudo_value(&g, q, 0)));
+/// assert_eq!(pseudo_value(&g, q, 3), pseudo_value(&g, q, 3));
+/// ```
+pub fn pseudo_value(g: &appell_symbolic::Graph, s: Symbol, trial: u64) -> f64 {
     let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
         ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
     h ^= h >> 31;

@@ -197,6 +197,9 @@ pub struct Model {
     pub twin: Option<Box<Model>>,
     /// The twin's direction-cosine symbols (empty in the model itself).
     pub cuts: Vec<Cut>,
+    /// Fold composites and rotors even where that costs operations (for
+    /// tests that compare folded and unfolded equations).
+    pub fold_always: bool,
 }
 
 /// A direction cosine standing as a symbol in the twin model: its rate is a
@@ -563,6 +566,7 @@ fn build_in(cx: &Ctxt, ast: &ModelAst, mut g: Graph, cut_from: Option<Vec<Mat3>>
         norms: b.norms,
         twin: None,
         cuts: b.cuts,
+        fold_always: false,
     })
 }
 
