@@ -284,14 +284,7 @@ fn wheel_axle_system_obeys_newton_with_its_constraint_reactions() {
     let mut rng = Rng(0xa71e);
     let (mut worst_lin, mut worst_ang) = (0.0_f64, 0.0_f64);
     for _ in 0..1000 {
-        let p = WheelAxle {
-            a: rng.uniform(0.1, 1.0),
-            l: rng.uniform(0.2, 2.0),
-            mass: rng.uniform(0.5, 5.0),
-            rim: rng.uniform(0.1, 2.0),
-            g: 9.81,
-            alpha: rng.uniform(-0.5, 0.5),
-        };
+        let p = common::random_wheel_axle!(rng);
         let mut q: Vec<f64> = (0..7).map(|_| rng.uniform(-3.0, 3.0)).collect();
         // Wheel 2 at +l along the axle (the rows keep it there).
         q[3] = q[0] - p.l * q[6].sin();

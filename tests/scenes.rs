@@ -44,14 +44,7 @@ fn scenes_are_listed_with_their_states_and_costs() {
 fn each_scene_equals_the_full_model_with_the_other_effects_switched_off() {
     let mut rng = Rng(61);
     for _ in 0..1000 {
-        let p = WheelAxle {
-            a: rng.uniform(0.1, 1.0),
-            l: rng.uniform(0.2, 2.0),
-            mass: rng.uniform(0.5, 5.0),
-            rim: rng.uniform(0.1, 2.0),
-            g: 9.81,
-            alpha: rng.uniform(-0.5, 0.5),
-        };
+        let p = common::random_wheel_axle!(rng);
         let (phi, w, s) = (
             rng.uniform(-3.0, 3.0),
             rng.uniform(-3.0, 3.0),

@@ -11,14 +11,7 @@ use common::{close, Rng};
 use model::WheelAxle;
 
 fn random_model(rng: &mut Rng) -> WheelAxle {
-    WheelAxle {
-        a: rng.uniform(0.1, 1.0),
-        l: rng.uniform(0.2, 2.0),
-        mass: rng.uniform(0.5, 5.0),
-        rim: rng.uniform(0.1, 2.0),
-        g: 9.81,
-        alpha: rng.uniform(-0.5, 0.5),
-    }
+    common::random_wheel_axle!(rng)
 }
 
 /// Eq. 64 with the drive torque: (64a) gains τ/a on its right side.

@@ -1,5 +1,6 @@
 //! The Whipple bicycle benchmark.
 
+mod common;
 #[path = "../examples/models/whipple_bicycle.rs"]
 mod whipple_bicycle;
 
@@ -40,14 +41,10 @@ fn oracle_difference(
     worst
 }
 
-/// A xorshift generator of uniform numbers in [lo, hi).
-fn uniform(mut seed: u64) -> impl FnMut(f64, f64) -> f64 {
-    move |lo, hi| {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        lo + (hi - lo) * ((seed >> 11) as f64 / (1u64 << 53) as f64)
-    }
+/// Uniform numbers in [lo, hi) from the shared xorshift generator.
+fn uniform(seed: u64) -> impl FnMut(f64, f64) -> f64 {
+    let mut rng = common::XorShift(seed);
+    move |lo, hi| rng.uniform(lo, hi)
 }
 
 #[test]

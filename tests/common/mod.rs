@@ -18,6 +18,38 @@ impl Rng {
     }
 }
 
+/// The plain xorshift64 generator (shifts 13, 7, 17), uniform in
+/// `[lo, hi)`: the sequence some tests' recorded figures were drawn from.
+pub struct XorShift(pub u64);
+
+impl XorShift {
+    /// Uniform in `[lo, hi)`.
+    pub fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
+        self.0 ^= self.0 << 13;
+        self.0 ^= self.0 >> 7;
+        self.0 ^= self.0 << 17;
+        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
+    }
+}
+
+/// A wheel-axle (the `WheelAxle` in scope) with random geometry, mass and
+/// slope, drawn from the `Rng` named `rng` in a fixed order.
+#[allow(unused_macros)] // each test file uses a subset
+macro_rules! random_wheel_axle {
+    ($rng:ident) => {
+        WheelAxle {
+            a: $rng.uniform(0.1, 1.0),
+            l: $rng.uniform(0.2, 2.0),
+            mass: $rng.uniform(0.5, 5.0),
+            rim: $rng.uniform(0.1, 2.0),
+            g: 9.81,
+            alpha: $rng.uniform(-0.5, 0.5),
+        }
+    };
+}
+#[allow(unused_imports)] // each test file uses a subset
+pub(crate) use random_wheel_axle;
+
 /// Relative closeness with an absolute floor of `rel`.
 pub fn close(a: f64, b: f64, rel: f64) -> bool {
     (a - b).abs() <= rel * (1.0 + a.abs().max(b.abs()))

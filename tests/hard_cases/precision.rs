@@ -10,6 +10,10 @@
 #[allow(dead_code, clippy::duplicate_mod)]
 #[path = "../../examples/models/chaplygin_sleigh.rs"]
 mod chaplygin_sleigh;
+#[allow(clippy::duplicate_mod)]
+#[path = "../common/mod.rs"]
+mod common;
+use common::XorShift;
 #[allow(dead_code, clippy::duplicate_mod)]
 #[path = "../../examples/models/double_pendulum.rs"]
 mod double_pendulum;
@@ -42,23 +46,10 @@ fn result(case: &str, criterion: &str, measured: String, pass: bool) -> CaseResu
     }
 }
 
-/// A deterministic xorshift generator.
-struct Rng(u64);
-
-impl Rng {
-    /// Uniform in `[lo, hi)`.
-    fn uniform(&mut self, lo: f64, hi: f64) -> f64 {
-        self.0 ^= self.0 << 13;
-        self.0 ^= self.0 >> 7;
-        self.0 ^= self.0 << 17;
-        lo + (hi - lo) * ((self.0 >> 11) as f64 / (1u64 << 53) as f64)
-    }
-}
-
 /// A random reduced state and inputs: retained coordinates in [−1, 1],
 /// speeds in [−2, 2], inputs in [−1, 1] (as `tests/oracle_agreement.rs`
 /// draws them), except where a model needs its own ranges.
-fn draw<M: Model>(rng: &mut Rng) -> (Vec<f64>, Vec<f64>) {
+fn draw<M: Model>(rng: &mut XorShift) -> (Vec<f64>, Vec<f64>) {
     let info = M::info();
     let mut state: Vec<f64> = info
         .retained
@@ -145,7 +136,7 @@ pub fn round_off<M: Model + Clone>(model: &M, count: usize, seed: u64) -> RoundO
     }
     let p32 = model32.prepare::<f32>();
     let p32_64 = model32.prepare::<f64>();
-    let mut rng = Rng(seed);
+    let mut rng = XorShift(seed);
     let (mut d64, mut d32, mut d32_64) = (vec![0.0; n], vec![0.0f32; n], vec![0.0; n]);
     let mut ddd = vec![DoubleDouble::default(); n];
     let (mut f64_max, mut f64_sum, mut f32_max, mut f32_sum) = (0.0f64, 0.0, 0.0f64, 0.0);
