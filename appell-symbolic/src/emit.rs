@@ -138,6 +138,9 @@ const MAX_INLINE_DEPTH: usize = 16;
 /// Exponents up to this are computed by multiplication chains.
 const MAX_CHAIN_EXPONENT: i32 = 64;
 
+/// The longest nested sum [`Lowering::flatten`] distributes.
+const MAX_DISTRIBUTED: usize = 8;
+
 /// A lowered, hash-consed straight-line program computing some roots.
 #[derive(Clone, Debug)]
 pub struct Program {
@@ -147,8 +150,15 @@ pub struct Program {
     uses: Vec<u32>,
 }
 
+/// A term of a sum: coefficient, factors, and a parameter-only value
+/// multiplied in (the merged parameter parts of terms that shared their
+/// state-dependent factors).
+type Term = (Number, Vec<(Id, i32)>, Option<u32>);
+
 struct Lowering<'g> {
     graph: &'g Graph,
+    /// How many nodes (and roots) read each node.
+    readers: FxHashMap<Id, u32>,
     insts: Vec<Inst>,
     index: FxHashMap<Inst, u32>,
     memo: FxHashMap<Id, u32>,
@@ -199,13 +209,13 @@ impl Lowering<'_> {
     /// one value (hoistable), multiplied by the rest and divided by the rest's
     /// denominator. A negative coefficient is folded into the parameter-only
     /// value when there is one, else applied as a negation.
-    fn product(&mut self, coeff: Number, factors: &[(Id, i32)]) -> u32 {
+    fn product(&mut self, coeff: Number, factors: &[(Id, i32)], extra: Option<u32>) -> u32 {
         type Factors = Vec<(Id, i32)>;
         let (params, others): (Factors, Factors) = factors
             .iter()
             .copied()
             .partition(|&(b, _)| self.graph.is_parameter_only(b));
-        let fold_sign = !params.is_empty();
+        let fold_sign = !params.is_empty() || extra.is_some();
         let k = if fold_sign { coeff } else { coeff.abs() };
         let group = |l: &mut Self, list: &[(Id, i32)], k: Option<Number>| -> Option<u32> {
             let mut num = Vec::new();
@@ -234,7 +244,13 @@ impl Lowering<'_> {
                 }
             }
         };
-        let p = group(self, &params, Some(k));
+        let mut p = group(self, &params, Some(k));
+        if let Some(x) = extra {
+            p = Some(match p {
+                Some(p) => self.push(Inst::Mul(p, x)),
+                None => x,
+            });
+        }
         // The rest: numerator times the parameter value, then one division.
         let mut num = Vec::new();
         let mut den = Vec::new();
@@ -266,45 +282,81 @@ impl Lowering<'_> {
 
     /// `constant + Σ k·Π bᵉ`, with common factors taken out greedily
     /// (`a·x + a·y + z → a·(x + y) + z`): the state-dependent factor shared by
-    /// the most terms first, so each is multiplied once.
-    fn sum(&mut self, constant: Number, mut terms: Vec<(Number, Vec<(Id, i32)>)>) -> u32 {
+    /// the most terms first, so each is multiplied once. Terms whose
+    /// state-dependent factors are the same are one term first, their
+    /// parameter-only parts summed (hoisted): `p·x·y + q·x·y → (p + q)·x·y`.
+    fn sum(&mut self, constant: Number, terms: Vec<Term>) -> u32 {
+        let (constant, terms) = self.flatten(constant, terms);
+        let mut terms = self.collect_parameters(terms);
         if terms.len() >= 2 {
             // The factor (not parameter-only: those are hoisted anyway) that
             // the most terms contain; ties go to the smallest id.
-            let mut counts: BTreeMap<Id, usize> = BTreeMap::new();
-            for (_, factors) in &terms {
-                for &(b, e) in factors {
-                    if e > 0 && !self.graph.is_parameter_only(b) {
-                        *counts.entry(b).or_insert(0) += 1;
-                    }
+            // Counted by lowered value: two nodes may lower to one value.
+            // A parameter-only factor counts too (it is hoisted, but each
+            // term still multiplies by it), after a state factor as often
+            // found.
+            let mut counts: BTreeMap<(u32, bool), (usize, bool)> = BTreeMap::new();
+            for (_, factors, extra) in &terms {
+                // A parameter factor saves a multiplication only where it
+                // is the term's one parameter-only factor (else it joins
+                // the others in one hoisted product anyway).
+                let params = factors
+                    .iter()
+                    .filter(|&&(b, _)| self.graph.is_parameter_only(b))
+                    .count()
+                    + usize::from(extra.is_some());
+                let mut seen: Vec<(u32, bool, bool)> = factors
+                    .iter()
+                    .map(|&(b, e)| (self.memo[&b], e < 0, !self.graph.is_parameter_only(b)))
+                    .filter(|&(_, _, state)| state || params == 1)
+                    .collect();
+                seen.sort_unstable();
+                seen.dedup();
+                for (inst, inverse, state) in seen {
+                    let c = counts.entry((inst, inverse)).or_insert((0, state));
+                    c.0 += 1;
                 }
             }
             let best = counts
                 .iter()
-                .filter(|(_, &c)| c >= 2)
-                .max_by_key(|(id, &c)| (c, std::cmp::Reverse(**id)))
-                .map(|(id, _)| *id);
-            if let Some(f) = best {
+                .filter(|(_, &(c, _))| c >= 2)
+                .max_by_key(|(key, &(c, state))| (c, state, std::cmp::Reverse(**key)))
+                .map(|(key, _)| *key);
+            if let Some((base, inverse)) = best {
+                let step = if inverse { 1 } else { -1 };
+                let memo = &self.memo;
+                let is_f = |b: Id, e: i32| memo[&b] == base && (e < 0) == inverse;
                 let (with, without): (Vec<_>, Vec<_>) = terms
                     .drain(..)
-                    .partition(|(_, fs)| fs.iter().any(|&(b, e)| b == f && e > 0));
-                let reduced: Vec<(Number, Vec<(Id, i32)>)> = with
+                    .partition(|(_, fs, _)| fs.iter().any(|&(b, e)| is_f(b, e)));
+                let reduced: Vec<Term> = with
                     .into_iter()
-                    .map(|(k, fs)| {
+                    .map(|(k, fs, extra)| {
+                        // One power of the factor comes out (of the first
+                        // node that lowers to it).
+                        let mut done = false;
                         let fs = fs
                             .into_iter()
-                            .filter_map(|(b, e)| match (b == f, e - 1) {
-                                (true, 0) => None,
-                                (true, r) => Some((b, r)),
-                                _ => Some((b, e)),
+                            .filter_map(|(b, e)| {
+                                if done || !is_f(b, e) {
+                                    return Some((b, e));
+                                }
+                                done = true;
+                                match e + step {
+                                    0 => None,
+                                    r => Some((b, r)),
+                                }
                             })
                             .collect();
-                        (k, fs)
+                        (k, fs, extra)
                     })
                     .collect();
                 let inner = self.sum(Number::ZERO, reduced);
-                let base = self.memo[&f];
-                let grouped = self.push(Inst::Mul(inner, base));
+                let grouped = if inverse {
+                    self.push(Inst::Div(inner, base))
+                } else {
+                    self.push(Inst::Mul(inner, base))
+                };
                 if without.is_empty() && constant.is_zero() {
                     return grouped;
                 }
@@ -314,28 +366,28 @@ impl Lowering<'_> {
         }
         let mut pos = Vec::new();
         let mut neg = Vec::new();
-        type Ordered = (bool, usize, Number, Vec<(Id, i32)>);
+        type Ordered = (bool, usize, Term);
         let mut ordered: Vec<Ordered> = terms
             .into_iter()
             .enumerate()
-            .map(|(i, (k, fs))| {
+            .map(|(i, t)| {
                 (
-                    !fs.iter().all(|&(b, _)| self.graph.is_parameter_only(b)),
+                    !t.1.iter().all(|&(b, _)| self.graph.is_parameter_only(b)),
                     i,
-                    k,
-                    fs,
+                    t,
                 )
             })
             .collect();
         ordered.sort_by_key(|t| (t.0, t.1));
-        for (_, _, k, factors) in ordered {
+        for (_, _, (k, factors, extra)) in ordered {
             // A coefficient joins the term's parameter-only factors (sign
             // included, so the term is simply added); without such factors
             // the sign becomes a subtraction.
-            let has_param = factors
-                .iter()
-                .any(|&(f, _)| self.graph.is_parameter_only(f));
-            if factors.is_empty() {
+            let has_param = extra.is_some()
+                || factors
+                    .iter()
+                    .any(|&(f, _)| self.graph.is_parameter_only(f));
+            if factors.is_empty() && extra.is_none() {
                 let c = self.constant(k.abs());
                 if k.is_negative() {
                     neg.push(c)
@@ -343,9 +395,9 @@ impl Lowering<'_> {
                     pos.push(c)
                 }
             } else if has_param || !k.is_negative() {
-                pos.push(self.product(k, &factors));
+                pos.push(self.product(k, &factors, extra));
             } else {
-                neg.push(self.product(k.abs(), &factors));
+                neg.push(self.product(k.abs(), &factors, extra));
             }
         }
         if !constant.is_zero() {
@@ -370,27 +422,156 @@ impl Lowering<'_> {
             .fold(start, |acc, &x| self.push(Inst::Sub(acc, x)))
     }
 
+    /// A term that holds a sum read nowhere else (`k·x·(a + b)`) gives its
+    /// terms to the enclosing sum (`k·x·a + k·x·b`), so the common factors
+    /// and parameter parts are sought over all of them (then taken out
+    /// again). A shared sum stays whole: it is computed once.
+    fn flatten(&self, mut constant: Number, terms: Vec<Term>) -> (Number, Vec<Term>) {
+        let nested = |t: &Term| -> Option<usize> {
+            if t.2.is_some() {
+                return None;
+            }
+            t.1.iter().position(|&(b, e)| {
+                e == 1
+                    && self.readers[&b] == 1
+                    && matches!(self.graph.node(b), Node::Add { terms, .. } if terms.len() <= MAX_DISTRIBUTED)
+            })
+        };
+        if !terms.iter().any(|t| nested(t).is_some()) {
+            return (constant, terms);
+        }
+        let mut out = Vec::with_capacity(terms.len() * 2);
+        let mut stack: Vec<Term> = terms.into_iter().rev().collect();
+        while let Some(t) = stack.pop() {
+            let Some(at) = nested(&t) else {
+                out.push(t);
+                continue;
+            };
+            let (k, mut rest, _) = t;
+            let (sum_id, _) = rest.remove(at);
+            let Node::Add {
+                constant: c,
+                terms: inner,
+            } = self.graph.node(sum_id)
+            else {
+                unreachable!("a nested sum")
+            };
+            if !c.is_zero() {
+                if rest.is_empty() {
+                    constant = constant + k * *c;
+                } else {
+                    stack.push((k * *c, rest.clone(), None));
+                }
+            }
+            for &(b, kb) in inner.iter().rev() {
+                let mut factors = match self.graph.node(b) {
+                    Node::Mul { factors, .. } => factors.to_vec(),
+                    _ => vec![(b, 1)],
+                };
+                for &(f, e) in &rest {
+                    match factors.iter_mut().find(|x| x.0 == f) {
+                        Some(x) => x.1 += e,
+                        None => factors.push((f, e)),
+                    }
+                }
+                factors.retain(|x| x.1 != 0);
+                factors.sort_unstable();
+                stack.push((k * kb, factors, None));
+            }
+        }
+        (constant, out)
+    }
+
+    /// Terms with the same state-dependent factors merged into one, whose
+    /// parameter-only part is the (hoisted) sum of theirs.
+    fn collect_parameters(&mut self, terms: Vec<Term>) -> Vec<Term> {
+        if terms.len() < 2 {
+            return terms;
+        }
+        // Keyed by lowered value: two nodes may lower to one value.
+        let mut groups: BTreeMap<Vec<(u32, i32)>, Vec<usize>> = BTreeMap::new();
+        for (i, (_, factors, _)) in terms.iter().enumerate() {
+            let mut key: Vec<(u32, i32)> = factors
+                .iter()
+                .filter(|&&(b, _)| !self.graph.is_parameter_only(b))
+                .map(|&(b, e)| (self.memo[&b], e))
+                .collect();
+            key.sort_unstable();
+            if !key.is_empty() {
+                groups.entry(key).or_default().push(i);
+            }
+        }
+        if groups.values().all(|members| members.len() < 2) {
+            return terms;
+        }
+        let mut merged: Vec<Option<Term>> = terms.into_iter().map(Some).collect();
+        let mut out = Vec::new();
+        for members in groups.into_values() {
+            if members.len() < 2 {
+                continue;
+            }
+            let state: Vec<(Id, i32)> = merged[members[0]]
+                .as_ref()
+                .expect("each term in one group")
+                .1
+                .iter()
+                .copied()
+                .filter(|&(b, _)| !self.graph.is_parameter_only(b))
+                .collect();
+            // Plain coefficients add up as numbers (x − x is no term).
+            let mut number = Number::ZERO;
+            let mut parts = Vec::with_capacity(members.len());
+            for &i in &members {
+                let (k, factors, extra) = merged[i].take().expect("each term in one group");
+                let params: Vec<(Id, i32)> = factors
+                    .into_iter()
+                    .filter(|&(b, _)| self.graph.is_parameter_only(b))
+                    .collect();
+                if params.is_empty() && extra.is_none() {
+                    number = number + k;
+                } else {
+                    parts.push(self.product(k, &params, extra));
+                }
+            }
+            if parts.is_empty() {
+                if !number.is_zero() {
+                    out.push((number, state, None));
+                }
+                continue;
+            }
+            if !number.is_zero() {
+                parts.push(self.constant(number));
+            }
+            let value = self.chain(&parts, Inst::Add).expect("one part or more");
+            out.push((Number::ONE, state, Some(value)));
+        }
+        // Unmerged terms first, in their order, then the merged ones.
+        let mut all: Vec<Term> = merged.into_iter().flatten().collect();
+        all.extend(out);
+        all
+    }
+
     fn lower_node(&mut self, id: Id) -> u32 {
         let node = self.graph.node(id);
         match node {
             Node::Num(n) => self.constant(*n),
             Node::Sym(s) => self.push(Inst::Symbol(*s)),
             Node::Add { constant, terms } => {
-                let terms: Vec<(Number, Vec<(Id, i32)>)> = terms
+                let terms: Vec<Term> = terms
                     .iter()
                     .map(|&(b, k)| {
                         let factors = match self.graph.node(b) {
                             Node::Mul { factors, .. } => factors.to_vec(),
                             _ => vec![(b, 1)],
                         };
-                        (k, factors)
+                        (k, factors, None)
                     })
                     .collect();
                 self.sum(*constant, terms)
             }
             Node::Mul { coeff, factors } => {
                 let factors = factors.to_vec();
-                self.product(*coeff, &factors)
+                self.product(*coeff, &factors, None)
             }
             Node::Fun(f, a) => {
                 let a = self.memo[a];
@@ -463,56 +644,516 @@ fn share_reciprocals(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32
     (out, outputs)
 }
 
+/// Products that share two factors share their product
+/// (`a·b·c, a·b·d → t = a·b; t·c, t·d`): each maximal tree of
+/// multiplications is read as its multiset of factors, and the pair of
+/// factors found in the most trees becomes one multiplication, greedily,
+/// while some pair is found in two trees or more. Reassociating a product
+/// changes its rounding by a few half-ulps at most (no cancellation).
+fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+    let n = insts.len();
+    // Parameter-only values are hoisted: they stay whole, and the
+    // parameter-only factors of a product stay one (hoisted) product.
+    let mut parameter_only: Vec<bool> = Vec::with_capacity(n);
+    for inst in &insts {
+        let p = match inst {
+            Inst::Const(_) => true,
+            Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
+            other => other.operands().iter().all(|&o| parameter_only[o as usize]),
+        };
+        parameter_only.push(p);
+    }
+    let mut uses = vec![0u32; n];
+    for inst in &insts {
+        for o in inst.operands() {
+            uses[o as usize] += 1;
+        }
+    }
+    for &o in &outputs {
+        uses[o as usize] += 1;
+    }
+    let is_mul = |i: u32| matches!(insts[i as usize], Inst::Mul(..));
+    // Interior: a multiplication used once, by a multiplication.
+    let mut interior = vec![false; n];
+    for inst in &insts {
+        if let Inst::Mul(a, b) = *inst {
+            for x in [a, b] {
+                if is_mul(x) && uses[x as usize] == 1 && !parameter_only[x as usize] {
+                    interior[x as usize] = true;
+                }
+            }
+        }
+    }
+    // Leaves of each tree root, as sorted lists; a leaf id >= n stands for
+    // a shared pair created below.
+    let mut roots: Vec<u32> = Vec::new();
+    let mut leaves: Vec<Vec<u32>> = Vec::new();
+    for (i, inst) in insts.iter().enumerate() {
+        if !matches!(inst, Inst::Mul(..)) || interior[i] || parameter_only[i] {
+            continue;
+        }
+        let mut list = Vec::new();
+        let mut stack = vec![i as u32];
+        while let Some(x) = stack.pop() {
+            match insts[x as usize] {
+                Inst::Mul(a, b) if x as usize == i || interior[x as usize] => {
+                    stack.push(a);
+                    stack.push(b);
+                }
+                _ => list.push(x),
+            }
+        }
+        list.sort_unstable();
+        roots.push(i as u32);
+        leaves.push(list);
+    }
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    // The parameter-only factors of each tree, as one product.
+    let mut grouped: FxHashMap<Vec<u32>, u32> = FxHashMap::default();
+    for list in leaves.iter_mut() {
+        let (params, mut rest): (Vec<u32>, Vec<u32>) =
+            list.iter().partition(|&&x| parameter_only[x as usize]);
+        if params.len() < 2 {
+            continue;
+        }
+        let mut acc = params[0];
+        for (j, &x) in params.iter().enumerate().skip(1) {
+            let key = params[..=j].to_vec();
+            acc = *grouped.entry(key).or_insert_with(|| {
+                pairs.push((acc, x));
+                (n + pairs.len() - 1) as u32
+            });
+        }
+        rest.push(acc);
+        rest.sort_unstable();
+        *list = rest;
+    }
+    loop {
+        let mut counts: FxHashMap<(u32, u32), usize> = FxHashMap::default();
+        for list in leaves.iter().filter(|l| l.len() >= 2) {
+            let mut seen: Vec<(u32, u32)> = Vec::new();
+            for x in 0..list.len() {
+                for y in x + 1..list.len() {
+                    seen.push((list[x], list[y]));
+                }
+            }
+            seen.sort_unstable();
+            seen.dedup();
+            for p in seen {
+                *counts.entry(p).or_insert(0) += 1;
+            }
+        }
+        let best = counts
+            .into_iter()
+            .filter(|&(_, c)| c >= 2)
+            .max_by_key(|&(p, c)| (c, std::cmp::Reverse(p)));
+        let Some(((a, b), _)) = best else { break };
+        let id = (n + pairs.len()) as u32;
+        pairs.push((a, b));
+        for list in leaves.iter_mut() {
+            let Some(ia) = list.iter().position(|&x| x == a) else {
+                continue;
+            };
+            let ib = if a == b {
+                list.iter()
+                    .skip(ia + 1)
+                    .position(|&x| x == b)
+                    .map(|j| j + ia + 1)
+            } else {
+                list.iter().position(|&x| x == b)
+            };
+            let Some(ib) = ib else { continue };
+            let (hi, lo) = (ia.max(ib), ia.min(ib));
+            list.remove(hi);
+            list.remove(lo);
+            list.push(id);
+            list.sort_unstable();
+        }
+    }
+    if pairs.is_empty() {
+        return (insts, outputs);
+    }
+    // Rebuild: each root becomes the chain over its remaining factors; a
+    // shared pair is emitted where first needed.
+    let root_of: FxHashMap<u32, usize> = roots.iter().enumerate().map(|(k, &r)| (r, k)).collect();
+    let mut out: Vec<Inst> = Vec::with_capacity(n + pairs.len());
+    let mut map = vec![u32::MAX; n];
+    let mut pair_at: Vec<Option<u32>> = vec![None; pairs.len()];
+    fn leaf(
+        x: u32,
+        n: usize,
+        map: &[u32],
+        pairs: &[(u32, u32)],
+        pair_at: &mut [Option<u32>],
+        out: &mut Vec<Inst>,
+    ) -> u32 {
+        if (x as usize) < n {
+            return map[x as usize];
+        }
+        let k = x as usize - n;
+        if let Some(at) = pair_at[k] {
+            return at;
+        }
+        let (a, b) = pairs[k];
+        let a = leaf(a, n, map, pairs, pair_at, out);
+        let b = leaf(b, n, map, pairs, pair_at, out);
+        out.push(Inst::Mul(a.min(b), a.max(b)));
+        let at = (out.len() - 1) as u32;
+        pair_at[k] = Some(at);
+        at
+    }
+    for (i, inst) in insts.into_iter().enumerate() {
+        if let Some(&k) = root_of.get(&(i as u32)) {
+            let list = leaves[k].clone();
+            let mut acc: Option<u32> = None;
+            for x in list {
+                let v = leaf(x, n, &map, &pairs, &mut pair_at, &mut out);
+                acc = Some(match acc {
+                    None => v,
+                    Some(a) => {
+                        out.push(Inst::Mul(a, v));
+                        (out.len() - 1) as u32
+                    }
+                });
+            }
+            map[i] = acc.expect("a product has factors");
+            continue;
+        }
+        if interior[i] {
+            // Never read: its tree's root reads the leaves directly.
+            out.push(Inst::Const(Number::ZERO));
+            map[i] = (out.len() - 1) as u32;
+            continue;
+        }
+        let r = |x: u32| map[x as usize];
+        let new = match inst {
+            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
+            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
+            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
+            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
+            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+            Inst::Neg(a) => Inst::Neg(r(a)),
+            Inst::Powi(a, e) => Inst::Powi(r(a), e),
+            Inst::Call(f, a) => Inst::Call(f, r(a)),
+            leaf => leaf,
+        };
+        out.push(new);
+        map[i] = (out.len() - 1) as u32;
+    }
+    let outputs = outputs.iter().map(|&o| map[o as usize]).collect();
+    (out, outputs)
+}
+
+/// Sums that share two terms share their sum (`a + b + c, a + b − d →
+/// t = a + b; t + c, t − d`; `a − b` and `b − a` share one subtraction):
+/// each maximal tree of additions and subtractions is read as its signed
+/// terms, and the pair of terms found in the most trees becomes one
+/// operation, greedily, while some pair is found in two trees or more.
+fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+    let n = insts.len();
+    let mut parameter_only: Vec<bool> = Vec::with_capacity(n);
+    for inst in &insts {
+        let p = match inst {
+            Inst::Const(_) => true,
+            Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
+            other => other.operands().iter().all(|&o| parameter_only[o as usize]),
+        };
+        parameter_only.push(p);
+    }
+    let mut uses = vec![0u32; n];
+    for inst in &insts {
+        for o in inst.operands() {
+            uses[o as usize] += 1;
+        }
+    }
+    for &o in &outputs {
+        uses[o as usize] += 1;
+    }
+    let is_sum = |i: u32| matches!(insts[i as usize], Inst::Add(..) | Inst::Sub(..));
+    // Interior: an addition, subtraction or negation used once, by an
+    // addition or subtraction (a negated term is a subtracted one).
+    let is_neg = |i: u32| matches!(insts[i as usize], Inst::Neg(..));
+    let mut interior = vec![false; n];
+    for inst in &insts {
+        if let Inst::Add(a, b) | Inst::Sub(a, b) = *inst {
+            for x in [a, b] {
+                if (is_sum(x) || is_neg(x)) && uses[x as usize] == 1 && !parameter_only[x as usize]
+                {
+                    interior[x as usize] = true;
+                }
+            }
+        }
+    }
+    // Signed terms (id, negated) of each tree; ids >= n are shared pairs.
+    let mut roots: Vec<u32> = Vec::new();
+    let mut terms: Vec<Vec<(u32, bool)>> = Vec::new();
+    let mut cancelled = false;
+    for (i, inst) in insts.iter().enumerate() {
+        if !matches!(inst, Inst::Add(..) | Inst::Sub(..)) || interior[i] || parameter_only[i] {
+            continue;
+        }
+        let mut list = Vec::new();
+        let mut stack = vec![(i as u32, false)];
+        while let Some((x, neg)) = stack.pop() {
+            let whole = x as usize == i || interior[x as usize];
+            match insts[x as usize] {
+                Inst::Add(a, b) if whole => {
+                    stack.push((a, neg));
+                    stack.push((b, neg));
+                }
+                Inst::Sub(a, b) if whole => {
+                    stack.push((a, neg));
+                    stack.push((b, !neg));
+                }
+                Inst::Neg(a) if x as usize != i && interior[x as usize] => {
+                    stack.push((a, !neg));
+                }
+                _ => list.push((x, neg)),
+            }
+        }
+        // x − x (two nodes of the graph that lowered to one value) is 0.
+        list.sort_unstable();
+        let mut kept: Vec<(u32, bool)> = Vec::with_capacity(list.len());
+        for t in list {
+            match kept.iter().position(|&(x, neg)| x == t.0 && neg != t.1) {
+                Some(at) => {
+                    kept.remove(at);
+                    cancelled = true;
+                }
+                None => kept.push(t),
+            }
+        }
+        roots.push(i as u32);
+        terms.push(kept);
+    }
+    // A pair (a, b, b negated relative to a), a < b; the shared value is
+    // a ± b, entering a tree with a's sign.
+    let mut pairs: Vec<(u32, u32, bool)> = Vec::new();
+    loop {
+        let mut counts: FxHashMap<(u32, u32, bool), usize> = FxHashMap::default();
+        for list in terms.iter().filter(|l| l.len() >= 2) {
+            let mut seen: Vec<(u32, u32, bool)> = Vec::new();
+            for x in 0..list.len() {
+                for y in x + 1..list.len() {
+                    let ((a, na), (b, nb)) = (list[x], list[y]);
+                    if a != b {
+                        seen.push((a.min(b), a.max(b), na != nb));
+                    }
+                }
+            }
+            seen.sort_unstable();
+            seen.dedup();
+            for p in seen {
+                *counts.entry(p).or_insert(0) += 1;
+            }
+        }
+        let best = counts
+            .into_iter()
+            .filter(|&(_, c)| c >= 2)
+            .max_by_key(|&(p, c)| (c, std::cmp::Reverse(p)));
+        let Some(((a, b, opposite), _)) = best else {
+            break;
+        };
+        let id = (n + pairs.len()) as u32;
+        pairs.push((a, b, opposite));
+        for list in terms.iter_mut().filter(|l| l.len() >= 2) {
+            let Some(ia) = list.iter().position(|&(x, _)| x == a) else {
+                continue;
+            };
+            let na = list[ia].1;
+            let Some(ib) = list
+                .iter()
+                .position(|&(x, nb)| x == b && (na != nb) == opposite)
+            else {
+                continue;
+            };
+            let (hi, lo) = (ia.max(ib), ia.min(ib));
+            list.remove(hi);
+            list.remove(lo);
+            list.push((id, na));
+            list.sort_unstable();
+        }
+    }
+    if pairs.is_empty() && !cancelled {
+        return (insts, outputs);
+    }
+    let root_of: FxHashMap<u32, usize> = roots.iter().enumerate().map(|(k, &r)| (r, k)).collect();
+    let mut out: Vec<Inst> = Vec::with_capacity(n + pairs.len());
+    let mut map = vec![u32::MAX; n];
+    let mut pair_at: Vec<Option<u32>> = vec![None; pairs.len()];
+    fn term(
+        x: u32,
+        n: usize,
+        map: &[u32],
+        pairs: &[(u32, u32, bool)],
+        pair_at: &mut [Option<u32>],
+        out: &mut Vec<Inst>,
+    ) -> u32 {
+        if (x as usize) < n {
+            return map[x as usize];
+        }
+        let k = x as usize - n;
+        if let Some(at) = pair_at[k] {
+            return at;
+        }
+        let (a, b, opposite) = pairs[k];
+        let a = term(a, n, map, pairs, pair_at, out);
+        let b = term(b, n, map, pairs, pair_at, out);
+        out.push(if opposite {
+            Inst::Sub(a, b)
+        } else {
+            Inst::Add(a.min(b), a.max(b))
+        });
+        let at = (out.len() - 1) as u32;
+        pair_at[k] = Some(at);
+        at
+    }
+    for (i, inst) in insts.into_iter().enumerate() {
+        if let Some(&k) = root_of.get(&(i as u32)) {
+            let list = terms[k].clone();
+            let mut pos = Vec::new();
+            let mut neg = Vec::new();
+            for (x, negated) in list {
+                let v = term(x, n, &map, &pairs, &mut pair_at, &mut out);
+                if negated {
+                    neg.push(v);
+                } else {
+                    pos.push(v);
+                }
+            }
+            if pos.is_empty() && neg.is_empty() {
+                out.push(Inst::Const(Number::ZERO));
+                map[i] = (out.len() - 1) as u32;
+                continue;
+            }
+            let mut acc = match pos.first() {
+                Some(&first) => first,
+                None => {
+                    // −(a − b) is b − a.
+                    let first = neg.remove(0);
+                    out.push(match out[first as usize] {
+                        Inst::Sub(a, b) => Inst::Sub(b, a),
+                        _ => Inst::Neg(first),
+                    });
+                    (out.len() - 1) as u32
+                }
+            };
+            for &v in pos.iter().skip(1) {
+                out.push(Inst::Add(acc.min(v), acc.max(v)));
+                acc = (out.len() - 1) as u32;
+            }
+            for v in neg {
+                out.push(Inst::Sub(acc, v));
+                acc = (out.len() - 1) as u32;
+            }
+            map[i] = acc;
+            continue;
+        }
+        if interior[i] {
+            out.push(Inst::Const(Number::ZERO));
+            map[i] = (out.len() - 1) as u32;
+            continue;
+        }
+        let r = |x: u32| map[x as usize];
+        let new = match inst {
+            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
+            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
+            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
+            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
+            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+            Inst::Neg(a) => Inst::Neg(r(a)),
+            Inst::Powi(a, e) => Inst::Powi(r(a), e),
+            Inst::Call(f, a) => Inst::Call(f, r(a)),
+            leaf => leaf,
+        };
+        out.push(new);
+        map[i] = (out.len() - 1) as u32;
+    }
+    let outputs = outputs.iter().map(|&o| map[o as usize]).collect();
+    (out, outputs)
+}
+
+/// Keeps only the instructions the outputs need, once each, renumbered in
+/// order.
+fn prune(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+    let mut needed = vec![false; insts.len()];
+    for &o in &outputs {
+        needed[o as usize] = true;
+    }
+    for i in (0..insts.len()).rev() {
+        if needed[i] {
+            for op in insts[i].operands() {
+                needed[op as usize] = true;
+            }
+        }
+    }
+    let mut renumber = vec![u32::MAX; insts.len()];
+    let mut kept = Vec::new();
+    let mut index: FxHashMap<Inst, u32> = FxHashMap::default();
+    for (i, inst) in insts.into_iter().enumerate() {
+        if !needed[i] {
+            continue;
+        }
+        let r = |x: u32| renumber[x as usize];
+        let inst = match inst {
+            Inst::Add(a, b) => Inst::Add(r(a).min(r(b)), r(a).max(r(b))),
+            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
+            Inst::Mul(a, b) => Inst::Mul(r(a).min(r(b)), r(a).max(r(b))),
+            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
+            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+            Inst::Neg(a) => Inst::Neg(r(a)),
+            Inst::Powi(a, e) => Inst::Powi(r(a), e),
+            Inst::Call(f, a) => Inst::Call(f, r(a)),
+            leaf => leaf,
+        };
+        // The same instruction twice (a product rebuilt from shared
+        // factors) is kept once.
+        renumber[i] = *index.entry(inst.clone()).or_insert_with(|| {
+            kept.push(inst);
+            (kept.len() - 1) as u32
+        });
+    }
+    let outputs = outputs.iter().map(|&o| renumber[o as usize]).collect();
+    (kept, outputs)
+}
+
 impl Program {
     /// Lowers the expressions `roots` of `graph`.
     pub fn lower(graph: &Graph, roots: &[Id]) -> Program {
+        let order = graph.reachable(roots);
+        let mut readers: FxHashMap<Id, u32> = FxHashMap::default();
+        for &id in order.iter().chain(roots) {
+            readers.entry(id).or_insert(0);
+        }
+        for &id in &order {
+            for c in graph.node(id).children() {
+                *readers.entry(c).or_insert(0) += 1;
+            }
+        }
+        for &r in roots {
+            *readers.entry(r).or_insert(0) += 1;
+        }
         let mut l = Lowering {
             graph,
+            readers,
             insts: Vec::new(),
             index: FxHashMap::default(),
             memo: FxHashMap::default(),
         };
-        for id in graph.reachable(roots) {
+        for id in order {
             let i = l.lower_node(id);
             l.memo.insert(id, i);
         }
         let outputs: Vec<u32> = roots.iter().map(|r| l.memo[r]).collect();
-        let (insts, outputs) = share_reciprocals(l.insts, outputs);
-        l.insts = insts;
-        // Keep only instructions the outputs need (lowering may have built
-        // intermediate forms that ended up unused), renumbered in order.
-        let mut needed = vec![false; l.insts.len()];
-        for &o in &outputs {
-            needed[o as usize] = true;
-        }
-        for i in (0..l.insts.len()).rev() {
-            if needed[i] {
-                for op in l.insts[i].operands() {
-                    needed[op as usize] = true;
-                }
-            }
-        }
-        let mut renumber = vec![u32::MAX; l.insts.len()];
-        let mut insts = Vec::new();
-        for (i, inst) in l.insts.into_iter().enumerate() {
-            if !needed[i] {
-                continue;
-            }
-            renumber[i] = insts.len() as u32;
-            let r = |x: u32| renumber[x as usize];
-            insts.push(match inst {
-                Inst::Add(a, b) => Inst::Add(r(a), r(b)),
-                Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
-                Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
-                Inst::Div(a, b) => Inst::Div(r(a), r(b)),
-                Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
-                Inst::Neg(a) => Inst::Neg(r(a)),
-                Inst::Powi(a, e) => Inst::Powi(r(a), e),
-                Inst::Call(f, a) => Inst::Call(f, r(a)),
-                leaf => leaf,
-            });
-        }
-        let outputs: Vec<u32> = outputs.iter().map(|&o| renumber[o as usize]).collect();
+        // Lowering builds forms that end up unused (a sum's terms before
+        // their common factors are taken out): drop them first, so that
+        // only live instructions count as uses below.
+        let (insts, outputs) = prune(l.insts, outputs);
+        let (insts, outputs) = share_reciprocals(insts, outputs);
+        let (insts, outputs) = share_products(graph, insts, outputs);
+        let (insts, outputs) = prune(insts, outputs);
+        let (insts, outputs) = share_sums(graph, insts, outputs);
+        let (insts, outputs) = prune(insts, outputs);
         let mut parameter_only = Vec::with_capacity(insts.len());
         let mut uses = vec![0u32; insts.len()];
         for inst in &insts {
@@ -1200,5 +1841,134 @@ mod stage_tests {
         let plain = p.to_rust(&g, &EmitOptions::default());
         assert_eq!(plain.stages.len(), 1);
         assert_eq!(plain.stages[0], plain.body);
+    }
+}
+
+#[cfg(test)]
+mod sharing_tests {
+    use super::*;
+
+    fn values(g: &Graph) -> impl Fn(Symbol) -> Option<f64> + '_ {
+        |s| {
+            Some(match g.symbol_name(s) {
+                "x" => 0.7,
+                "y" => -1.3,
+                "z" => 2.1,
+                "w" => 0.4,
+                "d" => 1.9,
+                "p" => 3.0,
+                "q" => -0.5,
+                _ => return None,
+            })
+        }
+    }
+
+    fn check(g: &mut Graph, texts: &[&str]) -> Program {
+        let roots: Vec<Id> = texts.iter().map(|t| g.parse(t).unwrap()).collect();
+        let p = Program::lower(g, &roots);
+        let got = p.eval(&values(g)).unwrap();
+        let expected = crate::eval::Tape::new(g, &roots).eval(&values(g)).unwrap();
+        for (a, b) in got.iter().zip(&expected) {
+            assert!((a - b).abs() <= 1e-14 * b.abs().max(1.0), "{a} vs {b}");
+        }
+        p
+    }
+
+    #[test]
+    fn products_sharing_two_factors_share_their_product() {
+        let mut g = Graph::new();
+        // x·y is found in three products: computed once, each product then
+        // costs one more multiplication (4 in all, against 6).
+        let p = check(&mut g, &["x*y*z", "x*y*w", "x*y*z*w + z"]);
+        let ops = p.op_count();
+        assert_eq!(ops.mul, 4, "{ops}");
+        assert_eq!(ops.add, 1, "{ops}");
+    }
+
+    #[test]
+    fn parameter_only_factors_stay_one_hoisted_value() {
+        let mut g = Graph::new();
+        g.parameter("p").unwrap();
+        g.parameter("q").unwrap();
+        let p = check(&mut g, &["p*q*sin(x)", "p*q*cos(x)*y"]);
+        // p·q is one parameter-only value, multiplied in at run time once
+        // per product.
+        let state_muls = p
+            .insts()
+            .iter()
+            .enumerate()
+            .filter(|(i, inst)| matches!(inst, Inst::Mul(..)) && !p.parameter_only[*i])
+            .count();
+        assert_eq!(state_muls, 3);
+        assert!(p
+            .insts()
+            .iter()
+            .enumerate()
+            .any(|(i, inst)| matches!(inst, Inst::Mul(..)) && p.parameter_only[i]));
+    }
+
+    #[test]
+    fn a_shared_denominator_is_taken_out_of_a_sum() {
+        let mut g = Graph::new();
+        // x/d + y/d + z → (x + y)/d + z: one division, two additions.
+        let p = check(&mut g, &["x/d + y/d + z"]);
+        let ops = p.op_count();
+        assert_eq!((ops.div, ops.add, ops.mul), (1, 2, 0), "{ops}");
+    }
+
+    #[test]
+    fn sums_sharing_two_terms_share_their_sum() {
+        let mut g = Graph::new();
+        // x + y is found in three sums (once with the opposite sign):
+        // computed once, then one operation per sum (4 in all, against 6).
+        let p = check(
+            &mut g,
+            &[
+                "sin(x) + cos(y) + z",
+                "sin(x) + cos(y) - w",
+                "w - sin(x) - cos(y)",
+            ],
+        );
+        let ops = p.op_count();
+        assert_eq!((ops.add, ops.neg), (4, 0), "{ops}");
+    }
+
+    #[test]
+    fn terms_with_the_same_state_factors_share_one_parameter_sum() {
+        let mut g = Graph::new();
+        g.parameter("p").unwrap();
+        g.parameter("q").unwrap();
+        // p·x·y + q·x·y + z → (p + q)·(x·y) + z: two multiplications and
+        // one addition at run time, p + q hoisted.
+        let p = check(&mut g, &["p*sin(x)*y + q*y*sin(x) + z"]);
+        let run_time = |want: fn(&Inst) -> bool| {
+            p.insts()
+                .iter()
+                .enumerate()
+                .filter(|(i, inst)| want(inst) && !p.parameter_only[*i])
+                .count()
+        };
+        assert_eq!(run_time(|i| matches!(i, Inst::Mul(..))), 2);
+        assert_eq!(run_time(|i| matches!(i, Inst::Add(..) | Inst::Sub(..))), 1);
+    }
+
+    #[test]
+    fn a_value_added_and_subtracted_cancels() {
+        let mut g = Graph::new();
+        // (sin y + z)·w and w·sin y + w·z are different nodes that lower to
+        // one value: their difference is no work at all.
+        let p = check(&mut g, &["(sin(y) + z)*w - w*sin(y) - w*z + x*d"]);
+        let ops = p.op_count();
+        assert_eq!(ops.total(), 1, "{ops}");
+    }
+
+    #[test]
+    fn a_parameter_shared_by_several_terms_is_taken_out() {
+        let mut g = Graph::new();
+        g.parameter("p").unwrap();
+        // p·x + p·y + p·z → p·(x + y + z): one multiplication.
+        let p = check(&mut g, &["p*sin(x) + p*cos(y) + p*z"]);
+        let ops = p.op_count();
+        assert_eq!((ops.mul, ops.add), (1, 2), "{ops}");
     }
 }
