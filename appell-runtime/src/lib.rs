@@ -41,7 +41,9 @@ pub use scalar::Scalar;
 /// Items the generated code refers to; not a stable API.
 #[doc(hidden)]
 pub mod __private {
-    pub use crate::linalg::{ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs};
+    pub use crate::linalg::{
+        check_pivot, constraint_scale, ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs,
+    };
     pub use crate::model::check_len;
     pub use crate::{
         BodyInfo, ContactInfo, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar,

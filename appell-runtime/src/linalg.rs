@@ -61,6 +61,60 @@ pub fn max_abs<T: Scalar, const N: usize, const M: usize>(b: &[[T; M]; N]) -> f6
     scale
 }
 
+/// The scale a constraint matrix's pivots are judged against: the largest
+/// magnitude among the entries of `a` and `rhs_scale` (a non-finite
+/// `rhs_scale` counts as 0). A non-finite entry of `a` is
+/// [`ModelError::NonFinite`].
+///
+/// ```
+/// use appell_runtime::linalg::constraint_scale;
+/// assert_eq!(constraint_scale(&[[1.0, -3.0], [0.5, 2.0]], 2.0), Ok(3.0));
+/// assert_eq!(constraint_scale(&[[1.0]], 7.0), Ok(7.0));
+/// assert!(constraint_scale(&[[f64::NAN]], 1.0).is_err());
+/// ```
+pub fn constraint_scale<T: Scalar, const N: usize, const M: usize>(
+    a: &[[T; M]; N],
+    rhs_scale: f64,
+) -> Result<f64, ModelError> {
+    let mut scale = if rhs_scale.is_finite() {
+        rhs_scale
+    } else {
+        0.0
+    };
+    for row in a.iter() {
+        for x in row {
+            let v = x.re().abs();
+            if !v.is_finite() {
+                return Err(ModelError::NonFinite {
+                    what: "the constraint matrix",
+                });
+            }
+            scale = scale.max(v);
+        }
+    }
+    Ok(scale)
+}
+
+/// Accepts a pivot of the dependent block when its magnitude exceeds
+/// `1e-12 × scale` (see [`constraint_scale`]) and is not zero; otherwise
+/// [`ModelError::SingularConstraints`] for `column`. [`lu_factor`] judges
+/// its pivots so, and so does generated code for the unknowns it solves
+/// one by one (a row of the block with a single entry).
+///
+/// ```
+/// use appell_runtime::linalg::check_pivot;
+/// assert!(check_pivot(1e-3, 1.0, 0).is_ok());
+/// assert!(check_pivot(1e-13, 1.0, 2).is_err());
+/// assert!(check_pivot(0.0, 0.0, 0).is_err());
+/// ```
+pub fn check_pivot<T: Scalar>(pivot: T, scale: f64, column: usize) -> Result<(), ModelError> {
+    let v = pivot.re().abs();
+    if v <= 1e-12 * scale || v == 0.0 || v.is_nan() {
+        return Err(ModelError::SingularConstraints { column, pivot: v });
+    }
+    Ok(())
+}
+
 /// Factors `A` in place by LU with partial pivoting (the multipliers below
 /// the diagonal, U on and above it) and returns the row exchanges, so that
 /// several right sides can be solved with [`lu_substitute`], including
@@ -84,23 +138,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
     a: &mut [[T; N]; N],
     rhs_scale: f64,
 ) -> Result<[usize; N], ModelError> {
-    let mut scale = if rhs_scale.is_finite() {
-        rhs_scale
-    } else {
-        0.0
-    };
-    for row in a.iter() {
-        for x in row {
-            let v = x.re().abs();
-            if !v.is_finite() {
-                return Err(ModelError::NonFinite {
-                    what: "the constraint matrix",
-                });
-            }
-            scale = scale.max(v);
-        }
-    }
-    let tol = 1e-12 * scale;
+    let scale = constraint_scale(a, rhs_scale)?;
     let mut swaps = [0usize; N];
     for col in 0..N {
         let mut p = col;
@@ -112,12 +150,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
                 p = r;
             }
         }
-        if best <= tol || best == 0.0 {
-            return Err(ModelError::SingularConstraints {
-                column: col,
-                pivot: best,
-            });
-        }
+        check_pivot(a[p][col], scale, col)?;
         swaps[col] = p;
         a.swap(p, col);
         let inv = T::one() / a[col][col];
