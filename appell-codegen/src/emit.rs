@@ -1035,8 +1035,11 @@ impl Emitter<'_> {
 {params_t}{prepare}        [{prepared_list}]
     }}
     fn rhs<__T: {P}::Scalar>(&self, __prepared: &[__T; {h}], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> {P}::Result<(), {P}::ModelError> {{
-{chk_state}{chk_inputs}{chk_dstate}{pos}        let [{hoisted_list}] = *__prepared;
+{chk_state}{chk_inputs}{chk_dstate}{pos}        // The closure reads the prepared values itself: bound outside, each
+        // would be captured by reference (an address stored per value and
+        // a load through it per use).
         let __result: {P}::Result<(), {P}::ModelError> = (|| {{
+        let [{hoisted_list}] = *__prepared;
 {params_t}{bind_state}{bind_inputs}{rhs_body}{ldlt}{write_out}        if !({finite}) {{ return {P}::Err({P}::ModelError::NonFinite {{ what: "the state derivative" }}); }}
         {P}::Ok(())
         }})();
