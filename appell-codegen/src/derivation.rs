@@ -1863,7 +1863,7 @@ fn composite_bodies(
 /// up (a bicycle's nested rotations) is abandoned early by a term budget and
 /// the factored form is kept.
 fn expanded(g: &mut appell_symbolic::Graph, e: Id) -> Result<Id, SymbolicError> {
-    const TERM_BUDGET: usize = 48;
+    const TERM_BUDGET: usize = 32;
     match g.expand_outside_functions(e, TERM_BUDGET) {
         Ok(x) if x == e => Ok(e),
         Ok(x) => {

@@ -295,7 +295,9 @@ impl Lowering<'_> {
             // A parameter-only factor counts too (it is hoisted, but each
             // term still multiplies by it), after a state factor as often
             // found.
-            let mut counts: BTreeMap<(u32, bool), (usize, bool)> = BTreeMap::new();
+            // All (value, divides, is state) pairs, once per term, sorted:
+            // runs of one pair count the terms that have it.
+            let mut seen: Vec<(u32, bool, bool)> = Vec::new();
             for (_, factors, extra) in &terms {
                 // A parameter factor saves a multiplication only where it
                 // is the term's one parameter-only factor (else it joins
@@ -305,23 +307,40 @@ impl Lowering<'_> {
                     .filter(|&&(b, _)| self.graph.is_parameter_only(b))
                     .count()
                     + usize::from(extra.is_some());
-                let mut seen: Vec<(u32, bool, bool)> = factors
-                    .iter()
-                    .map(|&(b, e)| (self.memo[&b], e < 0, !self.graph.is_parameter_only(b)))
-                    .filter(|&(_, _, state)| state || params == 1)
-                    .collect();
-                seen.sort_unstable();
-                seen.dedup();
-                for (inst, inverse, state) in seen {
-                    let c = counts.entry((inst, inverse)).or_insert((0, state));
-                    c.0 += 1;
+                let start = seen.len();
+                seen.extend(
+                    factors
+                        .iter()
+                        .map(|&(b, e)| (self.memo[&b], e < 0, !self.graph.is_parameter_only(b)))
+                        .filter(|&(_, _, state)| state || params == 1),
+                );
+                seen[start..].sort_unstable();
+                let mut w = start;
+                for r in start..seen.len() {
+                    if r == start || seen[r] != seen[w - 1] {
+                        seen[w] = seen[r];
+                        w += 1;
+                    }
+                }
+                seen.truncate(w);
+            }
+            seen.sort_unstable();
+            let mut best: Option<((usize, bool), (u32, bool))> = None;
+            let mut r = 0;
+            while r < seen.len() {
+                let (inst, inverse, state) = seen[r];
+                let mut c = 0;
+                while r < seen.len() && seen[r].0 == inst && seen[r].1 == inverse {
+                    c += 1;
+                    r += 1;
+                }
+                // Most terms first, a state factor before a parameter, then
+                // the smallest value.
+                if c >= 2 && best.is_none_or(|(score, _)| (c, state) > score) {
+                    best = Some(((c, state), (inst, inverse)));
                 }
             }
-            let best = counts
-                .iter()
-                .filter(|(_, &(c, _))| c >= 2)
-                .max_by_key(|(key, &(c, state))| (c, state, std::cmp::Reverse(**key)))
-                .map(|(key, _)| *key);
+            let best = best.map(|(_, key)| key);
             if let Some((base, inverse)) = best {
                 let step = if inverse { 1 } else { -1 };
                 let memo = &self.memo;
@@ -488,28 +507,44 @@ impl Lowering<'_> {
         if terms.len() < 2 {
             return terms;
         }
-        // Keyed by lowered value: two nodes may lower to one value.
-        let mut groups: BTreeMap<Vec<(u32, i32)>, Vec<usize>> = BTreeMap::new();
+        // Keyed by lowered value: two nodes may lower to one value. The
+        // keys share one buffer; equal keys are adjacent once sorted.
+        let mut buffer: Vec<(u32, i32)> = Vec::new();
+        let mut spans: Vec<(usize, usize, usize)> = Vec::with_capacity(terms.len());
         for (i, (_, factors, _)) in terms.iter().enumerate() {
-            let mut key: Vec<(u32, i32)> = factors
-                .iter()
-                .filter(|&&(b, _)| !self.graph.is_parameter_only(b))
-                .map(|&(b, e)| (self.memo[&b], e))
-                .collect();
-            key.sort_unstable();
-            if !key.is_empty() {
-                groups.entry(key).or_default().push(i);
+            let start = buffer.len();
+            buffer.extend(
+                factors
+                    .iter()
+                    .filter(|&&(b, _)| !self.graph.is_parameter_only(b))
+                    .map(|&(b, e)| (self.memo[&b], e)),
+            );
+            buffer[start..].sort_unstable();
+            if buffer.len() > start {
+                spans.push((start, buffer.len(), i));
             }
         }
-        if groups.values().all(|members| members.len() < 2) {
+        spans.sort_by(|a, b| buffer[a.0..a.1].cmp(&buffer[b.0..b.1]).then(a.2.cmp(&b.2)));
+        let mut groups: Vec<Vec<usize>> = Vec::new();
+        let mut r = 0;
+        while r < spans.len() {
+            let key = &buffer[spans[r].0..spans[r].1];
+            let mut members = vec![spans[r].2];
+            r += 1;
+            while r < spans.len() && &buffer[spans[r].0..spans[r].1] == key {
+                members.push(spans[r].2);
+                r += 1;
+            }
+            if members.len() >= 2 {
+                groups.push(members);
+            }
+        }
+        if groups.is_empty() {
             return terms;
         }
         let mut merged: Vec<Option<Term>> = terms.into_iter().map(Some).collect();
         let mut out = Vec::new();
-        for members in groups.into_values() {
-            if members.len() < 2 {
-                continue;
-            }
+        for members in groups {
             let state: Vec<(Id, i32)> = merged[members[0]]
                 .as_ref()
                 .expect("each term in one group")
