@@ -611,10 +611,11 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 let zero_column: Vec<bool> = (0..=l)
                     .map(|j| (0..k).all(|i| g.is_zero(part.s_rhs[(i, j)])))
                     .collect();
+                let nonzero = structural_solution(g, &part.s, &part.s_rhs, k, l + 1);
                 for f in 0..k {
                     for j in 0..=l {
                         let s = g.declare(&format!("__x_{f}_{j}"), SymbolKind::Auxiliary)?;
-                        ids.push(if zero_column[j] && j < l {
+                        ids.push(if (zero_column[j] || !nonzero[f][j]) && j < l {
                             zero
                         } else {
                             g.sym(s)?
@@ -1862,6 +1863,51 @@ fn composite_bodies(
 /// forcing vanish only after expansion), while an expansion that would blow
 /// up (a bicycle's nested rotations) is abandoned early by a term budget and
 /// the factored form is kept.
+/// Which entries of X in S X = R can be nonzero, from where S and R are
+/// identically zero: rows of S with a single entry among the unknowns not
+/// yet solved are solved one by one (as the generated code does), and an
+/// unknown so solved is zero in a column where its row of R and every
+/// earlier unknown its row reads are zero; the unknowns of the remaining
+/// block are taken as nonzero wherever the block's right side can be. (The
+/// bicycle's pitch rate does not depend on the rear wheel's rate.)
+fn structural_solution(
+    g: &appell_symbolic::Graph,
+    s: &SymMatrix,
+    r: &SymMatrix,
+    k: usize,
+    width: usize,
+) -> Vec<Vec<bool>> {
+    let entry = |i: usize, j: usize| !g.is_zero(s[(i, j)]);
+    let mut rows_left: Vec<usize> = (0..k).collect();
+    let mut cols_left: Vec<usize> = (0..k).collect();
+    let mut nonzero = vec![vec![true; width]; k];
+    let mut peeled: Vec<usize> = Vec::new();
+    while let Some((at, col)) = rows_left.iter().enumerate().find_map(|(at, &i)| {
+        let mut found = cols_left.iter().filter(|&&j| entry(i, j));
+        match (found.next(), found.next()) {
+            (Some(&j), None) => Some((at, j)),
+            _ => None,
+        }
+    }) {
+        let row = rows_left.remove(at);
+        cols_left.retain(|&j| j != col);
+        for c in 0..width {
+            nonzero[col][c] = !g.is_zero(r[(row, c)])
+                || peeled.iter().any(|&jj| entry(row, jj) && nonzero[jj][c]);
+        }
+        peeled.push(col);
+    }
+    for c in 0..width {
+        let block = rows_left.iter().any(|&row| {
+            !g.is_zero(r[(row, c)]) || peeled.iter().any(|&jj| entry(row, jj) && nonzero[jj][c])
+        });
+        for &j in &cols_left {
+            nonzero[j][c] = block;
+        }
+    }
+    nonzero
+}
+
 fn expanded(g: &mut appell_symbolic::Graph, e: Id) -> Result<Id, SymbolicError> {
     const TERM_BUDGET: usize = 32;
     match g.expand_outside_functions(e, TERM_BUDGET) {
