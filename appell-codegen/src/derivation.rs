@@ -2241,3 +2241,33 @@ fn equations_text(d: &Derivation) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn structural_solution_follows_the_singleton_rows() {
+        let mut g = appell_symbolic::Graph::new();
+        // Row 0 has one entry (column 1): x1 = r0 / a, zero where r0 is.
+        // The block (rows 1, 2; columns 0, 2) is then dense: its unknowns
+        // are nonzero where any of its rows' right sides, or x1 through
+        // the entries b and e, can be.
+        let s = SymMatrix::parse(
+            &mut g,
+            &[&["0", "a", "0"], &["c", "b", "d"], &["f", "0", "h"]],
+        )
+        .unwrap();
+        let r = SymMatrix::parse(
+            &mut g,
+            &[&["p", "0", "0"], &["0", "0", "0"], &["0", "0", "q"]],
+        )
+        .unwrap();
+        let nz = structural_solution(&g, &s, &r, 3, 3);
+        assert_eq!(nz[1], vec![true, false, false]);
+        // Column 0 reaches the block through b·x1; column 1 is zero
+        // throughout; column 2 through q.
+        assert_eq!(nz[0], vec![true, false, true]);
+        assert_eq!(nz[2], vec![true, false, true]);
+    }
+}
