@@ -1863,6 +1863,54 @@ fn composite_bodies(
 /// forcing vanish only after expansion), while an expansion that would blow
 /// up (a bicycle's nested rotations) is abandoned early by a term budget and
 /// the factored form is kept.
+/// The order in which a square system S x = r is solved when rows with a
+/// single entry among the unknowns not yet solved go first, one by one
+/// (see [`singleton_rows`]).
+pub struct SingletonOrder {
+    /// (row, unknown) pairs, in solving order.
+    pub peeled: Vec<(usize, usize)>,
+    /// The rows left to a dense solve, in order.
+    pub rows_left: Vec<usize>,
+    /// The unknowns left to a dense solve, in order.
+    pub cols_left: Vec<usize>,
+}
+
+/// Rows of a k×k matrix with a single nonzero entry among the unknowns not
+/// yet solved, peeled in order (each solved by one division; no other
+/// entry changes, so there is nothing for pivoting to protect); `entry`
+/// says whether an entry can be nonzero. The generated code and
+/// [`structural_solution`] both follow this order.
+///
+/// ```
+/// use appell_codegen::derivation::singleton_rows;
+/// // Row 0 reads only unknown 1; then rows 1 and 2 share unknowns 0 and 2.
+/// let nonzero = [[false, true, false], [true, true, true], [true, false, true]];
+/// let order = singleton_rows(3, |i, j| nonzero[i][j]);
+/// assert_eq!(order.peeled, vec![(0, 1)]);
+/// assert_eq!((order.rows_left, order.cols_left), (vec![1, 2], vec![0, 2]));
+/// ```
+pub fn singleton_rows(k: usize, entry: impl Fn(usize, usize) -> bool) -> SingletonOrder {
+    let mut rows_left: Vec<usize> = (0..k).collect();
+    let mut cols_left: Vec<usize> = (0..k).collect();
+    let mut peeled = Vec::new();
+    while let Some((at, col)) = rows_left.iter().enumerate().find_map(|(at, &i)| {
+        let mut found = cols_left.iter().filter(|&&j| entry(i, j));
+        match (found.next(), found.next()) {
+            (Some(&j), None) => Some((at, j)),
+            _ => None,
+        }
+    }) {
+        let row = rows_left.remove(at);
+        cols_left.retain(|&j| j != col);
+        peeled.push((row, col));
+    }
+    SingletonOrder {
+        peeled,
+        rows_left,
+        cols_left,
+    }
+}
+
 /// Which entries of X in S X = R can be nonzero, from where S and R are
 /// identically zero: rows of S with a single entry among the unknowns not
 /// yet solved are solved one by one (as the generated code does), and an
@@ -1878,30 +1926,23 @@ fn structural_solution(
     width: usize,
 ) -> Vec<Vec<bool>> {
     let entry = |i: usize, j: usize| !g.is_zero(s[(i, j)]);
-    let mut rows_left: Vec<usize> = (0..k).collect();
-    let mut cols_left: Vec<usize> = (0..k).collect();
+    let order = singleton_rows(k, entry);
     let mut nonzero = vec![vec![true; width]; k];
-    let mut peeled: Vec<usize> = Vec::new();
-    while let Some((at, col)) = rows_left.iter().enumerate().find_map(|(at, &i)| {
-        let mut found = cols_left.iter().filter(|&&j| entry(i, j));
-        match (found.next(), found.next()) {
-            (Some(&j), None) => Some((at, j)),
-            _ => None,
-        }
-    }) {
-        let row = rows_left.remove(at);
-        cols_left.retain(|&j| j != col);
+    for (t, &(row, col)) in order.peeled.iter().enumerate() {
         for c in 0..width {
             nonzero[col][c] = !g.is_zero(r[(row, c)])
-                || peeled.iter().any(|&jj| entry(row, jj) && nonzero[jj][c]);
+                || order.peeled[..t]
+                    .iter()
+                    .any(|&(_, jj)| entry(row, jj) && nonzero[jj][c]);
         }
-        peeled.push(col);
     }
+    let (rows_left, cols_left) = (&order.rows_left, &order.cols_left);
+    let peeled: Vec<usize> = order.peeled.iter().map(|&(_, j)| j).collect();
     for c in 0..width {
         let block = rows_left.iter().any(|&row| {
             !g.is_zero(r[(row, c)]) || peeled.iter().any(|&jj| entry(row, jj) && nonzero[jj][c])
         });
-        for &j in &cols_left {
+        for &j in cols_left {
             nonzero[j][c] = block;
         }
     }

@@ -13,7 +13,7 @@ use std::str::FromStr;
 use appell_symbolic::{EmitOptions, Id, Program, RustCode, Symbol, SymbolKind};
 use proc_macro2::TokenStream;
 
-use crate::derivation::{Derivation, Elimination, RowSource};
+use crate::derivation::{singleton_rows, Derivation, Elimination, RowSource, SingletonOrder};
 
 const P: &str = "::appell::__private";
 
@@ -354,20 +354,11 @@ impl Emitter<'_> {
         // so there is nothing for pivoting to protect); LU with partial
         // pivoting takes the rest.
         let entry = |i: usize, j: usize| !d.model.g.is_zero(ne.dp[i * m + j]);
-        let mut rows_left: Vec<usize> = (0..m).collect();
-        let mut cols_left: Vec<usize> = (0..m).collect();
-        let mut peeled: Vec<(usize, usize)> = Vec::new();
-        while let Some((at, col)) = rows_left.iter().enumerate().find_map(|(at, &i)| {
-            let mut found = cols_left.iter().filter(|&&j| entry(i, j));
-            match (found.next(), found.next()) {
-                (Some(&j), None) => Some((at, j)),
-                _ => None,
-            }
-        }) {
-            let row = rows_left.remove(at);
-            cols_left.retain(|&j| j != col);
-            peeled.push((row, col));
-        }
+        let SingletonOrder {
+            peeled,
+            rows_left,
+            cols_left,
+        } = singleton_rows(m, entry);
         let b = rows_left.len();
         let mut s = String::new();
         indent(&mut s, c.stages.first().map_or(&[], |v| v.as_slice()));
@@ -382,17 +373,19 @@ impl Emitter<'_> {
                 .sum()
         };
         let substitute_ops = |n: usize, k: usize| n + k * (2 * n * n - n);
+        // Factored in place when no row is peeled; read only otherwise.
+        let mutable = if peeled.is_empty() { "mut " } else { "" };
+        let _ = writeln!(
+            s,
+            "        let {mutable}__s: [[__T; {m}]; {m}] = [{}];",
+            matrix(0, m)
+        );
+        let _ = writeln!(
+            s,
+            "        let {mutable}__x0: [[__T; {width}]; {m}] = [{}];",
+            matrix(m * m, width)
+        );
         if peeled.is_empty() {
-            let _ = writeln!(
-                s,
-                "        let mut __s: [[__T; {m}]; {m}] = [{}];",
-                matrix(0, m)
-            );
-            let _ = writeln!(
-                s,
-                "        let mut __x0: [[__T; {width}]; {m}] = [{}];",
-                matrix(m * m, width)
-            );
             let _ = writeln!(
                 s,
                 "        let __swaps = {P}::lu_factor(&mut __s, {P}::max_abs(&__x0))?;"
@@ -415,16 +408,6 @@ impl Emitter<'_> {
             }
             solve_ops += factor_ops(m) + substitute_ops(m, width) + substitute_ops(m, 1);
         } else {
-            let _ = writeln!(
-                s,
-                "        let __s: [[__T; {m}]; {m}] = [{}];",
-                matrix(0, m)
-            );
-            let _ = writeln!(
-                s,
-                "        let __x0: [[__T; {width}]; {m}] = [{}];",
-                matrix(m * m, width)
-            );
             let _ = writeln!(
                 s,
                 "        let __scale = {P}::constraint_scale(&__s, {P}::max_abs(&__x0))?;"

@@ -46,6 +46,21 @@ pub enum Inst {
 }
 
 impl Inst {
+    /// The same instruction with each operand `x` replaced by `r(x)`.
+    fn remap(self, r: impl Fn(u32) -> u32) -> Inst {
+        match self {
+            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
+            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
+            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
+            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
+            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+            Inst::Neg(a) => Inst::Neg(r(a)),
+            Inst::Powi(a, e) => Inst::Powi(r(a), e),
+            Inst::Call(f, a) => Inst::Call(f, r(a)),
+            leaf => leaf,
+        }
+    }
+
     fn operands(&self) -> Vec<u32> {
         match *self {
             Inst::Const(_) | Inst::Symbol(_) => vec![],
@@ -633,50 +648,30 @@ fn share_reciprocals(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32
     if uses.iter().all(|&u| u < 2) {
         return (insts, outputs);
     }
-    let mut out: Vec<Inst> = Vec::with_capacity(insts.len() + 8);
-    let mut map = vec![0u32; insts.len()];
     let mut recip: BTreeMap<u32, u32> = BTreeMap::new();
     let mut one: Option<u32> = None;
-    for (i, inst) in insts.into_iter().enumerate() {
-        let r = |x: u32| map[x as usize];
-        let new = match inst {
-            Inst::Div(a, d) if uses[d as usize] >= 2 => {
-                let nd = r(d);
-                let rec = match recip.get(&nd) {
-                    Some(&x) => x,
-                    None => {
-                        let o = match one {
-                            Some(o) => o,
-                            None => {
-                                out.push(Inst::Const(Number::ONE));
-                                let o = (out.len() - 1) as u32;
-                                one = Some(o);
-                                o
-                            }
-                        };
-                        out.push(Inst::Div(o, nd));
-                        let x = (out.len() - 1) as u32;
-                        recip.insert(nd, x);
-                        x
-                    }
-                };
-                Inst::Mul(r(a), rec)
+    rewrite(insts, outputs, |_, inst, out, map| {
+        let Inst::Div(a, d) = *inst else { return None };
+        if uses[d as usize] < 2 {
+            return None;
+        }
+        let nd = map[d as usize];
+        let rec = match recip.get(&nd) {
+            Some(&x) => x,
+            None => {
+                let o = *one.get_or_insert_with(|| {
+                    out.push(Inst::Const(Number::ONE));
+                    (out.len() - 1) as u32
+                });
+                out.push(Inst::Div(o, nd));
+                let x = (out.len() - 1) as u32;
+                recip.insert(nd, x);
+                x
             }
-            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
-            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
-            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
-            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
-            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
-            Inst::Neg(a) => Inst::Neg(r(a)),
-            Inst::Powi(a, e) => Inst::Powi(r(a), e),
-            Inst::Call(f, a) => Inst::Call(f, r(a)),
-            leaf => leaf,
         };
-        out.push(new);
-        map[i] = (out.len() - 1) as u32;
-    }
-    let outputs = outputs.iter().map(|&o| map[o as usize]).collect();
-    (out, outputs)
+        out.push(Inst::Mul(map[a as usize], rec));
+        Some((out.len() - 1) as u32)
+    })
 }
 
 /// Products that share two factors share their product
@@ -689,24 +684,8 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
     let n = insts.len();
     // Parameter-only values are hoisted: they stay whole, and the
     // parameter-only factors of a product stay one (hoisted) product.
-    let mut parameter_only: Vec<bool> = Vec::with_capacity(n);
-    for inst in &insts {
-        let p = match inst {
-            Inst::Const(_) => true,
-            Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
-            other => other.operands().iter().all(|&o| parameter_only[o as usize]),
-        };
-        parameter_only.push(p);
-    }
-    let mut uses = vec![0u32; n];
-    for inst in &insts {
-        for o in inst.operands() {
-            uses[o as usize] += 1;
-        }
-    }
-    for &o in &outputs {
-        uses[o as usize] += 1;
-    }
+    let parameter_only = parameter_only_flags(graph, &insts);
+    let uses = use_counts(&insts, &outputs);
     let is_mul = |i: u32| matches!(insts[i as usize], Inst::Mul(..));
     // Interior: a multiplication used once, by a multiplication.
     let mut interior = vec![false; n];
@@ -764,25 +743,16 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
         *list = rest;
     }
     loop {
-        let mut counts: FxHashMap<(u32, u32), usize> = FxHashMap::default();
-        for list in leaves.iter().filter(|l| l.len() >= 2) {
-            let mut seen: Vec<(u32, u32)> = Vec::new();
+        let best = most_shared(leaves.iter().map(|list| {
+            let mut seen = Vec::new();
             for x in 0..list.len() {
                 for y in x + 1..list.len() {
                     seen.push((list[x], list[y]));
                 }
             }
-            seen.sort_unstable();
-            seen.dedup();
-            for p in seen {
-                *counts.entry(p).or_insert(0) += 1;
-            }
-        }
-        let best = counts
-            .into_iter()
-            .filter(|&(_, c)| c >= 2)
-            .max_by_key(|&(p, c)| (c, std::cmp::Reverse(p)));
-        let Some(((a, b), _)) = best else { break };
+            seen
+        }));
+        let Some((a, b)) = best else { break };
         let id = (n + pairs.len()) as u32;
         pairs.push((a, b));
         for list in leaves.iter_mut() {
@@ -811,8 +781,6 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
     // Rebuild: each root becomes the chain over its remaining factors; a
     // shared pair is emitted where first needed.
     let root_of: FxHashMap<u32, usize> = roots.iter().enumerate().map(|(k, &r)| (r, k)).collect();
-    let mut out: Vec<Inst> = Vec::with_capacity(n + pairs.len());
-    let mut map = vec![u32::MAX; n];
     let mut pair_at: Vec<Option<u32>> = vec![None; pairs.len()];
     fn leaf(
         x: u32,
@@ -837,12 +805,11 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
         pair_at[k] = Some(at);
         at
     }
-    for (i, inst) in insts.into_iter().enumerate() {
+    rewrite(insts, outputs, |i, _, out, map| {
         if let Some(&k) = root_of.get(&(i as u32)) {
-            let list = leaves[k].clone();
             let mut acc: Option<u32> = None;
-            for x in list {
-                let v = leaf(x, n, &map, &pairs, &mut pair_at, &mut out);
+            for &x in &leaves[k] {
+                let v = leaf(x, n, map, &pairs, &mut pair_at, out);
                 acc = Some(match acc {
                     None => v,
                     Some(a) => {
@@ -851,32 +818,15 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
                     }
                 });
             }
-            map[i] = acc.expect("a product has factors");
-            continue;
+            return Some(acc.expect("a product has factors"));
         }
-        if interior[i] {
-            // Never read: its tree's root reads the leaves directly.
+        // An interior multiplication is never read: its tree's root reads
+        // the leaves directly.
+        interior[i].then(|| {
             out.push(Inst::Const(Number::ZERO));
-            map[i] = (out.len() - 1) as u32;
-            continue;
-        }
-        let r = |x: u32| map[x as usize];
-        let new = match inst {
-            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
-            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
-            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
-            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
-            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
-            Inst::Neg(a) => Inst::Neg(r(a)),
-            Inst::Powi(a, e) => Inst::Powi(r(a), e),
-            Inst::Call(f, a) => Inst::Call(f, r(a)),
-            leaf => leaf,
-        };
-        out.push(new);
-        map[i] = (out.len() - 1) as u32;
-    }
-    let outputs = outputs.iter().map(|&o| map[o as usize]).collect();
-    (out, outputs)
+            (out.len() - 1) as u32
+        })
+    })
 }
 
 /// Sums that share two terms share their sum (`a + b + c, a + b − d →
@@ -886,24 +836,8 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
 /// operation, greedily, while some pair is found in two trees or more.
 fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
     let n = insts.len();
-    let mut parameter_only: Vec<bool> = Vec::with_capacity(n);
-    for inst in &insts {
-        let p = match inst {
-            Inst::Const(_) => true,
-            Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
-            other => other.operands().iter().all(|&o| parameter_only[o as usize]),
-        };
-        parameter_only.push(p);
-    }
-    let mut uses = vec![0u32; n];
-    for inst in &insts {
-        for o in inst.operands() {
-            uses[o as usize] += 1;
-        }
-    }
-    for &o in &outputs {
-        uses[o as usize] += 1;
-    }
+    let parameter_only = parameter_only_flags(graph, &insts);
+    let uses = use_counts(&insts, &outputs);
     let is_sum = |i: u32| matches!(insts[i as usize], Inst::Add(..) | Inst::Sub(..));
     // Interior: an addition, subtraction or negation used once, by an
     // addition or subtraction (a negated term is a subtracted one).
@@ -965,9 +899,8 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
     // a ± b, entering a tree with a's sign.
     let mut pairs: Vec<(u32, u32, bool)> = Vec::new();
     loop {
-        let mut counts: FxHashMap<(u32, u32, bool), usize> = FxHashMap::default();
-        for list in terms.iter().filter(|l| l.len() >= 2) {
-            let mut seen: Vec<(u32, u32, bool)> = Vec::new();
+        let best = most_shared(terms.iter().map(|list| {
+            let mut seen = Vec::new();
             for x in 0..list.len() {
                 for y in x + 1..list.len() {
                     let ((a, na), (b, nb)) = (list[x], list[y]);
@@ -976,19 +909,9 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
                     }
                 }
             }
-            seen.sort_unstable();
-            seen.dedup();
-            for p in seen {
-                *counts.entry(p).or_insert(0) += 1;
-            }
-        }
-        let best = counts
-            .into_iter()
-            .filter(|&(_, c)| c >= 2)
-            .max_by_key(|&(p, c)| (c, std::cmp::Reverse(p)));
-        let Some(((a, b, opposite), _)) = best else {
-            break;
-        };
+            seen
+        }));
+        let Some((a, b, opposite)) = best else { break };
         let id = (n + pairs.len()) as u32;
         pairs.push((a, b, opposite));
         for list in terms.iter_mut().filter(|l| l.len() >= 2) {
@@ -1013,8 +936,6 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
         return (insts, outputs);
     }
     let root_of: FxHashMap<u32, usize> = roots.iter().enumerate().map(|(k, &r)| (r, k)).collect();
-    let mut out: Vec<Inst> = Vec::with_capacity(n + pairs.len());
-    let mut map = vec![u32::MAX; n];
     let mut pair_at: Vec<Option<u32>> = vec![None; pairs.len()];
     fn term(
         x: u32,
@@ -1043,69 +964,122 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
         pair_at[k] = Some(at);
         at
     }
-    for (i, inst) in insts.into_iter().enumerate() {
-        if let Some(&k) = root_of.get(&(i as u32)) {
-            let list = terms[k].clone();
-            let mut pos = Vec::new();
-            let mut neg = Vec::new();
-            for (x, negated) in list {
-                let v = term(x, n, &map, &pairs, &mut pair_at, &mut out);
-                if negated {
-                    neg.push(v);
-                } else {
-                    pos.push(v);
-                }
-            }
-            if pos.is_empty() && neg.is_empty() {
+    rewrite(insts, outputs, |i, _, out, map| {
+        let Some(&k) = root_of.get(&(i as u32)) else {
+            // An interior term is never read: its tree's root reads the
+            // terms directly.
+            return interior[i].then(|| {
                 out.push(Inst::Const(Number::ZERO));
-                map[i] = (out.len() - 1) as u32;
-                continue;
-            }
-            let mut acc = match pos.first() {
-                Some(&first) => first,
-                None => {
-                    // −(a − b) is b − a.
-                    let first = neg.remove(0);
-                    out.push(match out[first as usize] {
-                        Inst::Sub(a, b) => Inst::Sub(b, a),
-                        _ => Inst::Neg(first),
-                    });
-                    (out.len() - 1) as u32
-                }
-            };
-            for &v in pos.iter().skip(1) {
-                out.push(Inst::Add(acc.min(v), acc.max(v)));
-                acc = (out.len() - 1) as u32;
-            }
-            for v in neg {
-                out.push(Inst::Sub(acc, v));
-                acc = (out.len() - 1) as u32;
-            }
-            map[i] = acc;
-            continue;
-        }
-        if interior[i] {
-            out.push(Inst::Const(Number::ZERO));
-            map[i] = (out.len() - 1) as u32;
-            continue;
-        }
-        let r = |x: u32| map[x as usize];
-        let new = match inst {
-            Inst::Add(a, b) => Inst::Add(r(a), r(b)),
-            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
-            Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
-            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
-            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
-            Inst::Neg(a) => Inst::Neg(r(a)),
-            Inst::Powi(a, e) => Inst::Powi(r(a), e),
-            Inst::Call(f, a) => Inst::Call(f, r(a)),
-            leaf => leaf,
+                (out.len() - 1) as u32
+            });
         };
-        out.push(new);
-        map[i] = (out.len() - 1) as u32;
+        let mut pos = Vec::new();
+        let mut neg = Vec::new();
+        for &(x, negated) in &terms[k] {
+            let v = term(x, n, map, &pairs, &mut pair_at, out);
+            if negated {
+                neg.push(v);
+            } else {
+                pos.push(v);
+            }
+        }
+        if pos.is_empty() && neg.is_empty() {
+            out.push(Inst::Const(Number::ZERO));
+            return Some((out.len() - 1) as u32);
+        }
+        let mut acc = match pos.first() {
+            Some(&first) => first,
+            None => {
+                // −(a − b) is b − a.
+                let first = neg.remove(0);
+                out.push(match out[first as usize] {
+                    Inst::Sub(a, b) => Inst::Sub(b, a),
+                    _ => Inst::Neg(first),
+                });
+                (out.len() - 1) as u32
+            }
+        };
+        for &v in pos.iter().skip(1) {
+            out.push(Inst::Add(acc.min(v), acc.max(v)));
+            acc = (out.len() - 1) as u32;
+        }
+        for v in neg {
+            out.push(Inst::Sub(acc, v));
+            acc = (out.len() - 1) as u32;
+        }
+        Some(acc)
+    })
+}
+
+/// Rewrites a program instruction by instruction: `special(i, inst, out,
+/// map)` may emit instruction i's replacement into `out` (`map` gives the
+/// new index of every earlier instruction) and return its index; else the
+/// instruction is copied with its operands renumbered.
+fn rewrite(
+    insts: Vec<Inst>,
+    outputs: Vec<u32>,
+    mut special: impl FnMut(usize, &Inst, &mut Vec<Inst>, &[u32]) -> Option<u32>,
+) -> (Vec<Inst>, Vec<u32>) {
+    let mut out: Vec<Inst> = Vec::with_capacity(insts.len() + 8);
+    let mut map = vec![u32::MAX; insts.len()];
+    for (i, inst) in insts.into_iter().enumerate() {
+        let at = match special(i, &inst, &mut out, &map) {
+            Some(at) => at,
+            None => {
+                out.push(inst.remap(|x| map[x as usize]));
+                (out.len() - 1) as u32
+            }
+        };
+        map[i] = at;
     }
     let outputs = outputs.iter().map(|&o| map[o as usize]).collect();
     (out, outputs)
+}
+
+/// The pair found in the most trees (each tree lists its pairs), if some
+/// pair is found in two or more; ties go to the smallest pair.
+fn most_shared<K: Copy + Ord + std::hash::Hash>(trees: impl Iterator<Item = Vec<K>>) -> Option<K> {
+    let mut counts: FxHashMap<K, usize> = FxHashMap::default();
+    for mut seen in trees {
+        seen.sort_unstable();
+        seen.dedup();
+        for p in seen {
+            *counts.entry(p).or_insert(0) += 1;
+        }
+    }
+    counts
+        .into_iter()
+        .filter(|&(_, c)| c >= 2)
+        .max_by_key(|&(p, c)| (c, std::cmp::Reverse(p)))
+        .map(|(p, _)| p)
+}
+
+/// Whether each instruction depends on parameters (and constants) only.
+fn parameter_only_flags(graph: &Graph, insts: &[Inst]) -> Vec<bool> {
+    let mut flags: Vec<bool> = Vec::with_capacity(insts.len());
+    for inst in insts {
+        let p = match inst {
+            Inst::Const(_) => true,
+            Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
+            other => other.operands().iter().all(|&o| flags[o as usize]),
+        };
+        flags.push(p);
+    }
+    flags
+}
+
+/// How many instructions (and outputs) read each instruction.
+fn use_counts(insts: &[Inst], outputs: &[u32]) -> Vec<u32> {
+    let mut uses = vec![0u32; insts.len()];
+    for inst in insts {
+        for o in inst.operands() {
+            uses[o as usize] += 1;
+        }
+    }
+    for &o in outputs {
+        uses[o as usize] += 1;
+    }
+    uses
 }
 
 /// Keeps only the instructions the outputs need, once each, renumbered in
@@ -1189,22 +1163,8 @@ impl Program {
         let (insts, outputs) = prune(insts, outputs);
         let (insts, outputs) = share_sums(graph, insts, outputs);
         let (insts, outputs) = prune(insts, outputs);
-        let mut parameter_only = Vec::with_capacity(insts.len());
-        let mut uses = vec![0u32; insts.len()];
-        for inst in &insts {
-            let p = match inst {
-                Inst::Const(_) => true,
-                Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
-                other => other.operands().iter().all(|&o| parameter_only[o as usize]),
-            };
-            parameter_only.push(p);
-            for o in inst.operands() {
-                uses[o as usize] += 1;
-            }
-        }
-        for &o in &outputs {
-            uses[o as usize] += 1;
-        }
+        let parameter_only = parameter_only_flags(graph, &insts);
+        let uses = use_counts(&insts, &outputs);
         Program {
             insts,
             outputs,
