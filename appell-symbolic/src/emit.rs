@@ -742,8 +742,11 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
         rest.sort_unstable();
         *list = rest;
     }
-    loop {
-        let best = most_shared(leaves.iter().map(|list| {
+    let first = n + pairs.len();
+    let shared = share_pairs(
+        &mut leaves,
+        first,
+        |list| {
             let mut seen = Vec::new();
             for x in 0..list.len() {
                 for y in x + 1..list.len() {
@@ -751,13 +754,10 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
                 }
             }
             seen
-        }));
-        let Some((a, b)) = best else { break };
-        let id = (n + pairs.len()) as u32;
-        pairs.push((a, b));
-        for list in leaves.iter_mut() {
+        },
+        |list, (a, b), id| {
             let Some(ia) = list.iter().position(|&x| x == a) else {
-                continue;
+                return false;
             };
             let ib = if a == b {
                 list.iter()
@@ -767,14 +767,16 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
             } else {
                 list.iter().position(|&x| x == b)
             };
-            let Some(ib) = ib else { continue };
+            let Some(ib) = ib else { return false };
             let (hi, lo) = (ia.max(ib), ia.min(ib));
             list.remove(hi);
             list.remove(lo);
             list.push(id);
             list.sort_unstable();
-        }
-    }
+            true
+        },
+    );
+    pairs.extend(shared);
     if pairs.is_empty() {
         return (insts, outputs);
     }
@@ -897,9 +899,10 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
     }
     // A pair (a, b, b negated relative to a), a < b; the shared value is
     // a ± b, entering a tree with a's sign.
-    let mut pairs: Vec<(u32, u32, bool)> = Vec::new();
-    loop {
-        let best = most_shared(terms.iter().map(|list| {
+    let pairs: Vec<(u32, u32, bool)> = share_pairs(
+        &mut terms,
+        n,
+        |list| {
             let mut seen = Vec::new();
             for x in 0..list.len() {
                 for y in x + 1..list.len() {
@@ -910,28 +913,26 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
                 }
             }
             seen
-        }));
-        let Some((a, b, opposite)) = best else { break };
-        let id = (n + pairs.len()) as u32;
-        pairs.push((a, b, opposite));
-        for list in terms.iter_mut().filter(|l| l.len() >= 2) {
+        },
+        |list, (a, b, opposite), id| {
             let Some(ia) = list.iter().position(|&(x, _)| x == a) else {
-                continue;
+                return false;
             };
             let na = list[ia].1;
             let Some(ib) = list
                 .iter()
                 .position(|&(x, nb)| x == b && (na != nb) == opposite)
             else {
-                continue;
+                return false;
             };
             let (hi, lo) = (ia.max(ib), ia.min(ib));
             list.remove(hi);
             list.remove(lo);
             list.push((id, na));
             list.sort_unstable();
-        }
-    }
+            true
+        },
+    );
     if pairs.is_empty() && !cancelled {
         return (insts, outputs);
     }
@@ -1036,22 +1037,81 @@ fn rewrite(
     (out, outputs)
 }
 
-/// The pair found in the most trees (each tree lists its pairs), if some
-/// pair is found in two or more; ties go to the smallest pair.
-fn most_shared<K: Copy + Ord + std::hash::Hash>(trees: impl Iterator<Item = Vec<K>>) -> Option<K> {
-    let mut counts: FxHashMap<K, usize> = FxHashMap::default();
-    for mut seen in trees {
-        seen.sort_unstable();
-        seen.dedup();
-        for p in seen {
+/// Greedy sharing of pairs over trees (each a list of items): while some
+/// pair is found in two trees or more, the pair found in the most trees
+/// (ties: the smallest) becomes a new item, numbered `first` + its index,
+/// in every tree that holds it. `pairs_of` lists a tree's pairs and
+/// `replace` puts the new item in place of one occurrence of a pair
+/// (false if the tree has none). Counts are kept up to date incrementally:
+/// only the trees that held the chosen pair are read again. Returns the
+/// pairs in the order chosen.
+fn share_pairs<I, P: Copy + Ord + std::hash::Hash>(
+    trees: &mut [Vec<I>],
+    first: usize,
+    pairs_of: impl Fn(&[I]) -> Vec<P>,
+    mut replace: impl FnMut(&mut Vec<I>, P, u32) -> bool,
+) -> Vec<P> {
+    use std::cmp::Reverse;
+    use std::collections::BinaryHeap;
+    let distinct = |tree: &[I]| {
+        let mut ps = pairs_of(tree);
+        ps.sort_unstable();
+        ps.dedup();
+        ps
+    };
+    let mut counts: FxHashMap<P, usize> = FxHashMap::default();
+    let mut holders: FxHashMap<P, Vec<usize>> = FxHashMap::default();
+    let mut held: Vec<Vec<P>> = Vec::with_capacity(trees.len());
+    for (t, tree) in trees.iter().enumerate() {
+        let ps = distinct(tree);
+        for &p in &ps {
             *counts.entry(p).or_insert(0) += 1;
+            holders.entry(p).or_default().push(t);
+        }
+        held.push(ps);
+    }
+    // Largest count first, then the smallest pair; an entry whose count is
+    // no longer the pair's is stale and skipped.
+    let mut heap: BinaryHeap<(usize, Reverse<P>)> = counts
+        .iter()
+        .filter(|&(_, &c)| c >= 2)
+        .map(|(&p, &c)| (c, Reverse(p)))
+        .collect();
+    let mut chosen = Vec::new();
+    while let Some((c, Reverse(p))) = heap.pop() {
+        if counts.get(&p) != Some(&c) {
+            continue;
+        }
+        let id = (first + chosen.len()) as u32;
+        chosen.push(p);
+        let mut list = holders.remove(&p).unwrap_or_default();
+        list.sort_unstable();
+        list.dedup();
+        for t in list {
+            if held[t].binary_search(&p).is_err() {
+                continue;
+            }
+            for q in std::mem::take(&mut held[t]) {
+                let c = counts.get_mut(&q).expect("a counted pair");
+                *c -= 1;
+                if *c >= 2 {
+                    heap.push((*c, Reverse(q)));
+                }
+            }
+            replace(&mut trees[t], p, id);
+            let ps = distinct(&trees[t]);
+            for &q in &ps {
+                let c = counts.entry(q).or_insert(0);
+                *c += 1;
+                if *c >= 2 {
+                    heap.push((*c, Reverse(q)));
+                }
+                holders.entry(q).or_default().push(t);
+            }
+            held[t] = ps;
         }
     }
-    counts
-        .into_iter()
-        .filter(|&(_, c)| c >= 2)
-        .max_by_key(|&(p, c)| (c, std::cmp::Reverse(p)))
-        .map(|(p, _)| p)
+    chosen
 }
 
 /// Whether each instruction depends on parameters (and constants) only.
