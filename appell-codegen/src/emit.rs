@@ -373,119 +373,94 @@ impl Emitter<'_> {
                 .sum()
         };
         let substitute_ops = |n: usize, k: usize| n + k * (2 * n * n - n);
-        // Factored in place when no row is peeled; read only otherwise.
-        let mutable = if peeled.is_empty() { "mut " } else { "" };
         let _ = writeln!(
             s,
-            "        let {mutable}__s: [[__T; {m}]; {m}] = [{}];",
+            "        let __s: [[__T; {m}]; {m}] = [{}];",
             matrix(0, m)
         );
         let _ = writeln!(
             s,
-            "        let {mutable}__x0: [[__T; {width}]; {m}] = [{}];",
+            "        let __x0: [[__T; {width}]; {m}] = [{}];",
             matrix(m * m, width)
         );
-        if peeled.is_empty() {
+        let _ = writeln!(
+            s,
+            "        let __scale = {P}::constraint_scale(&__s, {P}::max_abs(&__x0))?;"
+        );
+        for (t, &(i, j)) in peeled.iter().enumerate() {
+            let _ = writeln!(s, "        {P}::check_pivot(__s[{i}][{j}], __scale, {j})?;");
             let _ = writeln!(
                 s,
-                "        let __swaps = {P}::lu_factor(&mut __s, {P}::max_abs(&__x0))?;"
+                "        let __inv_{t} = <__T as {P}::Scalar>::one() / __s[{i}][{j}];"
             );
-            let _ = writeln!(s, "        {P}::lu_substitute(&__s, &__swaps, &mut __x0);");
-            for i in 0..m {
-                for (k, j) in cols.iter().enumerate() {
-                    let _ = writeln!(s, "        let __x_{i}_{j} = __x0[{i}][{k}];");
-                }
-            }
-            indent(&mut s, c.stages.get(1).map_or(&[], |v| v.as_slice()));
-            let _ = writeln!(
-                s,
-                "        let mut __x1: [[__T; 1]; {m}] = [{}];",
-                matrix(m * m + m * width, 1)
-            );
-            let _ = writeln!(s, "        {P}::lu_substitute(&__s, &__swaps, &mut __x1);");
-            for i in 0..m {
-                let _ = writeln!(s, "        let __w_{i} = __x1[{i}][0];");
-            }
-            solve_ops += factor_ops(m) + substitute_ops(m, width) + substitute_ops(m, 1);
-        } else {
-            let _ = writeln!(
-                s,
-                "        let __scale = {P}::constraint_scale(&__s, {P}::max_abs(&__x0))?;"
-            );
+            solve_ops += 1;
+        }
+        // Right sides `rhs` (an array of `w` columns); `name(j, k)` is
+        // the solved unknown j's value in column k.
+        let solve = |s: &mut String,
+                     ops: &mut usize,
+                     rhs: &str,
+                     w: usize,
+                     name: &dyn Fn(usize, usize) -> String,
+                     factor: bool| {
             for (t, &(i, j)) in peeled.iter().enumerate() {
-                let _ = writeln!(s, "        {P}::check_pivot(__s[{i}][{j}], __scale, {j})?;");
-                let _ = writeln!(
-                    s,
-                    "        let __inv_{t} = <__T as {P}::Scalar>::one() / __s[{i}][{j}];"
-                );
-                solve_ops += 1;
-            }
-            // Right sides `rhs` (an array of `w` columns); `name(j, k)` is
-            // the solved unknown j's value in column k.
-            let solve = |s: &mut String,
-                         ops: &mut usize,
-                         rhs: &str,
-                         w: usize,
-                         name: &dyn Fn(usize, usize) -> String,
-                         factor: bool| {
-                for (t, &(i, j)) in peeled.iter().enumerate() {
-                    for k in 0..w {
-                        let mut e = format!("{rhs}[{i}][{k}]");
-                        for &(_, jj) in &peeled[..t] {
-                            if entry(i, jj) {
-                                e = format!("{e} - __s[{i}][{jj}] * {}", name(jj, k));
-                                *ops += 2;
-                            }
+                for k in 0..w {
+                    let mut e = format!("{rhs}[{i}][{k}]");
+                    for &(_, jj) in &peeled[..t] {
+                        if entry(i, jj) {
+                            e = format!("{e} - __s[{i}][{jj}] * {}", name(jj, k));
+                            *ops += 2;
                         }
-                        let _ = writeln!(s, "        let {} = ({e}) * __inv_{t};", name(j, k));
-                        *ops += 1;
                     }
+                    let _ = writeln!(s, "        let {} = ({e}) * __inv_{t};", name(j, k));
+                    *ops += 1;
                 }
-                if b == 0 {
-                    return;
-                }
-                let rows: Vec<String> = rows_left
+            }
+            if b == 0 {
+                return;
+            }
+            let rows: Vec<String> = rows_left
+                .iter()
+                .map(|&r| {
+                    let row: Vec<String> = (0..w)
+                        .map(|k| {
+                            let mut e = format!("{rhs}[{r}][{k}]");
+                            for &(_, jj) in &peeled {
+                                if entry(r, jj) {
+                                    e = format!("{e} - __s[{r}][{jj}] * {}", name(jj, k));
+                                    *ops += 2;
+                                }
+                            }
+                            e
+                        })
+                        .collect();
+                    format!("[{}]", row.join(", "))
+                })
+                .collect();
+            let _ = writeln!(
+                s,
+                "        let mut {rhs}b: [[__T; {w}]; {b}] = [{}];",
+                rows.join(", ")
+            );
+            if factor {
+                let block: Vec<String> = rows_left
                     .iter()
                     .map(|&r| {
-                        let row: Vec<String> = (0..w)
-                            .map(|k| {
-                                let mut e = format!("{rhs}[{r}][{k}]");
-                                for &(_, jj) in &peeled {
-                                    if entry(r, jj) {
-                                        e = format!("{e} - __s[{r}][{jj}] * {}", name(jj, k));
-                                        *ops += 2;
-                                    }
-                                }
-                                e
-                            })
+                        let row: Vec<String> = cols_left
+                            .iter()
+                            .map(|&c| format!("__s[{r}][{c}]"))
                             .collect();
                         format!("[{}]", row.join(", "))
                     })
                     .collect();
+                let columns: Vec<String> = cols_left.iter().map(|c| c.to_string()).collect();
                 let _ = writeln!(
                     s,
-                    "        let mut {rhs}b: [[__T; {w}]; {b}] = [{}];",
-                    rows.join(", ")
+                    "        let mut __sb: [[__T; {b}]; {b}] = [{}];",
+                    block.join(", ")
                 );
-                if factor {
-                    let block: Vec<String> = rows_left
-                        .iter()
-                        .map(|&r| {
-                            let row: Vec<String> = cols_left
-                                .iter()
-                                .map(|&c| format!("__s[{r}][{c}]"))
-                                .collect();
-                            format!("[{}]", row.join(", "))
-                        })
-                        .collect();
-                    let columns: Vec<String> = cols_left.iter().map(|c| c.to_string()).collect();
-                    let _ = writeln!(
-                        s,
-                        "        let mut __sb: [[__T; {b}]; {b}] = [{}];",
-                        block.join(", ")
-                    );
-                    // The block's column numbers are S's.
-                    let _ = writeln!(
+                // The block's column numbers are S's.
+                let _ = writeln!(
                         s,
                         "        let __swaps = match {P}::lu_factor(&mut __sb, __scale) {{ \
                          Ok(swaps) => swaps, \
@@ -494,30 +469,29 @@ impl Emitter<'_> {
                          Err(e) => return Err(e) }};",
                         columns.join(", ")
                     );
-                    *ops += factor_ops(b);
-                }
-                let _ = writeln!(
-                    s,
-                    "        {P}::lu_substitute(&__sb, &__swaps, &mut {rhs}b);"
-                );
-                *ops += substitute_ops(b, w);
-                for (q, &c) in cols_left.iter().enumerate() {
-                    for k in 0..w {
-                        let _ = writeln!(s, "        let {} = {rhs}b[{q}][{k}];", name(c, k));
-                    }
-                }
-            };
-            let x_name = |j: usize, k: usize| format!("__x_{j}_{}", cols[k]);
-            solve(&mut s, &mut solve_ops, "__x0", width, &x_name, true);
-            indent(&mut s, c.stages.get(1).map_or(&[], |v| v.as_slice()));
+                *ops += factor_ops(b);
+            }
             let _ = writeln!(
                 s,
-                "        let __x1: [[__T; 1]; {m}] = [{}];",
-                matrix(m * m + m * width, 1)
+                "        {P}::lu_substitute(&__sb, &__swaps, &mut {rhs}b);"
             );
-            let w_name = |j: usize, _k: usize| format!("__w_{j}");
-            solve(&mut s, &mut solve_ops, "__x1", 1, &w_name, false);
-        }
+            *ops += substitute_ops(b, w);
+            for (q, &c) in cols_left.iter().enumerate() {
+                for k in 0..w {
+                    let _ = writeln!(s, "        let {} = {rhs}b[{q}][{k}];", name(c, k));
+                }
+            }
+        };
+        let x_name = |j: usize, k: usize| format!("__x_{j}_{}", cols[k]);
+        solve(&mut s, &mut solve_ops, "__x0", width, &x_name, true);
+        indent(&mut s, c.stages.get(1).map_or(&[], |v| v.as_slice()));
+        let _ = writeln!(
+            s,
+            "        let __x1: [[__T; 1]; {m}] = [{}];",
+            matrix(m * m + m * width, 1)
+        );
+        let w_name = |j: usize, _k: usize| format!("__w_{j}");
+        solve(&mut s, &mut solve_ops, "__x1", 1, &w_name, false);
         indent(&mut s, c.stages.get(2).map_or(&[], |v| v.as_slice()));
         c.body.clear();
         (c, s, solve_ops)
