@@ -135,7 +135,8 @@ pub struct Derivation {
     pub raw_elimination: Elimination,
     /// The inertial part of f, per speed (for scenes).
     pub inertial_terms: Vec<Vec<Id>>,
-    /// Each load's part of f, per speed, with its effect (for scenes).
+    /// Each effect's part of f, per speed (its loads summed and expanded
+    /// together; for scenes).
     pub load_terms: Vec<(String, Vec<Id>)>,
     /// The power of each input-dependent load, with its effect (for scenes).
     pub power_terms: Vec<(String, Id)>,
@@ -1211,20 +1212,37 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 .map(|k| dot(g, f.vector, force_beta[fi][k]))
                 .collect::<Result<_, _>>()?,
         };
-        for k in 0..l {
-            forcing_terms[k].push(per_k[k]);
-        }
         load_terms.push((f.effect.clone(), per_k));
     }
     for (ti, t) in model.torques.iter().enumerate() {
         let per_k: Vec<Id> = (0..l)
             .map(|k| dot(g, t.vector, torque_gamma[ti][k]))
             .collect::<Result<_, _>>()?;
+        load_terms.push((t.effect.clone(), per_k));
+    }
+    // One sum per effect, expanded on its own: the loads of one effect
+    // can cancel in part (a torque and its reaction on two bodies leave
+    // only the relative rotation's partial velocity).
+    let mut merged: Vec<(String, Vec<Id>)> = Vec::new();
+    for (effect, per_k) in load_terms {
+        match merged.iter_mut().find(|(e, _)| *e == effect) {
+            Some((_, sum)) => {
+                for (s, x) in sum.iter_mut().zip(per_k) {
+                    *s = g.add(*s, x)?;
+                }
+            }
+            None => merged.push((effect, per_k)),
+        }
+    }
+    for (_, per_k) in merged.iter_mut() {
+        for x in per_k.iter_mut() {
+            *x = expanded(g, *x)?;
+        }
         for k in 0..l {
             forcing_terms[k].push(per_k[k]);
         }
-        load_terms.push((t.effect.clone(), per_k));
     }
+    let mut load_terms = merged;
     for k in 0..l {
         for j in k..l {
             mass[k * l + j] = expanded(g, mass[k * l + j])?;
