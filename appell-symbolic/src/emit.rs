@@ -784,34 +784,13 @@ fn share_products(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<In
     // shared pair is emitted where first needed.
     let root_of: FxHashMap<u32, usize> = roots.iter().enumerate().map(|(k, &r)| (r, k)).collect();
     let mut pair_at: Vec<Option<u32>> = vec![None; pairs.len()];
-    fn leaf(
-        x: u32,
-        n: usize,
-        map: &[u32],
-        pairs: &[(u32, u32)],
-        pair_at: &mut [Option<u32>],
-        out: &mut Vec<Inst>,
-    ) -> u32 {
-        if (x as usize) < n {
-            return map[x as usize];
-        }
-        let k = x as usize - n;
-        if let Some(at) = pair_at[k] {
-            return at;
-        }
-        let (a, b) = pairs[k];
-        let a = leaf(a, n, map, pairs, pair_at, out);
-        let b = leaf(b, n, map, pairs, pair_at, out);
-        out.push(Inst::Mul(a.min(b), a.max(b)));
-        let at = (out.len() - 1) as u32;
-        pair_at[k] = Some(at);
-        at
-    }
     rewrite(insts, outputs, |i, _, out, map| {
         if let Some(&k) = root_of.get(&(i as u32)) {
             let mut acc: Option<u32> = None;
             for &x in &leaves[k] {
-                let v = leaf(x, n, map, &pairs, &mut pair_at, out);
+                let v = shared_value(x, n, map, &pairs, &mut pair_at, out, &|(_, _), a, b| {
+                    Inst::Mul(a.min(b), a.max(b))
+                });
                 acc = Some(match acc {
                     None => v,
                     Some(a) => {
@@ -938,33 +917,6 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
     }
     let root_of: FxHashMap<u32, usize> = roots.iter().enumerate().map(|(k, &r)| (r, k)).collect();
     let mut pair_at: Vec<Option<u32>> = vec![None; pairs.len()];
-    fn term(
-        x: u32,
-        n: usize,
-        map: &[u32],
-        pairs: &[(u32, u32, bool)],
-        pair_at: &mut [Option<u32>],
-        out: &mut Vec<Inst>,
-    ) -> u32 {
-        if (x as usize) < n {
-            return map[x as usize];
-        }
-        let k = x as usize - n;
-        if let Some(at) = pair_at[k] {
-            return at;
-        }
-        let (a, b, opposite) = pairs[k];
-        let a = term(a, n, map, pairs, pair_at, out);
-        let b = term(b, n, map, pairs, pair_at, out);
-        out.push(if opposite {
-            Inst::Sub(a, b)
-        } else {
-            Inst::Add(a.min(b), a.max(b))
-        });
-        let at = (out.len() - 1) as u32;
-        pair_at[k] = Some(at);
-        at
-    }
     rewrite(insts, outputs, |i, _, out, map| {
         let Some(&k) = root_of.get(&(i as u32)) else {
             // An interior term is never read: its tree's root reads the
@@ -977,7 +929,21 @@ fn share_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>,
         let mut pos = Vec::new();
         let mut neg = Vec::new();
         for &(x, negated) in &terms[k] {
-            let v = term(x, n, map, &pairs, &mut pair_at, out);
+            let v = shared_value(
+                x,
+                n,
+                map,
+                &pairs,
+                &mut pair_at,
+                out,
+                &|(_, _, opposite), a, b| {
+                    if opposite {
+                        Inst::Sub(a, b)
+                    } else {
+                        Inst::Add(a.min(b), a.max(b))
+                    }
+                },
+            );
             if negated {
                 neg.push(v);
             } else {
@@ -1114,6 +1080,51 @@ fn share_pairs<I, P: Copy + Ord + std::hash::Hash>(
     chosen
 }
 
+/// The instruction holding item `x` of [`share_pairs`]: an original
+/// instruction's new index (`map`), or a shared pair's value, emitted into
+/// `out` by `make(pair, a, b)` from its two items where first needed.
+fn shared_value<P: Copy + PairItems>(
+    x: u32,
+    n: usize,
+    map: &[u32],
+    pairs: &[P],
+    pair_at: &mut [Option<u32>],
+    out: &mut Vec<Inst>,
+    make: &dyn Fn(P, u32, u32) -> Inst,
+) -> u32 {
+    if (x as usize) < n {
+        return map[x as usize];
+    }
+    let k = x as usize - n;
+    if let Some(at) = pair_at[k] {
+        return at;
+    }
+    let (a, b) = pairs[k].items();
+    let a = shared_value(a, n, map, pairs, pair_at, out, make);
+    let b = shared_value(b, n, map, pairs, pair_at, out, make);
+    out.push(make(pairs[k], a, b));
+    let at = (out.len() - 1) as u32;
+    pair_at[k] = Some(at);
+    at
+}
+
+/// The two items a shared pair combines.
+trait PairItems {
+    fn items(&self) -> (u32, u32);
+}
+
+impl PairItems for (u32, u32) {
+    fn items(&self) -> (u32, u32) {
+        *self
+    }
+}
+
+impl PairItems for (u32, u32, bool) {
+    fn items(&self) -> (u32, u32) {
+        (self.0, self.1)
+    }
+}
+
 /// Whether each instruction depends on parameters (and constants) only.
 fn parameter_only_flags(graph: &Graph, insts: &[Inst]) -> Vec<bool> {
     let mut flags: Vec<bool> = Vec::with_capacity(insts.len());
@@ -1164,16 +1175,11 @@ fn prune(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
             continue;
         }
         let r = |x: u32| renumber[x as usize];
-        let inst = match inst {
-            Inst::Add(a, b) => Inst::Add(r(a).min(r(b)), r(a).max(r(b))),
-            Inst::Sub(a, b) => Inst::Sub(r(a), r(b)),
-            Inst::Mul(a, b) => Inst::Mul(r(a).min(r(b)), r(a).max(r(b))),
-            Inst::Div(a, b) => Inst::Div(r(a), r(b)),
-            Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
-            Inst::Neg(a) => Inst::Neg(r(a)),
-            Inst::Powi(a, e) => Inst::Powi(r(a), e),
-            Inst::Call(f, a) => Inst::Call(f, r(a)),
-            leaf => leaf,
+        // Commutative operands in order, so equal instructions are equal.
+        let inst = match inst.remap(r) {
+            Inst::Add(a, b) => Inst::Add(a.min(b), a.max(b)),
+            Inst::Mul(a, b) => Inst::Mul(a.min(b), a.max(b)),
+            other => other,
         };
         // The same instruction twice (a product rebuilt from shared
         // factors) is kept once.
