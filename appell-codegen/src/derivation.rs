@@ -1215,9 +1215,15 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         load_terms.push((f.effect.clone(), per_k));
     }
     for (ti, t) in model.torques.iter().enumerate() {
-        let per_k: Vec<Id> = (0..l)
-            .map(|k| dot(g, t.vector, torque_gamma[ti][k]))
-            .collect::<Result<_, _>>()?;
+        let rot = model.frames[t.frame].rot;
+        let vector = mat_t_vec(g, &rot, t.vector)?;
+        let vector = expanded3(g, vector)?;
+        let mut per_k = Vec::with_capacity(l);
+        for k in 0..l {
+            let gamma = mat_t_vec(g, &rot, torque_gamma[ti][k])?;
+            let gamma = expanded3(g, gamma)?;
+            per_k.push(dot(g, vector, gamma)?);
+        }
         load_terms.push((t.effect.clone(), per_k));
     }
     // One sum per effect, expanded on its own: the loads of one effect

@@ -397,20 +397,36 @@ impl Emitter<'_> {
         }
         // Right sides `rhs` (an array of `w` columns); `name(j, k)` is
         // the solved unknown j's value in column k.
+        // `zero(i, k)`: the right side's entry is identically zero. An
+        // unknown solved from zeros alone is zero and costs nothing, and
+        // no update multiplies by it.
         let solve = |s: &mut String,
                      ops: &mut usize,
                      rhs: &str,
                      w: usize,
                      name: &dyn Fn(usize, usize) -> String,
+                     zero: &dyn Fn(usize, usize) -> bool,
                      factor: bool| {
+            let mut vanishing = std::collections::HashSet::new();
             for (t, &(i, j)) in peeled.iter().enumerate() {
                 for k in 0..w {
                     let mut e = format!("{rhs}[{i}][{k}]");
+                    let mut terms = 0;
                     for &(_, jj) in &peeled[..t] {
-                        if entry(i, jj) {
+                        if entry(i, jj) && !vanishing.contains(&(jj, k)) {
                             e = format!("{e} - __s[{i}][{jj}] * {}", name(jj, k));
                             *ops += 2;
+                            terms += 1;
                         }
+                    }
+                    if terms == 0 && zero(i, k) {
+                        vanishing.insert((j, k));
+                        let _ = writeln!(
+                            s,
+                            "        let {} = <__T as {P}::Scalar>::zero();",
+                            name(j, k)
+                        );
+                        continue;
                     }
                     let _ = writeln!(s, "        let {} = ({e}) * __inv_{t};", name(j, k));
                     *ops += 1;
@@ -426,7 +442,7 @@ impl Emitter<'_> {
                         .map(|k| {
                             let mut e = format!("{rhs}[{r}][{k}]");
                             for &(_, jj) in &peeled {
-                                if entry(r, jj) {
+                                if entry(r, jj) && !vanishing.contains(&(jj, k)) {
                                     e = format!("{e} - __s[{r}][{jj}] * {}", name(jj, k));
                                     *ops += 2;
                                 }
@@ -483,7 +499,16 @@ impl Emitter<'_> {
             }
         };
         let x_name = |j: usize, k: usize| format!("__x_{j}_{}", cols[k]);
-        solve(&mut s, &mut solve_ops, "__x0", width, &x_name, true);
+        let rhs_zero = |i: usize, k: usize| d.model.g.is_zero(ne.rhs[i * (l + 1) + cols[k]]);
+        solve(
+            &mut s,
+            &mut solve_ops,
+            "__x0",
+            width,
+            &x_name,
+            &rhs_zero,
+            true,
+        );
         indent(&mut s, c.stages.get(1).map_or(&[], |v| v.as_slice()));
         let _ = writeln!(
             s,
@@ -491,7 +516,15 @@ impl Emitter<'_> {
             matrix(m * m + m * width, 1)
         );
         let w_name = |j: usize, _k: usize| format!("__w_{j}");
-        solve(&mut s, &mut solve_ops, "__x1", 1, &w_name, false);
+        solve(
+            &mut s,
+            &mut solve_ops,
+            "__x1",
+            1,
+            &w_name,
+            &|_, _| false,
+            false,
+        );
         indent(&mut s, c.stages.get(2).map_or(&[], |v| v.as_slice()));
         c.body.clear();
         (c, s, solve_ops)
@@ -524,11 +557,13 @@ impl Emitter<'_> {
                 )
             }
         );
+        // `__e_i_j` = l_ij d_j, kept before the division: each update is then
+        // one product, l_ik (l_jk d_k) = l_ik e_jk.
         for j in 0..l {
             let mut e = format!("__m_{j}_{j}");
             for k in 0..j {
-                e.push_str(&format!(" - __l_{j}_{k} * __l_{j}_{k} * __d_{k}"));
-                ops += 3;
+                e.push_str(&format!(" - __l_{j}_{k} * __e_{j}_{k}"));
+                ops += 2;
             }
             let _ = writeln!(s, "        let __d_{j} = {e};");
             if checks {
@@ -537,10 +572,11 @@ impl Emitter<'_> {
             for i in j + 1..l {
                 let mut e = format!("__m_{i}_{j}");
                 for k in 0..j {
-                    e.push_str(&format!(" - __l_{i}_{k} * __l_{j}_{k} * __d_{k}"));
-                    ops += 3;
+                    e.push_str(&format!(" - __l_{i}_{k} * __e_{j}_{k}"));
+                    ops += 2;
                 }
-                let _ = writeln!(s, "        let __l_{i}_{j} = ({e}) / __d_{j};");
+                let _ = writeln!(s, "        let __e_{i}_{j} = {e};");
+                let _ = writeln!(s, "        let __l_{i}_{j} = __e_{i}_{j} / __d_{j};");
                 ops += 1;
             }
         }

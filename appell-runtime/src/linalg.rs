@@ -48,6 +48,7 @@ pub fn lu_solve<T: Scalar, const N: usize, const M: usize>(
 /// use appell_runtime::linalg::max_abs;
 /// assert_eq!(max_abs(&[[1.0, -3.0], [f64::NAN, 2.0]]), 3.0);
 /// ```
+#[inline]
 pub fn max_abs<T: Scalar, const N: usize, const M: usize>(b: &[[T; M]; N]) -> f64 {
     let mut scale = 0.0f64;
     for row in b.iter() {
@@ -72,6 +73,7 @@ pub fn max_abs<T: Scalar, const N: usize, const M: usize>(b: &[[T; M]; N]) -> f6
 /// assert_eq!(constraint_scale(&[[1.0]], 7.0), Ok(7.0));
 /// assert!(constraint_scale(&[[f64::NAN]], 1.0).is_err());
 /// ```
+#[inline]
 pub fn constraint_scale<T: Scalar, const N: usize, const M: usize>(
     a: &[[T; M]; N],
     rhs_scale: f64,
@@ -107,6 +109,7 @@ pub fn constraint_scale<T: Scalar, const N: usize, const M: usize>(
 /// assert!(check_pivot(1e-13, 1.0, 2).is_err());
 /// assert!(check_pivot(0.0, 0.0, 0).is_err());
 /// ```
+#[inline]
 pub fn check_pivot<T: Scalar>(pivot: T, scale: f64, column: usize) -> Result<(), ModelError> {
     let v = pivot.re().abs();
     if v <= 1e-12 * scale || v == 0.0 || v.is_nan() {
@@ -134,6 +137,7 @@ pub fn check_pivot<T: Scalar>(pivot: T, scale: f64, column: usize) -> Result<(),
 /// assert_eq!(c, [[1.0], [1.0]]);
 /// assert!(lu_factor(&mut [[1.0, 2.0], [2.0, 4.0]], 1.0).is_err());
 /// ```
+#[inline]
 pub fn lu_factor<T: Scalar, const N: usize>(
     a: &mut [[T; N]; N],
     rhs_scale: f64,
@@ -180,6 +184,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
 /// lu_substitute(&a, &swaps, &mut b);
 /// assert_eq!(b, [[2.0, 1.0], [1.0, 3.0]]);
 /// ```
+#[inline]
 pub fn lu_substitute<T: Scalar, const N: usize, const M: usize>(
     a: &[[T; N]; N],
     swaps: &[usize; N],
