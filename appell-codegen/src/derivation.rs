@@ -250,6 +250,12 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     // (row, its tokens, holonomic, the same row before expansion)
     let mut rows: Vec<(Id, proc_macro2::TokenStream, bool, Id)> = Vec::new();
     let mut origins: Vec<RowSource> = Vec::new();
+    // For a rolling row (or a holonomic row found equal to one): the contact
+    // and the row's direction (the twin's), so that its rate can be taken
+    // as (rate of the material velocity)·e when that velocity vanishes.
+    let mut forms: Vec<Option<(usize, Vec3)>> = Vec::new();
+    let mut contact_velocity: Vec<Vec3> = Vec::new();
+    let mut complete: Vec<bool> = Vec::new();
     let mut holonomic = Vec::new();
     for (index, c) in model.holonomic.iter().enumerate() {
         holonomic.push(c.residual);
@@ -276,6 +282,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         match (model.g.time_derivative(c.residual, &rules), raw) {
             (Ok(r), Ok(raw)) => {
                 rows.push((r, c.at.clone(), true, raw));
+                forms.push(None);
                 origins.push(RowSource::Holonomic(index));
             }
             (Err(e), _) | (_, Err(e)) => cx.error_spanned_by(&c.at, e),
@@ -286,6 +293,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             .as_ref()
             .map_or(c.residual, |t| t.nonholonomic[index].residual);
         rows.push((c.residual, c.at.clone(), false, raw));
+        forms.push(None);
         origins.push(RowSource::Nonholonomic(index));
     }
     // Rolling: v(material point at P) = v(centre) + ω × (P − centre) = 0.
@@ -312,21 +320,59 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             None => v.to_vec(),
         };
         // The same rows as written (not multiplied out), from the twin.
-        let raw: Vec<Id> = match (&twin, &twin_rules) {
+        // The material point's velocity as written (the twin's), and the
+        // directions it is constrained along.
+        let (raw_v, raw_dirs): (Vec<Id>, Vec<Vec3>) = match (&twin, &twin_rules) {
             (Some(t), Some(tr)) => {
                 let tb = &t.bodies[r.body];
                 let tr_roll = &t.rolling[contact];
-                rolling_components(
+                let v = rolling_components(
                     g,
                     tb.center,
                     t.frames[tb.frame.expect("rigid")].omega,
                     tr_roll.contact,
-                    tr_roll.along.as_deref(),
+                    None,
                     tr,
-                )?
+                )?;
+                (v, tr_roll.along.clone().unwrap_or_default())
             }
-            _ => rolling_components(g, body.center, omega, r.contact, r.along.as_deref(), &rules)?,
+            _ => (
+                rolling_components(g, body.center, omega, r.contact, None, &rules)?,
+                r.along.clone().unwrap_or_default(),
+            ),
         };
+        let raw_v = [raw_v[0], raw_v[1], raw_v[2]];
+        let (zero, one) = (g.int(0)?, g.int(1)?);
+        let raw_dirs: Vec<Vec3> = match r.along {
+            Some(_) => raw_dirs,
+            None => (0..3)
+                .map(|k| {
+                    let mut e = [zero; 3];
+                    e[k] = one;
+                    e
+                })
+                .collect(),
+        };
+        let mut raw = Vec::with_capacity(raw_dirs.len());
+        for e in &raw_dirs {
+            raw.push(dot(g, raw_v, *e)?);
+        }
+        // Every component of the material velocity vanishes on the
+        // constrained motion when the rows cover N, or when the component
+        // normal to two `along` directions is identically zero (the rear
+        // wheel's: its centre stays at height rr); `complete_normal` may
+        // find a holonomic row for it below.
+        contact_velocity.push(raw_v);
+        complete.push(match r.along.as_deref() {
+            None => true,
+            Some([d0, d1]) => {
+                let n = cross(g, *d0, *d1)?;
+                let c = dot(g, v, n)?;
+                let c = expanded(g, c)?;
+                g.is_zero(c)
+            }
+            Some(_) => false,
+        });
         let before = rows.len();
         for (k, (c, raw_c)) in components.into_iter().zip(raw).enumerate() {
             if g.is_zero(c) {
@@ -336,6 +382,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 continue;
             }
             rows.push((c, r.at.clone(), false, raw_c));
+            forms.push(Some((contact, raw_dirs[k])));
             origins.push(RowSource::Rolling {
                 contact,
                 direction: k,
@@ -345,12 +392,47 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             cx.error_spanned_by(&r.at, "this rolling contact constrains nothing: the contact point's velocity is identically zero");
         }
     }
+    // A holonomic row that is, identically, a rolling contact's material
+    // velocity along the normal of its two `along` directions (the
+    // bicycle's pitch constraint: the front contact's height rate is the
+    // vertical velocity of the wheel's material point there, since that
+    // point is the lowest of the rim) completes the contact.
+    for (row, form) in rows.iter().zip(forms.iter_mut()).filter(|(r, _)| r.2) {
+        for (contact, r) in model.rolling.iter().enumerate() {
+            let Some([d0, d1]) = r.along.as_deref() else {
+                continue;
+            };
+            if complete[contact] {
+                continue;
+            }
+            let g = &mut model.g;
+            let body = &model.bodies[r.body];
+            let omega = model.frames[body.frame.expect("rigid")].omega;
+            let normal = cross(g, *d0, *d1)?;
+            let candidate =
+                rolling_components(g, body.center, omega, r.contact, Some(&[normal]), &rules)?[0];
+            if same_function(g, row.0, candidate) != Some(true) {
+                continue;
+            }
+            let normal = match &twin {
+                Some(t) => match t.rolling[contact].along.as_deref() {
+                    Some([e0, e1]) => cross(g, *e0, *e1)?,
+                    _ => continue,
+                },
+                None => normal,
+            };
+            complete[contact] = true;
+            *form = Some((contact, normal));
+            break;
+        }
+    }
     let mut d_rows = Vec::new();
     let mut d0 = Vec::new();
     let mut row_sources = Vec::new();
     let mut kept_sources = Vec::new();
     let mut raw_rows = Vec::new();
-    for ((row, span, holo, raw_row), origin) in rows.iter().zip(&origins) {
+    let mut raw_forms = Vec::new();
+    for (index, ((row, span, holo, raw_row), origin)) in rows.iter().zip(&origins).enumerate() {
         let bad: Vec<String> = model
             .g
             .dependencies(*row)
@@ -382,6 +464,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 d_rows.extend(form.coefficients);
                 d0.push(form.remainder);
                 raw_rows.push(*raw_row);
+                raw_forms.push(forms[index]);
                 row_sources.push(span.clone());
                 kept_sources.push(*origin);
             }
@@ -768,8 +851,26 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             .collect::<Result<_, _>>()?;
         let mut raw_rates = Vec::new();
         if !row_ops.is_empty() {
-            for &row in &raw_rows {
-                let rate = g.time_derivative(row, &along_rates)?;
+            for (&row, form) in raw_rows.iter().zip(&raw_forms) {
+                // When the contact's material velocity v vanishes on the
+                // constrained motion, the rate of v·e is (rate of v)·e:
+                // the term v·ė is zero there, though only numerically once
+                // the dependent rates are X [ẏ; 1].
+                let rate = match form {
+                    Some((contact, e)) if complete[*contact] => {
+                        let v = contact_velocity[*contact];
+                        let mut terms = Vec::with_capacity(3);
+                        for i in 0..3 {
+                            if g.is_zero(e[i]) {
+                                continue;
+                            }
+                            let r = g.time_derivative(v[i], &along_rates)?;
+                            terms.push(g.mul(r, e[i])?);
+                        }
+                        g.sum(&terms)?
+                    }
+                    _ => g.time_derivative(row, &along_rates)?,
+                };
                 let rate = uncut.apply(g, rate)?;
                 raw_rates.push(fixed_rates.apply(g, rate)?);
             }
@@ -874,6 +975,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         };
     let mut body_terms = Vec::new();
     let mut rotations = Vec::new();
+    // ∂v/∂q̇_r of each body's mass centre.
+    let mut center_parts: Vec<Vec<Vec3>> = Vec::new();
     for b in &model.bodies {
         let mut v = [zero; 3];
         for i in 0..3 {
@@ -881,6 +984,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         }
         let (parts, rest) = raw_parts(g, v)?;
         let (beta, beta0) = through_c(g, &parts, rest)?;
+        center_parts.push(parts);
         let (gamma_b, omega_b, rotation) = match b.frame {
             Some(fi) => {
                 let frame = &model.frames[fi];
@@ -939,20 +1043,31 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         dependent_remainders.push((model.coords[d].1.rate, e));
     }
     // `v` is the twin's when there is one (see `uncut`).
+    // `parts`, when given, are the partial velocities ∂v/∂q̇_r already
+    // built for β̄ (the same values): the dependent rates' terms reuse them.
     let remainder = |g: &mut appell_symbolic::Graph,
                      fixed_rates: &mut Substitution,
                      uncut: &mut Substitution,
-                     v: Vec3|
+                     v: Vec3,
+                     parts: Option<&[Vec3]>|
      -> Result<Vec3, SymbolicError> {
         let mut out = [zero; 3];
         for i in 0..3 {
             let along = g.time_derivative(v[i], &along_rates)?;
             let along = uncut.apply(g, along)?;
             let mut terms = vec![fixed_rates.apply(g, along)?];
-            for &(rate, r) in &dependent_remainders {
-                let c = g.diff(v[i], rate)?;
-                let c = uncut.apply(g, c)?;
-                let c = fixed_rates.apply(g, c)?;
+            for (&(rate, r), &d) in dependent_remainders.iter().zip(&dependent) {
+                let c = match parts {
+                    Some(p) => p[d][i],
+                    None => {
+                        let c = g.diff(v[i], rate)?;
+                        let c = uncut.apply(g, c)?;
+                        fixed_rates.apply(g, c)?
+                    }
+                };
+                if g.is_zero(c) {
+                    continue;
+                }
                 terms.push(g.mul(c, r)?);
             }
             // Left factored: a remainder enters f only through dot products
@@ -971,7 +1086,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 let omega = twin
                     .as_ref()
                     .map_or(model.frames[f].omega, |t| t.frames[f].omega);
-                let alpha_n = remainder(g, &mut fixed_rates, &mut uncut, omega)?;
+                let alpha_n = remainder(g, &mut fixed_rates, &mut uncut, omega, None)?;
                 let alpha_b = mat_t_vec(g, rot, alpha_n)?;
                 Some(expanded3(g, alpha_b)?)
             }
@@ -1037,6 +1152,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     b.mass,
                     t.beta.clone(),
                     twin.as_ref().map_or(b.center, |t| t.bodies[bi].center),
+                    center_parts[bi].clone(),
                 )),
                 Composite::Leader {
                     mass: total,
@@ -1070,16 +1186,16 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                         }
                         None => *center,
                     };
-                    Some((*total, beta, twin_center))
+                    Some((*total, beta, twin_center, parts))
                 }
             };
-            if let Some((m_total, beta, center)) = &translational {
+            if let Some((m_total, beta, center, parts)) = &translational {
                 let center_rules = twin_rules.as_ref().unwrap_or(&rules);
                 let mut v = [zero; 3];
                 for i in 0..3 {
                     v[i] = g.time_derivative(center[i], center_rules)?;
                 }
-                let a_rem = remainder(g, &mut fixed_rates, &mut uncut, v)?;
+                let a_rem = remainder(g, &mut fixed_rates, &mut uncut, v, Some(parts))?;
                 for k in 0..l {
                     let ab = dot(g, a_rem, beta[k])?;
                     let inertial = g.mul(*m_total, ab)?;
@@ -1089,7 +1205,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             for k in 0..l {
                 for j in k..l {
                     let mut e = zero;
-                    if let Some((m_total, beta, _)) = &translational {
+                    if let Some((m_total, beta, _, _)) = &translational {
                         let bb = dot(g, beta[k], beta[j])?;
                         e = g.mul(*m_total, bb)?;
                     }
@@ -2112,6 +2228,24 @@ fn numerically_independent(
     true
 }
 
+/// Whether `a` and `b` are the same function: equal to 1e-10, relative, at
+/// three pseudo-random points (see [`pseudo_value`]) where they are not
+/// zero. `None` when some evaluation fails.
+fn same_function(g: &appell_symbolic::Graph, a: Id, b: Id) -> Option<bool> {
+    let tape = appell_symbolic::Tape::new(g, &[a, b]);
+    for trial in 0..3u64 {
+        let v = tape.eval(&|s| Some(pseudo_value(g, s, trial))).ok()?;
+        let (x, y) = (v[0], v[1]);
+        if !(x.is_finite() && y.is_finite()) {
+            return None;
+        }
+        if x.abs() < 1e-6 || (x - y).abs() > 1e-10 * x.abs().max(y.abs()) {
+            return Some(false);
+        }
+    }
+    Some(true)
+}
+
 /// The first row of D that is numerically a combination of the rows before
 /// it at every one of three pseudo-random configurations (parameters in
 /// [0.5, 1.5], coordinates and rates in [−1, 1]). A dependence that holds only
@@ -2310,6 +2444,20 @@ fn equations_text(d: &Derivation) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn same_function_sees_identities_the_expansion_does_not() {
+        let mut g = appell_symbolic::Graph::new();
+        g.coordinate("q").unwrap();
+        g.parameter("r").unwrap();
+        let a = g.parse("r*sin(q)^2 + r*cos(q)^2").unwrap();
+        let b = g.parse("r").unwrap();
+        let c = g.parse("r*sin(q)").unwrap();
+        assert_eq!(same_function(&g, a, b), Some(true));
+        assert_eq!(same_function(&g, a, c), Some(false));
+        let nan = g.parse("sqrt(-r)").unwrap();
+        assert_eq!(same_function(&g, nan, nan), None);
+    }
 
     #[test]
     fn structural_solution_follows_the_singleton_rows() {
