@@ -329,6 +329,10 @@ impl Lowering<'_> {
                         .map(|&(b, e)| (self.memo[&b], e < 0, !self.graph.is_parameter_only(b)))
                         .filter(|&(_, _, state)| state || params == 1),
                 );
+                // The merged parameter part too, when it is the only one.
+                if let (Some(x), 1) = (extra, params) {
+                    seen.push((*x, false, false));
+                }
                 seen[start..].sort_unstable();
                 let mut w = start;
                 for r in start..seen.len() {
@@ -360,9 +364,10 @@ impl Lowering<'_> {
                 let step = if inverse { 1 } else { -1 };
                 let memo = &self.memo;
                 let is_f = |b: Id, e: i32| memo[&b] == base && (e < 0) == inverse;
-                let (with, without): (Vec<_>, Vec<_>) = terms
-                    .drain(..)
-                    .partition(|(_, fs, _)| fs.iter().any(|&(b, e)| is_f(b, e)));
+                let (with, without): (Vec<_>, Vec<_>) =
+                    terms.drain(..).partition(|(_, fs, extra)| {
+                        fs.iter().any(|&(b, e)| is_f(b, e)) || (!inverse && *extra == Some(base))
+                    });
                 let reduced: Vec<Term> = with
                     .into_iter()
                     .map(|(k, fs, extra)| {
@@ -381,7 +386,9 @@ impl Lowering<'_> {
                                     r => Some((b, r)),
                                 }
                             })
-                            .collect();
+                            .collect::<Vec<_>>();
+                        // Else it is the merged parameter part.
+                        let extra = if done { extra } else { None };
                         (k, fs, extra)
                     })
                     .collect();
@@ -2143,6 +2150,18 @@ mod sharing_tests {
         // An output keeps its sign: nothing to absorb into.
         let (insts, _) = absorb_negations(vec![Symbol(x), Neg(0)], vec![1]);
         assert_eq!(insts[1], Neg(0));
+    }
+
+    #[test]
+    fn a_merged_parameter_part_shared_by_terms_is_taken_out() {
+        let mut g = Graph::new();
+        g.parameter("p").unwrap();
+        g.parameter("q").unwrap();
+        // (p + q)·sin x + (p + q)·cos y, each parameter sum merged from two
+        // terms: (p + q)·(sin x + cos y), the sum hoisted.
+        let p = check(&mut g, &["p*sin(x) + q*sin(x) + p*cos(y) + q*cos(y)"]);
+        let ops = p.op_count();
+        assert_eq!((ops.mul, ops.add), (1, 2), "{ops}");
     }
 
     #[test]
