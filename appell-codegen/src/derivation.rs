@@ -973,7 +973,12 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             let (parts, rest) = split_linear(g, v, &rates)?;
             Ok((parts, expanded3(g, rest)?))
         };
-    let mut body_terms = Vec::new();
+    let mut body_terms: Vec<BodyTerms> = Vec::new();
+    // Per body: (the earlier body whose frame it turns from, the direction
+    // cosines between the two frames, the relative angular velocity in its
+    // own frame) when its γ̄ were built from that body's.
+    #[allow(clippy::type_complexity)]
+    let mut relative_frames: Vec<Option<(usize, Mat3, Vec3)>> = Vec::new();
     let mut rotations = Vec::new();
     // ∂v/∂q̇_r of each body's mass centre.
     let mut center_parts: Vec<Vec<Vec3>> = Vec::new();
@@ -989,18 +994,103 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             Some(fi) => {
                 let frame = &model.frames[fi];
                 let rot = frame.rot;
-                let (parts, rest) = split_linear(g, frame.omega, &rates)?;
-                let parts = parts
-                    .iter()
-                    .map(|v| mat_t_vec(g, &rot, *v).and_then(|x| expanded3(g, x)))
-                    .collect::<Result<Vec<_>, _>>()?;
-                let rest = mat_t_vec(g, &rot, rest)?;
-                let rest = expanded3(g, rest)?;
-                let (gamma_b, gamma0_b) = through_c(g, &parts, rest)?;
-                let omega_b = combine(g, &gamma_b, gamma0_b, &speed_rates)?;
-                (gamma_b, omega_b, Some(rot))
+                // A frame turned from an earlier body's frame by a simple
+                // rotation (every direction cosine between them a single
+                // term) whose relative angular velocity has constant
+                // components: γ̄ in this frame is the earlier γ̄ rotated,
+                // plus the relative part, so the earlier body's values are
+                // reused instead of expanding the chain of rotations again.
+                let mut via = None;
+                let mut relative = None;
+                for (pb, pt) in body_terms.iter().enumerate() {
+                    let Some(pf) = model.bodies[pb].frame else {
+                        continue;
+                    };
+                    if pf == fi {
+                        continue;
+                    }
+                    let prot = model.frames[pf].rot;
+                    let mut rel = [[zero; 3]; 3];
+                    let mut simple = true;
+                    for i in 0..3 {
+                        for j in 0..3 {
+                            let d = dot(
+                                g,
+                                [rot[0][i], rot[1][i], rot[2][i]],
+                                [prot[0][j], prot[1][j], prot[2][j]],
+                            )?;
+                            rel[i][j] = expanded(g, d)?;
+                            if matches!(g.node(rel[i][j]), appell_symbolic::Node::Add { .. }) {
+                                simple = false;
+                            }
+                        }
+                    }
+                    if !simple {
+                        continue;
+                    }
+                    let mut dw = [zero; 3];
+                    for i in 0..3 {
+                        dw[i] = g.sub(frame.omega[i], model.frames[pf].omega[i])?;
+                    }
+                    let dw = mat_t_vec(g, &rot, dw)?;
+                    let dw = expanded3(g, dw)?;
+                    let (dparts, drest) = split_linear(g, dw, &rates)?;
+                    if !dparts
+                        .iter()
+                        .flatten()
+                        .chain(&drest)
+                        .all(|&c| g.is_parameter_only(c))
+                    {
+                        continue;
+                    }
+                    let (dgamma, dgamma0) = through_c(g, &dparts, drest)?;
+                    let mut gamma_b = vec![[zero; 3]; l];
+                    for k in 0..l {
+                        for i in 0..3 {
+                            let mut terms = vec![dgamma[k][i]];
+                            for j in 0..3 {
+                                if !g.is_zero(rel[i][j]) {
+                                    terms.push(g.mul(rel[i][j], pt.gamma_b[k][j])?);
+                                }
+                            }
+                            gamma_b[k][i] = g.sum(&terms)?;
+                        }
+                    }
+                    let domega = combine(g, &dgamma, dgamma0, &speed_rates)?;
+                    let mut omega_b = [zero; 3];
+                    for i in 0..3 {
+                        let mut terms = vec![domega[i]];
+                        for j in 0..3 {
+                            if !g.is_zero(rel[i][j]) {
+                                terms.push(g.mul(rel[i][j], pt.omega_b[j])?);
+                            }
+                        }
+                        omega_b[i] = g.sum(&terms)?;
+                    }
+                    via = Some((gamma_b, omega_b));
+                    relative = Some((pb, rel, dw));
+                    break;
+                }
+                relative_frames.push(relative);
+                if let Some((gamma_b, omega_b)) = via {
+                    (gamma_b, omega_b, Some(rot))
+                } else {
+                    let (parts, rest) = split_linear(g, frame.omega, &rates)?;
+                    let parts = parts
+                        .iter()
+                        .map(|v| mat_t_vec(g, &rot, *v).and_then(|x| expanded3(g, x)))
+                        .collect::<Result<Vec<_>, _>>()?;
+                    let rest = mat_t_vec(g, &rot, rest)?;
+                    let rest = expanded3(g, rest)?;
+                    let (gamma_b, gamma0_b) = through_c(g, &parts, rest)?;
+                    let omega_b = combine(g, &gamma_b, gamma0_b, &speed_rates)?;
+                    (gamma_b, omega_b, Some(rot))
+                }
             }
-            None => (vec![[zero; 3]; l], [zero; 3], None),
+            None => {
+                relative_frames.push(None);
+                (vec![[zero; 3]; l], [zero; 3], None)
+            }
         };
         body_terms.push(BodyTerms {
             beta,
@@ -1081,15 +1171,44 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     let mut alphas: Vec<Option<Vec3>> = Vec::new();
     for (bi, b) in model.bodies.iter().enumerate() {
         alphas.push(match &rotations[bi] {
-            Some(rot) => {
-                let f = b.frame.expect("rigid");
-                let omega = twin
-                    .as_ref()
-                    .map_or(model.frames[f].omega, |t| t.frames[f].omega);
-                let alpha_n = remainder(g, &mut fixed_rates, &mut uncut, omega, None)?;
-                let alpha_b = mat_t_vec(g, rot, alpha_n)?;
-                Some(expanded3(g, alpha_b)?)
-            }
+            Some(rot) => match &relative_frames[bi] {
+                Some((pb, rel, dw)) if alphas[*pb].is_some() => {
+                    // α = (the earlier body's α, turned) + ω × ω_rel + the
+                    // relative rates' own remainders (dependent ones).
+                    let parent = alphas[*pb].expect("rigid");
+                    let mut w_rel = [zero; 3];
+                    for i in 0..3 {
+                        w_rel[i] = fixed_rates.apply(g, dw[i])?;
+                    }
+                    let spin = cross(g, body_terms[bi].omega_b, w_rel)?;
+                    let mut alpha = [zero; 3];
+                    for i in 0..3 {
+                        let mut terms = vec![spin[i]];
+                        for j in 0..3 {
+                            if !g.is_zero(rel[i][j]) {
+                                terms.push(g.mul(rel[i][j], parent[j])?);
+                            }
+                        }
+                        for &(rate, r) in &dependent_remainders {
+                            let c = g.diff(dw[i], rate)?;
+                            if !g.is_zero(c) {
+                                terms.push(g.mul(c, r)?);
+                            }
+                        }
+                        alpha[i] = g.sum(&terms)?;
+                    }
+                    Some(alpha)
+                }
+                _ => {
+                    let f = b.frame.expect("rigid");
+                    let omega = twin
+                        .as_ref()
+                        .map_or(model.frames[f].omega, |t| t.frames[f].omega);
+                    let alpha_n = remainder(g, &mut fixed_rates, &mut uncut, omega, None)?;
+                    let alpha_b = mat_t_vec(g, rot, alpha_n)?;
+                    Some(expanded3(g, alpha_b)?)
+                }
+            },
             None => None,
         });
     }
