@@ -1017,7 +1017,8 @@ const MAX_SIGN_DEPTH: usize = 8;
 /// Absorbs negations into their readers: `x + (−a)` is `x − a`,
 /// `x − (−a)` is `x + a`, and a product, quotient or `(−a) − x` passes the
 /// sign on to its own readers (`(−a)·b` read by a sum is `− a·b` there).
-/// A `Neg` whose sign every reader can take this way disappears. IEEE
+/// A `Neg` whose sign every reader can take this way disappears, and so
+/// does `b − a` computed beside `a − b` (its negation). IEEE
 /// negation is exact and rounding is symmetric, so every value is the same
 /// bit for bit; only the work changes.
 fn absorb_negations(mut insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
@@ -1070,8 +1071,20 @@ fn absorb_negations(mut insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<
         true
     }
     let mut changed = false;
+    // b − a beside a − b is the negation of the latter.
+    let mut differences: FxHashMap<(u32, u32), u32> = FxHashMap::default();
     for i in 0..insts.len() {
-        let Inst::Neg(a) = insts[i] else { continue };
+        let a = match insts[i] {
+            Inst::Neg(a) => a,
+            Inst::Sub(x, y) => match differences.get(&(y, x)) {
+                Some(&d) => d,
+                None => {
+                    differences.insert((x, y), i as u32);
+                    continue;
+                }
+            },
+            _ => continue,
+        };
         let mut planned = FxHashMap::default();
         if !plan(i as u32, &insts, &readers, &output, 0, &mut planned) {
             continue;
@@ -2150,6 +2163,24 @@ mod sharing_tests {
         // An output keeps its sign: nothing to absorb into.
         let (insts, _) = absorb_negations(vec![Symbol(x), Neg(0)], vec![1]);
         assert_eq!(insts[1], Neg(0));
+        // w·(x − y) + z·(y − x): y − x is −(x − y), and the sum subtracts.
+        let insts = vec![
+            Symbol(x),
+            Symbol(y),
+            Symbol(z),
+            Symbol(w),
+            Sub(0, 1),
+            Mul(3, 4),
+            Sub(1, 0),
+            Mul(2, 6),
+            Add(5, 7),
+        ];
+        let before = program(insts.clone(), vec![8]);
+        let (insts, outputs) = absorb_negations(insts, vec![8]);
+        let after = program(insts, outputs);
+        assert_eq!(before.eval(&values(&g)), after.eval(&values(&g)));
+        let ops = after.op_count();
+        assert_eq!((ops.add, ops.mul), (2, 2), "{ops}");
     }
 
     #[test]
