@@ -364,15 +364,15 @@ impl Emitter<'_> {
         indent(&mut s, c.stages.first().map_or(&[], |v| v.as_slice()));
         let mut solve_ops = 0;
         // As `lu_factor` and `lu_substitute` count them: the factorization
-        // (a reciprocal per column, a multiplier and a multiply-subtract per
-        // entry below and right of the pivot), then n + k(2n² − n) for k
+        // (a reciprocal per column, kept, a multiplier and a multiply-subtract
+        // per entry below and right of the pivot), then k(2n² − n) for k
         // right-hand columns (X's, then w's).
         let factor_ops = |n: usize| -> usize {
             (0..n)
                 .map(|c| 1 + (n - c - 1) * (1 + 2 * (n - c - 1)))
                 .sum()
         };
-        let substitute_ops = |n: usize, k: usize| n + k * (2 * n * n - n);
+        let substitute_ops = |n: usize, k: usize| k * (2 * n * n - n);
         let _ = writeln!(
             s,
             "        let __s: [[__T; {m}]; {m}] = [{}];",

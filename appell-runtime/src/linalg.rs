@@ -119,7 +119,8 @@ pub fn check_pivot<T: Scalar>(pivot: T, scale: f64, column: usize) -> Result<(),
 }
 
 /// Factors `A` in place by LU with partial pivoting (the multipliers below
-/// the diagonal, U on and above it) and returns the row exchanges, so that
+/// the diagonal, U above it, and the reciprocals of U's pivots on it, so
+/// that no substitution divides again) and returns the row exchanges, so that
 /// several right sides can be solved with [`lu_substitute`], including
 /// right sides that depend on an earlier solution. A pivot smaller than
 /// `1e-12 ×` the largest magnitude among `A`'s entries and `rhs_scale` is
@@ -169,6 +170,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
                 a[r][j] -= f * t;
             }
         }
+        a[col][col] = inv;
     }
     Ok(swaps)
 }
@@ -207,7 +209,7 @@ pub fn lu_substitute<T: Scalar, const N: usize, const M: usize>(
         }
     }
     for col in (0..N).rev() {
-        let inv = T::one() / a[col][col];
+        let inv = a[col][col];
         for j in 0..M {
             let mut s = b[col][j];
             for k in col + 1..N {
