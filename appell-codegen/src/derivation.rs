@@ -360,8 +360,8 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         // Every component of the material velocity vanishes on the
         // constrained motion when the rows cover N, or when the component
         // normal to two `along` directions is identically zero (the rear
-        // wheel's: its centre stays at height rr); `complete_normal` may
-        // find a holonomic row for it below.
+        // wheel's: its centre stays at height rr); a holonomic row equal to
+        // that component may complete it below.
         contact_velocity.push(raw_v);
         complete.push(match r.along.as_deref() {
             None => true,
@@ -1009,40 +1009,10 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     if pf == fi {
                         continue;
                     }
-                    let prot = model.frames[pf].rot;
-                    let mut rel = [[zero; 3]; 3];
-                    let mut simple = true;
-                    for i in 0..3 {
-                        for j in 0..3 {
-                            let d = dot(
-                                g,
-                                [rot[0][i], rot[1][i], rot[2][i]],
-                                [prot[0][j], prot[1][j], prot[2][j]],
-                            )?;
-                            rel[i][j] = expanded(g, d)?;
-                            if matches!(g.node(rel[i][j]), appell_symbolic::Node::Add { .. }) {
-                                simple = false;
-                            }
-                        }
-                    }
-                    if !simple {
+                    let Some((rel, dw)) = simple_turn(g, frame, &model.frames[pf], &rates)? else {
                         continue;
-                    }
-                    let mut dw = [zero; 3];
-                    for i in 0..3 {
-                        dw[i] = g.sub(frame.omega[i], model.frames[pf].omega[i])?;
-                    }
-                    let dw = mat_t_vec(g, &rot, dw)?;
-                    let dw = expanded3(g, dw)?;
+                    };
                     let (dparts, drest) = split_linear(g, dw, &rates)?;
-                    if !dparts
-                        .iter()
-                        .flatten()
-                        .chain(&drest)
-                        .all(|&c| g.is_parameter_only(c))
-                    {
-                        continue;
-                    }
                     let (dgamma, dgamma0) = through_c(g, &dparts, drest)?;
                     let mut gamma_b = vec![[zero; 3]; l];
                     for k in 0..l {
@@ -2347,6 +2317,52 @@ fn numerically_independent(
     true
 }
 
+/// When `frame` is `parent` turned by a simple rotation: every direction
+/// cosine between the two is a single term (no sum), and the relative
+/// angular velocity, in `frame`'s components, is a combination of the
+/// coordinate rates with constant coefficients (the steer, a wheel's spin).
+/// Returns the direction cosines (`rel[i][j]` = frame axis i · parent axis
+/// j, so v_frame = rel · v_parent) and that relative angular velocity.
+fn simple_turn(
+    g: &mut appell_symbolic::Graph,
+    frame: &crate::model::Frame,
+    parent: &crate::model::Frame,
+    rates: &[Symbol],
+) -> Result<Option<(Mat3, Vec3)>, SymbolicError> {
+    let (rot, prot) = (frame.rot, parent.rot);
+    let zero = g.int(0)?;
+    let mut rel = [[zero; 3]; 3];
+    for i in 0..3 {
+        for j in 0..3 {
+            let d = dot(
+                g,
+                [rot[0][i], rot[1][i], rot[2][i]],
+                [prot[0][j], prot[1][j], prot[2][j]],
+            )?;
+            rel[i][j] = expanded(g, d)?;
+            if matches!(g.node(rel[i][j]), appell_symbolic::Node::Add { .. }) {
+                return Ok(None);
+            }
+        }
+    }
+    let mut dw = [zero; 3];
+    for i in 0..3 {
+        dw[i] = g.sub(frame.omega[i], parent.omega[i])?;
+    }
+    let dw = mat_t_vec(g, &rot, dw)?;
+    let dw = expanded3(g, dw)?;
+    let (parts, rest) = split_linear(g, dw, rates)?;
+    if !parts
+        .iter()
+        .flatten()
+        .chain(&rest)
+        .all(|&c| g.is_parameter_only(c))
+    {
+        return Ok(None);
+    }
+    Ok(Some((rel, dw)))
+}
+
 /// Whether `a` and `b` are the same function: equal to 1e-10, relative, at
 /// three pseudo-random points (see [`pseudo_value`]) where they are not
 /// zero. `None` when some evaluation fails.
@@ -2563,6 +2579,67 @@ fn equations_text(d: &Derivation) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn simple_turn_finds_a_rotation_about_a_parent_axis() {
+        let mut g = appell_symbolic::Graph::new();
+        let a = g.coordinate("a").unwrap();
+        let b = g.coordinate("b").unwrap();
+        let rates = [a.rate, b.rate];
+        let mut frame = |g: &mut appell_symbolic::Graph, rot: [[&str; 3]; 3], omega: [&str; 3]| {
+            crate::model::Frame {
+                name: String::new(),
+                rot: rot.map(|row| row.map(|e| g.parse(e).unwrap())),
+                omega: omega.map(|e| g.parse(e).unwrap()),
+            }
+        };
+        // P turns about N.z by a; F turns about P.z by b.
+        let p = frame(
+            &mut g,
+            [
+                ["cos(a)", "-sin(a)", "0"],
+                ["sin(a)", "cos(a)", "0"],
+                ["0", "0", "1"],
+            ],
+            ["0", "0", "a_dot"],
+        );
+        let f = frame(
+            &mut g,
+            [
+                [
+                    "cos(a)*cos(b) - sin(a)*sin(b)",
+                    "-cos(a)*sin(b) - sin(a)*cos(b)",
+                    "0",
+                ],
+                [
+                    "sin(a)*cos(b) + cos(a)*sin(b)",
+                    "cos(a)*cos(b) - sin(a)*sin(b)",
+                    "0",
+                ],
+                ["0", "0", "1"],
+            ],
+            ["0", "0", "a_dot + b_dot"],
+        );
+        let (rel, dw) = simple_turn(&mut g, &f, &p, &rates).unwrap().unwrap();
+        let expect = |g: &mut appell_symbolic::Graph, t: &str| g.parse(t).unwrap();
+        assert_eq!(rel[0][0], expect(&mut g, "cos(b)"));
+        assert_eq!(rel[0][1], expect(&mut g, "sin(b)"));
+        assert_eq!(rel[2][2], expect(&mut g, "1"));
+        let (zero, b_dot) = (g.int(0).unwrap(), g.sym(b.rate).unwrap());
+        assert_eq!(dw, [zero, zero, b_dot]);
+        // G turns about P.x by b: simple from P, not from F.
+        let h = frame(
+            &mut g,
+            [
+                ["cos(a)", "-sin(a)*cos(b)", "sin(a)*sin(b)"],
+                ["sin(a)", "cos(a)*cos(b)", "-cos(a)*sin(b)"],
+                ["0", "sin(b)", "cos(b)"],
+            ],
+            ["b_dot*cos(a)", "b_dot*sin(a)", "a_dot"],
+        );
+        assert!(simple_turn(&mut g, &h, &p, &rates).unwrap().is_some());
+        assert!(simple_turn(&mut g, &h, &f, &rates).unwrap().is_none());
+    }
 
     #[test]
     fn same_function_sees_identities_the_expansion_does_not() {
