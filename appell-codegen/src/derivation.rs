@@ -1014,29 +1014,11 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     };
                     let (dparts, drest) = split_linear(g, dw, &rates)?;
                     let (dgamma, dgamma0) = through_c(g, &dparts, drest)?;
-                    let mut gamma_b = vec![[zero; 3]; l];
-                    for k in 0..l {
-                        for i in 0..3 {
-                            let mut terms = vec![dgamma[k][i]];
-                            for j in 0..3 {
-                                if !g.is_zero(rel[i][j]) {
-                                    terms.push(g.mul(rel[i][j], pt.gamma_b[k][j])?);
-                                }
-                            }
-                            gamma_b[k][i] = g.sum(&terms)?;
-                        }
-                    }
+                    let gamma_b = (0..l)
+                        .map(|k| turned(g, &rel, pt.gamma_b[k], dgamma[k]))
+                        .collect::<Result<Vec<_>, _>>()?;
                     let domega = combine(g, &dgamma, dgamma0, &speed_rates)?;
-                    let mut omega_b = [zero; 3];
-                    for i in 0..3 {
-                        let mut terms = vec![domega[i]];
-                        for j in 0..3 {
-                            if !g.is_zero(rel[i][j]) {
-                                terms.push(g.mul(rel[i][j], pt.omega_b[j])?);
-                            }
-                        }
-                        omega_b[i] = g.sum(&terms)?;
-                    }
+                    let omega_b = turned(g, &rel, pt.omega_b, domega)?;
                     via = Some((gamma_b, omega_b));
                     relative = Some((pb, rel, dw));
                     break;
@@ -1151,14 +1133,9 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                         w_rel[i] = fixed_rates.apply(g, dw[i])?;
                     }
                     let spin = cross(g, body_terms[bi].omega_b, w_rel)?;
-                    let mut alpha = [zero; 3];
+                    let mut alpha = turned(g, rel, parent, spin)?;
                     for i in 0..3 {
-                        let mut terms = vec![spin[i]];
-                        for j in 0..3 {
-                            if !g.is_zero(rel[i][j]) {
-                                terms.push(g.mul(rel[i][j], parent[j])?);
-                            }
-                        }
+                        let mut terms = vec![alpha[i]];
                         for &(rate, r) in &dependent_remainders {
                             let c = g.diff(dw[i], rate)?;
                             if !g.is_zero(c) {
@@ -2315,6 +2292,27 @@ fn numerically_independent(
         }
     }
     true
+}
+
+/// `rel · v + plus`, componentwise, skipping the zero direction cosines
+/// (v and plus in the frames `rel` maps between; see [`simple_turn`]).
+fn turned(
+    g: &mut appell_symbolic::Graph,
+    rel: &Mat3,
+    v: Vec3,
+    plus: Vec3,
+) -> Result<Vec3, SymbolicError> {
+    let mut out = plus;
+    for i in 0..3 {
+        let mut terms = vec![plus[i]];
+        for j in 0..3 {
+            if !g.is_zero(rel[i][j]) {
+                terms.push(g.mul(rel[i][j], v[j])?);
+            }
+        }
+        out[i] = g.sum(&terms)?;
+    }
+    Ok(out)
 }
 
 /// When `frame` is `parent` turned by a simple rotation: every direction
