@@ -140,6 +140,15 @@ fn main() {
         let program = Program::lower(&g, &[e, dx]);
         let rust = program.to_rust(&g, &EmitOptions::default());
         code.push_str(&rust.function(&format!("joint_{k}"), "::appell_runtime::Scalar", &all));
+        let fused = program.to_rust(
+            &g,
+            &EmitOptions {
+                fused: true,
+                ..EmitOptions::default()
+            },
+        );
+        let fused_fn = fused.function(&format!("fused_{k}"), "::appell_runtime::Scalar", &all);
+        code.push_str(&fused_fn);
         code.push_str(&rust.split_functions(
             &format!("split_{k}"),
             "::appell_runtime::Scalar",
@@ -160,13 +169,14 @@ fn main() {
         }
         let _ = writeln!(
             table,
-            "    Case {{ text: {:?}, ops: {}, powi: {}, joint_f64: joint_{k}::<f64>, joint_f32: joint_{k}::<f32>, \
-             joint_dual: joint_{k}::<num_dual::Dual64>, \
+            "    Case {{ text: {:?}, ops: {}, powi: {}, fused_text: {}, joint_f64: joint_{k}::<f64>, joint_f32: joint_{k}::<f32>, \
+             joint_dual: joint_{k}::<num_dual::Dual64>, fused_f64: fused_{k}::<f64>, \
              split: |p, s| {{ let h = split_{k}_prepare::<f64>(p[0], p[1]); split_{k}(&h, p[0], p[1], s[0], s[1], s[2]) }}, \
              points: &[{points}] }},",
             g.display(e).to_string(),
             rust.ops.total() + rust.prepare_ops.total(),
             rust.ops.powi + rust.prepare_ops.powi > 0,
+            fused_fn.contains("fused_mul_add"),
         );
     }
     table.push_str("];\n");

@@ -25,6 +25,7 @@ fn options(hoist: bool) -> EmitOptions {
         hoist_parameters: hoist,
         symbol_text: Default::default(),
         symbol_stage: Default::default(),
+        fused: true,
     }
 }
 
@@ -36,6 +37,7 @@ fn f64_options() -> EmitOptions {
         hoist_parameters: false,
         symbol_text: Default::default(),
         symbol_stage: Default::default(),
+        fused: false,
     }
 }
 

@@ -1438,6 +1438,13 @@ pub struct EmitOptions {
     /// results are the symbols of the next stage) within one program that
     /// shares every common subexpression.
     pub symbol_stage: BTreeMap<Symbol, usize>,
+    /// Write a product that feeds a sum or a difference, and is not shared,
+    /// as `x.fused_mul_add(y, z)` (a method the scalar trait must provide,
+    /// equal to `x * y + z`): one instruction where the target fuses them.
+    /// A difference is written with the sign moved onto a factor or the
+    /// addend, which IEEE arithmetic gives exactly, so an unfused
+    /// `fused_mul_add` gives the same values as the plain text.
+    pub fused: bool,
 }
 
 impl Default for EmitOptions {
@@ -1449,6 +1456,7 @@ impl Default for EmitOptions {
             hoist_parameters: true,
             symbol_text: BTreeMap::new(),
             symbol_stage: BTreeMap::new(),
+            fused: false,
         }
     }
 }
@@ -1885,6 +1893,50 @@ impl<'a> Writer<'a> {
         }
     }
 
+    /// The factors of instruction `i` when it is a product written inline
+    /// (not bound), so a sum reading it can fuse it.
+    fn inline_product(&self, i: u32) -> Option<(u32, u32)> {
+        match self.p.insts[i as usize] {
+            Inst::Mul(a, b) if self.names[i as usize].is_none() => Some((a, b)),
+            _ => None,
+        }
+    }
+
+    /// `x.fused_mul_add(y, z)` for a sum or difference with an inline
+    /// product operand: a + x·y, x·y + b, a − x·y as (−x)·y + a, and
+    /// x·y − b as x·y + (−b).
+    fn fused_inline(&self, i: usize) -> Option<String> {
+        let atom = |j: u32| {
+            let (s, p) = self.expr(j as usize);
+            if p < Prec::Atom {
+                format!("({s})")
+            } else {
+                s
+            }
+        };
+        let arg = |j: u32| self.expr(j as usize).0;
+        let fused = |x: String, y: u32, z: String| format!("{x}.fused_mul_add({}, {z})", arg(y));
+        match self.p.insts[i] {
+            Inst::Add(a, b) => {
+                if let Some((x, y)) = self.inline_product(b) {
+                    Some(fused(atom(x), y, arg(a)))
+                } else {
+                    let (x, y) = self.inline_product(a)?;
+                    Some(fused(atom(x), y, arg(b)))
+                }
+            }
+            Inst::Sub(a, b) => {
+                if let Some((x, y)) = self.inline_product(b) {
+                    Some(fused(format!("(-{})", atom(x)), y, arg(a)))
+                } else {
+                    let (x, y) = self.inline_product(a)?;
+                    Some(fused(atom(x), y, format!("-{}", atom(b))))
+                }
+            }
+            _ => None,
+        }
+    }
+
     /// The text of instruction `i` itself.
     fn expr_inline(&self, i: usize) -> (String, Prec) {
         let wrap = |(s, p): (String, Prec), min: Prec| {
@@ -1901,6 +1953,11 @@ impl<'a> Writer<'a> {
                 s
             }
         };
+        if self.o.fused {
+            if let Some(text) = self.fused_inline(i) {
+                return (text, Prec::Atom);
+            }
+        }
         match self.p.insts[i] {
             Inst::Const(_) | Inst::Symbol(_) => self.expr(i),
             Inst::Add(a, b) => {

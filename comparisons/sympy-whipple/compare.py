@@ -2,9 +2,11 @@
 """Time SymPy's generated C rhs (at -O2 and -O3) and appell's generated Rust
 rhs alternately, so that all see the same machine load.
 
-Usage: python3 compare.py [rounds] [path/to/whipple_bicycle]
+Usage: python3 compare.py [rounds] [path/to/whipple_bicycle] [path/to/native/whipple_bicycle]
 The ratio reported is SymPy's ns per call over appell's (below 1: SymPy's C
-is faster).
+is faster). The optional third path is the same example built with
+RUSTFLAGS="-C target-cpu=native"; it is timed in the same rounds, and the
+native C variants are then also compared with it (ratio_native_*).
 
 Each round runs appell's `bench`, then the harness built three ways (-O2
 and -O3 with -march=native, -O2 for the generic x86-64 target), then
@@ -25,6 +27,7 @@ BUILD = os.path.join(HERE, "build")
 ROUNDS = int(sys.argv[1]) if len(sys.argv) > 1 else 9
 APPELL = sys.argv[2] if len(sys.argv) > 2 else os.path.join(
     HERE, "..", "..", "target", "release", "examples", "whipple_bicycle")
+APPELL_NATIVE = sys.argv[3] if len(sys.argv) > 3 else None
 
 # name -> compiler flags; "O2" and "O3" are with -march=native, "O2-generic"
 # targets the default x86-64 baseline (as the Rust build does without
@@ -41,8 +44,8 @@ for name, flags in VARIANTS.items():
     bins[name] = exe
 
 
-def appell_bench():
-    r = json.loads(subprocess.run([APPELL, "bench"], capture_output=True, text=True,
+def appell_bench(exe=APPELL):
+    r = json.loads(subprocess.run([exe, "bench"], capture_output=True, text=True,
                                   check=True).stdout)
     return r["rhs_ns"], r["ops"]
 
@@ -59,27 +62,37 @@ for k in range(ROUNDS):
     # appell, SymPy variants, appell, SymPy variants in reverse order: every
     # program is timed twice per round and keeps the faster of its two runs
     # (a run that overlaps a burst of other load is then discarded).
-    times = {"appell": []}
+    times = {"appell": [], "appell_native": []}
     for name in VARIANTS:
         times[name] = []
     for order in (list(VARIANTS), list(reversed(VARIANTS))):
         ns, appell_ops = appell_bench()
         times["appell"].append(ns)
+        if APPELL_NATIVE:
+            times["appell_native"].append(appell_bench(APPELL_NATIVE)[0])
         for name in order:
             times[name].append(sympy_bench(name))
     a = min(times["appell"])
     r = {"appell_ns": a, "appell_ns_runs": times["appell"]}
+    if APPELL_NATIVE:
+        r["appell_native_ns"] = min(times["appell_native"])
+        r["appell_native_ns_runs"] = times["appell_native"]
     for name in VARIANTS:
         ns = min(times[name])
         r[f"sympy_{name}_ns"] = ns
         r[f"sympy_{name}_ns_runs"] = times[name]
         r[f"ratio_{name}"] = ns / a
+        if APPELL_NATIVE and "march=native" in " ".join(VARIANTS[name]):
+            r[f"ratio_native_{name}"] = ns / r["appell_native_ns"]
     rounds.append(r)
-    print(f"round {k + 1}: appell {a:6.1f} ns; sympy "
+    native = f" (native {r['appell_native_ns']:6.1f} ns)" if APPELL_NATIVE else ""
+    print(f"round {k + 1}: appell {a:6.1f} ns{native}; sympy "
           + ", ".join(f"{name} {r[f'sympy_{name}_ns']:6.1f} ns ({r[f'ratio_{name}']:4.2f}x)"
                       for name in VARIANTS), flush=True)
 
 keys = ["appell_ns"] + [f"sympy_{n}_ns" for n in VARIANTS] + [f"ratio_{n}" for n in VARIANTS]
+if APPELL_NATIVE:
+    keys += ["appell_native_ns"] + [k for k in rounds[0] if k.startswith("ratio_native_")]
 med = {key: statistics.median(r[key] for r in rounds) for key in keys}
 derive = json.load(open(os.path.join(BUILD, "derive.json")))
 summary = {"rounds_n": ROUNDS, "medians": med, "appell_ops": appell_ops,
