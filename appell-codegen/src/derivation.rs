@@ -1178,7 +1178,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                     let rotor_inertia = &model.bodies[ri].inertia;
                     for (i, (row, rotor_row)) in inertia.iter_mut().zip(rotor_inertia).enumerate() {
                         for (j, (e, x)) in row.iter_mut().zip(rotor_row).enumerate() {
-                            if i == r.axis && j == r.axis {
+                            if r.whole && i == r.axis && j == r.axis {
                                 continue;
                             }
                             *e = g.add(*e, *x)?;
@@ -1197,28 +1197,52 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
                 let mut axis = [zero; 3];
                 axis[a] = g.int(1)?;
                 let w_cross_a = cross(g, c_t.omega_b, axis)?;
-                // The rotor's axial partial angular velocities
-                // o_k = s_k + γ̄ᶜ_k·a enter as λ o_k o_j, a product of two
-                // sums the expansion keeps whole (the bicycle 1,047 -> 1,031
-                // ops against λ (s_k γ̄ᶜ_j·a + s_j γ̄ᶜ_k·a + s_k s_j) beside
-                // the carrier's λ γ̄ᶜ_k·a γ̄ᶜ_j·a, multiplied out).
-                let o: Vec<Id> = (0..l)
-                    .map(|k| g.add(s[k], c_t.gamma_b[k][a]))
-                    .collect::<Result<_, _>>()?;
-                let axial_rate = g.add(c_t.omega_b[a], spin)?;
-                let axial_accel = g.add(alpha[a], spin_rate)?;
-                for k in 0..l {
-                    for j in k..l {
-                        let e = g.mul(o[k], o[j])?;
-                        let e = g.mul(r.axial, e)?;
-                        mass[k * l + j] = g.add(mass[k * l + j], e)?;
+                if r.whole {
+                    // The rotor's axial partial angular velocities
+                    // o_k = s_k + γ̄ᶜ_k·a enter as λ o_k o_j, a product of two
+                    // sums the expansion keeps whole (the bicycle 1,047 -> 1,031
+                    // ops against λ (s_k γ̄ᶜ_j·a + s_j γ̄ᶜ_k·a + s_k s_j) beside
+                    // the carrier's λ γ̄ᶜ_k·a γ̄ᶜ_j·a, multiplied out).
+                    let o: Vec<Id> = (0..l)
+                        .map(|k| g.add(s[k], c_t.gamma_b[k][a]))
+                        .collect::<Result<_, _>>()?;
+                    let axial_rate = g.add(c_t.omega_b[a], spin)?;
+                    let axial_accel = g.add(alpha[a], spin_rate)?;
+                    for k in 0..l {
+                        for j in k..l {
+                            let e = g.mul(o[k], o[j])?;
+                            let e = g.mul(r.axial, e)?;
+                            mass[k * l + j] = g.add(mass[k * l + j], e)?;
+                        }
+                        let x = g.mul(axial_accel, o[k])?;
+                        let y = dot(g, c_t.gamma_b[k], w_cross_a)?;
+                        let y = g.mul(axial_rate, y)?;
+                        let sum = g.add(x, y)?;
+                        let e = g.mul(r.axial, sum)?;
+                        forcing_terms[k].push(g.neg(e)?);
                     }
-                    let x = g.mul(axial_accel, o[k])?;
-                    let y = dot(g, c_t.gamma_b[k], w_cross_a)?;
-                    let y = g.mul(axial_rate, y)?;
-                    let sum = g.add(x, y)?;
-                    let e = g.mul(r.axial, sum)?;
-                    forcing_terms[k].push(g.neg(e)?);
+                } else {
+                    // Split: λ (s_k γ̄ᶜ_j·a + s_j γ̄ᶜ_k·a + s_k s_j) beside the
+                    // carrier's λ γ̄ᶜ_k·a γ̄ᶜ_j·a, and
+                    // λ (θ̈ γ̄ᶜ_k·a + θ̇ γ̄ᶜ_k·(ωᶜ × a) + s_k (αᶜ·a + θ̈)).
+                    for k in 0..l {
+                        for j in k..l {
+                            let x = g.mul(s[k], c_t.gamma_b[j][a])?;
+                            let y = g.mul(s[j], c_t.gamma_b[k][a])?;
+                            let z = g.mul(s[k], s[j])?;
+                            let sum = g.sum(&[x, y, z])?;
+                            let e = g.mul(r.axial, sum)?;
+                            mass[k * l + j] = g.add(mass[k * l + j], e)?;
+                        }
+                        let x = g.mul(spin_rate, c_t.gamma_b[k][a])?;
+                        let y = dot(g, c_t.gamma_b[k], w_cross_a)?;
+                        let y = g.mul(spin, y)?;
+                        let z = g.add(alpha[a], spin_rate)?;
+                        let z = g.mul(s[k], z)?;
+                        let sum = g.sum(&[x, y, z])?;
+                        let e = g.mul(r.axial, sum)?;
+                        forcing_terms[k].push(g.neg(e)?);
+                    }
                 }
             }
             // (mass, β̄_k, the centre in the twin or the model)
@@ -1345,13 +1369,34 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
     }
     // Rotors folded into their carriers, kept when that costs fewer
     // operations.
-    let found = rotors(g, &model.bodies, &model.frames, &model.coords)?;
+    // Each rotor's terms are written whole or split, whichever the
+    // assembled M and f count fewer operations with (the bicycle's front
+    // wheel, whose spin rate is dependent, prefers whole; every combination
+    // is tried for up to four rotors).
+    let mut found = rotors(g, &model.bodies, &model.frames, &model.coords)?;
     if found.iter().any(Option::is_some) {
-        let candidate = assemble(g, &chosen, &found)?;
-        if model.fold_always
-            || assembled_ops(g, &candidate, l)?
-                < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)?
-        {
+        let indices: Vec<usize> = (0..found.len()).filter(|&i| found[i].is_some()).collect();
+        let combinations = match model.rotor_form {
+            None if indices.len() <= 4 => 1usize << indices.len(),
+            _ => 1,
+        };
+        let mut best: Option<(usize, Vec<Option<Rotor>>, (Vec<Id>, Vec<Vec<Id>>))> = None;
+        for mask in 0..combinations {
+            let mut forms = found.clone();
+            for (bit, &i) in indices.iter().enumerate() {
+                if let Some(r) = forms[i].as_mut() {
+                    r.whole = model.rotor_form.unwrap_or(mask & (1 << bit) == 0);
+                }
+            }
+            let assembled = assemble(g, &chosen, &forms)?;
+            let ops = assembled_ops(g, &assembled, l)?;
+            if best.as_ref().is_none_or(|(b, _, _)| ops < *b) {
+                best = Some((ops, forms, assembled));
+            }
+        }
+        let (ops, forms, candidate) = best.expect("at least one combination");
+        found = forms;
+        if model.fold_always || ops < assembled_ops(g, &(mass.clone(), forcing_terms.clone()), l)? {
             (mass, forcing_terms) = candidate;
             for (bi, r) in found.iter().enumerate() {
                 if let Some(r) = r {
@@ -1874,6 +1919,9 @@ struct Rotor {
     coordinate: usize,
     /// The moment of inertia about the axis.
     axial: Id,
+    /// Its terms written with its axial partial angular velocities whole
+    /// (λ o_k o_j), or split against the carrier's (see [`rotors`]).
+    whole: bool,
 }
 
 /// Finds rotors: a rigid body whose frame is a carrier body's frame turned
@@ -1944,6 +1992,7 @@ fn rotors(
                             axis: k,
                             coordinate,
                             axial: inertia[k][k],
+                            whole: true,
                         });
                         break;
                     }

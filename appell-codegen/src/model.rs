@@ -200,6 +200,9 @@ pub struct Model {
     /// Fold composites and rotors even where that costs operations (for
     /// tests that compare folded and unfolded equations).
     pub fold_always: bool,
+    /// Write every rotor's terms whole (`Some(true)`) or split
+    /// (`Some(false)`) instead of the cheaper (for tests of both forms).
+    pub rotor_form: Option<bool>,
 }
 
 /// A direction cosine standing as a symbol in the twin model: its rate is a
@@ -567,6 +570,7 @@ fn build_in(cx: &Ctxt, ast: &ModelAst, mut g: Graph, cut_from: Option<Vec<Mat3>>
         twin: None,
         cuts: b.cuts,
         fold_always: false,
+        rotor_form: None,
     })
 }
 

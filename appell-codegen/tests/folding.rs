@@ -10,11 +10,21 @@ use appell_symbolic::Tape;
 
 /// M and f (and the equations text) of `src`, folding forced or not.
 fn equations(src: &str, fold_always: bool) -> (Vec<Vec<f64>>, String) {
+    equations_with(src, fold_always, None)
+}
+
+/// The same, with the rotors' form forced (whole or split) when given.
+fn equations_with(
+    src: &str,
+    fold_always: bool,
+    rotor_form: Option<bool>,
+) -> (Vec<Vec<f64>>, String) {
     let input: syn::DeriveInput = syn::parse_str(src).expect("valid Rust");
     let cx = Ctxt::new();
     let ast = parse::parse(&cx, &input);
     let mut m = model::build(&cx, &ast).expect("model");
     m.fold_always = fold_always;
+    m.rotor_form = rotor_form;
     let d = derive(&cx, m).expect("derivation");
     cx.check().expect("no errors");
     let mut roots = d.mass.clone();
@@ -72,11 +82,13 @@ fn a_particle_on_a_rigid_arm_folds_into_a_composite() {
 #[test]
 fn a_spinning_rotor_folds_into_its_gimbal() {
     let (plain, _) = equations(GYROSCOPE, false);
-    let (folded, text) = equations(GYROSCOPE, true);
-    assert!(text.contains("composite: `gimbal` with `rotor`"), "{text}");
-    assert!(
-        text.contains("rotor: `rotor` spins about axis y of `gimbal`"),
-        "{text}"
-    );
-    assert_same(&plain, &folded);
+    for form in [None, Some(true), Some(false)] {
+        let (folded, text) = equations_with(GYROSCOPE, true, form);
+        assert!(text.contains("composite: `gimbal` with `rotor`"), "{text}");
+        assert!(
+            text.contains("rotor: `rotor` spins about axis y of `gimbal`"),
+            "{text}"
+        );
+        assert_same(&plain, &folded);
+    }
 }
