@@ -1380,7 +1380,7 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
             None if indices.len() <= 4 => 1usize << indices.len(),
             _ => 1,
         };
-        let mut best: Option<(usize, Vec<Option<Rotor>>, (Vec<Id>, Vec<Vec<Id>>))> = None;
+        let mut best: Option<(usize, Vec<Option<Rotor>>, Assembled)> = None;
         for mask in 0..combinations {
             let mut forms = found.clone();
             for (bit, &i) in indices.iter().enumerate() {
@@ -1906,6 +1906,9 @@ fn assembled_ops(
     }
     Ok(g.op_count(&roots)?.total())
 }
+
+/// M's entries and f's terms per speed, as `assemble` builds them.
+type Assembled = (Vec<Id>, Vec<Vec<Id>>);
 
 /// An axisymmetric body turning about its symmetry axis, which is fixed in
 /// another body's frame (a wheel on its axle; see [`rotors`]).
