@@ -817,7 +817,39 @@ fn derive_inner(cx: &Ctxt, model: &mut Model) -> Result<Option<Parts>, SymbolicE
         fixed_rates.insert(model.coords[r].1.rate, qdot[r]);
     }
     let mut elimination = Elimination::Symbolic;
-    if let Some((xs, x_ids, k, s_mat, s_rhs, free_cols, row_ops)) = numeric_part {
+    if let Some((xs, x_ids, k, mut s_mat, mut s_rhs, free_cols, row_ops)) = numeric_part {
+        // S and R read off the rows as the model wrote them (T applied to
+        // the twin's rows, whose coefficients keep their factored form)
+        // rather than from the expanded D: the bicycle 1,025 -> 989 ops.
+        // Kept only where every entry agrees with the elimination's at the
+        // test points.
+        if !row_ops.is_empty() {
+            let speed_cols: Vec<Symbol> = model
+                .speeds
+                .iter()
+                .map(|&sp| model.coords[sp].1.rate)
+                .collect();
+            let free: Vec<Symbol> = free_cols
+                .iter()
+                .map(|&c| model.coords[dependent[c]].1.rate)
+                .collect();
+            if let Some((new_s, new_r)) = schur_as_written(
+                g,
+                SchurRows {
+                    rows: &raw_rows,
+                    row_ops: &row_ops,
+                    width: k_unknowns,
+                    rates: &rates,
+                    free: &free,
+                    speeds: &speed_cols,
+                },
+                &mut uncut,
+                (&s_mat, &s_rhs),
+            )? {
+                s_mat = new_s;
+                s_rhs = new_r;
+            }
+        }
         // The accelerations need Ẋ only in the combination w = Ẋ [ẏ; 1]
         // (the dependent acceleration remainder): every β̄_k is linear in the
         // column X_k, so Σ_k β̄̇_k ẏ_k + β̄̇ sees Σ_k Ẋ_k ẏ_k + Ẋ_l. The rate
@@ -1905,6 +1937,91 @@ fn assembled_ops(
         roots.push(expanded(g, f)?);
     }
     Ok(g.op_count(&roots)?.total())
+}
+
+/// S's and R's entries, row by row.
+type SchurParts = (Vec<Id>, Vec<Id>);
+
+/// The constraint rows as written and what [`schur_as_written`] reads off
+/// them.
+struct SchurRows<'a> {
+    /// The rows as the model wrote them (the twin's, when there is one).
+    rows: &'a [Id],
+    /// T, the elimination's row operations, k × `width`.
+    row_ops: &'a [Id],
+    width: usize,
+    /// Every coordinate rate (set to zero for the rows' remainders).
+    rates: &'a [Symbol],
+    /// The rates of the free unknowns (S's columns).
+    free: &'a [Symbol],
+    /// The rates of the privileged speeds (R's first columns).
+    speeds: &'a [Symbol],
+}
+
+/// S and R of the numeric elimination read off T (D q̇ + d) with the rows
+/// as written: S_if = ∂(T rows)_i/∂ż_f, R_ik = −∂(T rows)_i/∂ẏ_k and
+/// R_il = −(T rows)_i at q̇ = 0, the twin's symbols put back by `uncut`.
+/// The rows' coefficients stay in the form the model gave them (a rolling
+/// contact's (v + ω × r)·e with its unit vector unexpanded), which the
+/// emitter shares with the other terms. `None` unless every nonzero entry
+/// equals the elimination's (`known`) at the test points of
+/// [`same_function`].
+fn schur_as_written(
+    g: &mut appell_symbolic::Graph,
+    rows: SchurRows<'_>,
+    uncut: &mut Substitution,
+    known: (&[Id], &[Id]),
+) -> Result<Option<SchurParts>, SymbolicError> {
+    let (s_known, r_known) = known;
+    let k = rows.free.len();
+    let l = rows.speeds.len();
+    let zero = g.int(0)?;
+    let mut no_rates = Substitution::new();
+    for &r in rows.rates {
+        no_rates.insert(r, zero);
+    }
+    let mut s = s_known.to_vec();
+    let mut r = r_known.to_vec();
+    for i in 0..k {
+        let mut terms = Vec::new();
+        for (j, &row) in rows.rows.iter().enumerate() {
+            let t = rows.row_ops[i * rows.width + j];
+            if !g.is_zero(t) {
+                terms.push(g.mul(t, row)?);
+            }
+        }
+        let combined = g.sum(&terms)?;
+        // (entry, its value: a coefficient or the remainder, and its sign)
+        let mut entries: Vec<(&mut Id, Option<Symbol>, bool)> = Vec::new();
+        let (s_row, r_row) = (
+            &mut s[i * k..(i + 1) * k],
+            &mut r[i * (l + 1)..(i + 1) * (l + 1)],
+        );
+        for (e, &rate) in s_row.iter_mut().zip(rows.free) {
+            entries.push((e, Some(rate), false));
+        }
+        let (r_speeds, r_rest) = r_row.split_at_mut(l);
+        for (e, &rate) in r_speeds.iter_mut().zip(rows.speeds) {
+            entries.push((e, Some(rate), true));
+        }
+        entries.push((&mut r_rest[0], None, true));
+        for (entry, rate, negate) in entries {
+            if g.is_zero(*entry) {
+                continue;
+            }
+            let c = match rate {
+                Some(rate) => g.diff(combined, rate)?,
+                None => no_rates.apply(g, combined)?,
+            };
+            let c = uncut.apply(g, c)?;
+            let c = if negate { g.neg(c)? } else { c };
+            if same_function(g, *entry, c) != Some(true) {
+                return Ok(None);
+            }
+            *entry = c;
+        }
+    }
+    Ok(Some((s, r)))
 }
 
 /// M's entries and f's terms per speed, as `assemble` builds them.
