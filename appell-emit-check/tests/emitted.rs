@@ -38,16 +38,21 @@ fn same_bits(a: f64, b: f64, powi: bool) -> bool {
     (a - b).abs() <= ulps * f64::EPSILON * a.abs().max(b.abs())
 }
 
-#[test]
-fn emitted_code_equals_the_engine_bit_for_bit() {
+/// Runs `f` at every case's points and checks each output against the
+/// engine's with `agree`; returns how many outputs were compared.
+fn compare_all(
+    what: &str,
+    f: impl Fn(&Case) -> fn(f64, f64, f64, f64, f64) -> [f64; 2],
+    agree: impl Fn(f64, f64, &Case) -> bool,
+) -> usize {
     let mut checked = 0;
     for c in CASES {
         for (p, expected) in c.points {
-            let got = (c.joint_f64)(p[0], p[1], p[2], p[3], p[4]);
+            let got = f(c)(p[0], p[1], p[2], p[3], p[4]);
             for k in 0..2 {
                 assert!(
-                    same_bits(got[k], expected[k], c.powi),
-                    "output {k} of {}: compiled {} vs engine {}",
+                    agree(got[k], expected[k], c),
+                    "output {k} of {}: {what} {} vs engine {}",
                     c.text,
                     got[k],
                     expected[k]
@@ -56,6 +61,16 @@ fn emitted_code_equals_the_engine_bit_for_bit() {
             }
         }
     }
+    checked
+}
+
+#[test]
+fn emitted_code_equals_the_engine_bit_for_bit() {
+    let checked = compare_all(
+        "compiled",
+        |c| c.joint_f64,
+        |a, b, c| same_bits(a, b, c.powi),
+    );
     assert_eq!(checked, CASES.len() * 6 * 2);
 }
 
@@ -66,35 +81,19 @@ fn emitted_code_equals_the_engine_bit_for_bit() {
 /// checked there.
 #[test]
 fn fused_code_equals_the_engine_without_fma() {
-    let mut fused = 0;
-    for c in CASES {
-        for (p, expected) in c.points {
-            let got = (c.fused_f64)(p[0], p[1], p[2], p[3], p[4]);
-            for k in 0..2 {
-                if cfg!(target_feature = "fma") {
-                    let scale = expected[k].abs().max(1.0);
-                    assert!(
-                        (got[k] - expected[k]).abs() <= 1e-6 * scale
-                            || (got[k].is_nan() && expected[k].is_nan()),
-                        "output {k} of {}: fused {} vs engine {}",
-                        c.text,
-                        got[k],
-                        expected[k]
-                    );
-                } else {
-                    assert!(
-                        same_bits(got[k], expected[k], c.powi),
-                        "output {k} of {}: fused {} vs engine {}",
-                        c.text,
-                        got[k],
-                        expected[k]
-                    );
-                }
+    compare_all(
+        "fused",
+        |c| c.fused_f64,
+        |a, b, c| {
+            if cfg!(target_feature = "fma") {
+                (a - b).abs() <= 1e-6 * b.abs().max(1.0) || (a.is_nan() && b.is_nan())
+            } else {
+                same_bits(a, b, c.powi)
             }
-        }
-        fused += usize::from(c.fused_text);
-    }
+        },
+    );
     // The generator's expressions have products feeding sums in most cases.
+    let fused = CASES.iter().filter(|c| c.fused_text).count();
     assert!(fused > CASES.len() / 2, "only {fused} cases were fused");
 }
 
