@@ -91,7 +91,9 @@
 //! `constraints`, `contacts` (a list of `{"point", "body", "along"}`),
 //! `scenes` (a list of `{"name", "effects", "retained", "state_len",
 //! "rhs_ops", "outputs"}`), `force_points`, `torques`, `symbolic_elimination` and
-//! `rhs_ops` (`{"add", "mul", "div", "calls", "total"}`). See [`info_json`].
+//! `rhs_ops` (`{"add", "mul", "div", "calls", "other", "total"}`, where
+//! `other` counts negations, large integer powers and the numeric solves'
+//! operations, which `total` includes). See [`info_json`].
 //!
 //! # `bench`
 //!
@@ -468,6 +470,7 @@ fn eval_stream<M: Model>(
 /// assert_eq!(info["parameters"][0]["value"], 0.25);
 /// assert_eq!(info["state"], serde_json::json!(["phi", "phi_dot"]));
 /// assert_eq!(info["rhs_ops"]["total"], 1);
+/// assert_eq!(info["rhs_ops"]["other"], 0);
 /// ```
 pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
     let info = M::info();
@@ -537,6 +540,7 @@ pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
             "mul": ops.mul,
             "div": ops.div,
             "calls": ops.calls,
+            "other": ops.total.saturating_sub(ops.add + ops.mul + ops.div + ops.calls),
             "total": ops.total,
         },
     }))
