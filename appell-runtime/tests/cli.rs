@@ -268,7 +268,7 @@ fn info_lists_the_metadata() {
     assert_eq!(info["symbolic_elimination"], true);
     assert_eq!(
         info["rhs_ops"],
-        json!({"add": 2, "mul": 7, "div": 2, "calls": 3, "total": 14})
+        json!({"add": 2, "mul": 7, "div": 2, "calls": 3, "other": 0, "total": 14})
     );
 }
 
