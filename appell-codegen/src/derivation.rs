@@ -2265,7 +2265,7 @@ pub struct SingletonOrder {
 /// yet solved, peeled in order (each solved by one division; no other
 /// entry changes, so there is nothing for pivoting to protect); `entry`
 /// says whether an entry can be nonzero. The generated code and
-/// [`structural_solution`] both follow this order.
+/// `structural_solution` both follow this order.
 ///
 /// ```
 /// use appell_codegen::derivation::singleton_rows;
