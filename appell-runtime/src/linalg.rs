@@ -50,16 +50,33 @@ pub fn lu_solve<T: Scalar, const N: usize, const M: usize>(
 /// ```
 #[inline]
 pub fn max_abs<T: Scalar, const N: usize, const M: usize>(b: &[[T; M]; N]) -> f64 {
-    let mut scale = 0.0f64;
-    for row in b.iter() {
-        for x in row {
-            let v = x.re().abs();
-            if v.is_finite() {
-                scale = scale.max(v);
-            }
+    let mut v = [[0.0f64; M]; N];
+    for (row, out) in b.iter().zip(v.iter_mut()) {
+        for (x, o) in row.iter().zip(out.iter_mut()) {
+            let m = x.re().abs();
+            // False for NaN and ±∞, which count as 0.
+            *o = if m <= f64::MAX { m } else { 0.0 };
         }
     }
-    scale
+    pairwise(v.as_flattened_mut(), |a, b| if a > b { a } else { b })
+}
+
+/// Reduces `v` by `op` pairwise (a tree of depth log₂ n rather than a
+/// chain of n − 1), overwriting it; 0 for an empty slice.
+#[inline(always)]
+fn pairwise(v: &mut [f64], op: impl Fn(f64, f64) -> f64) -> f64 {
+    let mut n = v.len();
+    if n == 0 {
+        return 0.0;
+    }
+    while n > 1 {
+        let half = n / 2;
+        for i in 0..half {
+            v[i] = op(v[i], v[n - half + i]);
+        }
+        n -= half;
+    }
+    v[0]
 }
 
 /// The scale a constraint matrix's pivots are judged against: the largest
@@ -78,23 +95,27 @@ pub fn constraint_scale<T: Scalar, const N: usize, const M: usize>(
     a: &[[T; M]; N],
     rhs_scale: f64,
 ) -> Result<f64, ModelError> {
-    let mut scale = if rhs_scale.is_finite() {
-        rhs_scale
-    } else {
-        0.0
-    };
-    for row in a.iter() {
-        for x in row {
-            let v = x.re().abs();
-            if !v.is_finite() {
-                return Err(ModelError::NonFinite {
-                    what: "the constraint matrix",
-                });
-            }
-            scale = scale.max(v);
+    let mut v = [[0.0f64; M]; N];
+    for (row, out) in a.iter().zip(v.iter_mut()) {
+        for (x, o) in row.iter().zip(out.iter_mut()) {
+            *o = x.re().abs();
         }
     }
-    Ok(scale)
+    // A NaN entry makes the sum NaN, an infinite one the maximum infinite.
+    let mut w = v;
+    let sum = pairwise(w.as_flattened_mut(), |a, b| a + b);
+    let scale = pairwise(v.as_flattened_mut(), |a, b| if a > b { a } else { b });
+    if sum.is_nan() || scale > f64::MAX {
+        return Err(ModelError::NonFinite {
+            what: "the constraint matrix",
+        });
+    }
+    // `rhs_scale > scale` is false for NaN, so a NaN right side counts as 0.
+    Ok(if rhs_scale > scale && rhs_scale <= f64::MAX {
+        rhs_scale
+    } else {
+        scale
+    })
 }
 
 /// Accepts a pivot of the dependent block when its magnitude exceeds
@@ -157,7 +178,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
         }
         check_pivot(a[p][col], scale, col)?;
         swaps[col] = p;
-        a.swap(p, col);
+        swap_rows(a, col, p);
         let inv = T::one() / a[col][col];
         for r in col + 1..N {
             let f = a[r][col] * inv;
@@ -173,6 +194,18 @@ pub fn lu_factor<T: Scalar, const N: usize>(
         a[col][col] = inv;
     }
     Ok(swaps)
+}
+
+/// Exchanges rows `i` and `p ≥ i` of `a`. Written with constant indices
+/// (one test per candidate row), so that after unrolling a small matrix
+/// stays in registers instead of being indexed in memory.
+#[inline(always)]
+fn swap_rows<T: Copy, const N: usize, const M: usize>(a: &mut [[T; M]; N], i: usize, p: usize) {
+    for r in i + 1..N {
+        if p == r {
+            a.swap(i, r);
+        }
+    }
 }
 
 /// Solves `A X = B` in place with the factors and row exchanges of
@@ -194,7 +227,7 @@ pub fn lu_substitute<T: Scalar, const N: usize, const M: usize>(
 ) {
     // P A = L U with the exchanges applied to whole rows: P b first, then L.
     for col in 0..N {
-        b.swap(swaps[col], col);
+        swap_rows(b, col, swaps[col]);
     }
     for col in 0..N {
         for r in col + 1..N {
@@ -283,6 +316,49 @@ pub fn ldlt_solve<T: Scalar, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn scales_read_every_entry_and_report_non_finite_ones() {
+        // Seven entries (an odd count at every level of the pairwise
+        // reduction), the largest in each position in turn.
+        let entries = [0.5, -0.25, 0.125, 1.0, -2.0, 0.75, 1.5];
+        for k in 0..7 {
+            let rest = (0..7)
+                .filter(|&j| j != k)
+                .map(|j| f64::abs(entries[j]))
+                .fold(0.0, f64::max);
+            let mut a = [entries];
+            a[0][k] = -9.0;
+            assert_eq!(constraint_scale(&a, 3.0), Ok(9.0));
+            assert_eq!(max_abs(&a), 9.0);
+            a[0][k] = f64::INFINITY;
+            assert!(constraint_scale(&a, 3.0).is_err());
+            assert_eq!(max_abs(&a), rest);
+            a[0][k] = f64::NAN;
+            assert!(constraint_scale(&a, 3.0).is_err());
+            assert_eq!(max_abs(&a), rest);
+        }
+        assert_eq!(constraint_scale(&[[1.0]], f64::NAN), Ok(1.0));
+        assert_eq!(constraint_scale(&[[1.0]], f64::INFINITY), Ok(1.0));
+        assert_eq!(max_abs::<f64, 0, 3>(&[]), 0.0);
+    }
+
+    #[test]
+    fn every_row_exchange_is_applied() {
+        // Pivots found in each later row in turn: the largest entry of the
+        // first column moves through all three rows.
+        for big in 0..3 {
+            let mut a = [[1.0, 2.0, 0.5], [0.25, 1.0, 3.0], [2.0, -1.0, 1.0]];
+            a[big][0] = 10.0;
+            let a0 = a;
+            let mut b = [[1.0], [2.0], [3.0]];
+            lu_solve(&mut a, &mut b).unwrap();
+            for i in 0..3 {
+                let r: f64 = (0..3).map(|k| a0[i][k] * b[k][0]).sum::<f64>() - (i + 1) as f64;
+                assert!(r.abs() < 1e-14, "row {big}: residual {r}");
+            }
+        }
+    }
 
     #[test]
     fn lu_matches_a_known_solution() {
