@@ -176,9 +176,9 @@ pub fn lu_factor<T: Scalar, const N: usize>(
                 p = r;
             }
         }
-        check_pivot(a[p][col], scale, col)?;
         swaps[col] = p;
         swap_rows(a, col, p);
+        check_pivot(a[col][col], scale, col)?;
         let inv = T::one() / a[col][col];
         for r in col + 1..N {
             let f = a[r][col] * inv;
