@@ -97,11 +97,13 @@ macro_rules! float_scalar {
             }
             #[inline(always)]
             fn sin(self) -> Self {
-                float_scalar!(@call $t, $libm_suffix, sin, self)
+                // Inline, in f64 (`appell-trig`: the engine's own values);
+                // for f32 the f64 value rounded once.
+                appell_trig::sin(self as f64) as $t
             }
             #[inline(always)]
             fn cos(self) -> Self {
-                float_scalar!(@call $t, $libm_suffix, cos, self)
+                appell_trig::cos(self as f64) as $t
             }
             #[inline(always)]
             fn tan(self) -> Self {

@@ -114,8 +114,10 @@ impl Func {
     /// Applies the function to a float.
     pub fn apply(self, x: f64) -> f64 {
         match self {
-            Func::Sin => x.sin(),
-            Func::Cos => x.cos(),
+            // The same functions as the generated code's (`appell-trig`), so
+            // that the engine's values and the compiled code's agree.
+            Func::Sin => appell_trig::sin(x),
+            Func::Cos => appell_trig::cos(x),
             Func::Tan => x.tan(),
             Func::Exp => x.exp(),
             Func::Ln => x.ln(),
