@@ -12,15 +12,15 @@
 //! both values of one angle (the compiler shares the work when the rhs asks
 //! for both), and it lets the calls for different angles overlap:
 //!
-//! 1. `|x| ≤ π/4` (most angles of a mechanism near its working point): no
+//! 1. `|x| ≤ 1` (most angles of a mechanism near its working point): no
 //!    reduction, straight to the polynomials;
 //! 2. otherwise `x = k π/2 + r + r_lo` with `|r| ≲ π/4`, π/2 split into four
 //!    parts whose first three have 33 significant bits, so that `k · part`
 //!    is exact for `|k| < 2²⁰` and the subtractions cancel exactly
 //!    (Sterbenz) where `x` is close to a multiple of π/2; the one rounded
 //!    subtraction left is kept as the pair `r + r_lo` (TwoSum);
-//! 3. the Taylor polynomials of `sin r` to `r¹⁷` and of `cos r` to `r¹⁶`,
-//!    whose truncation errors at `|r| = π/4` are below 10⁻¹⁸, evaluated by
+//! 3. the Taylor polynomials of `sin r` to `r¹⁷` and of `cos r` to `r¹⁸`,
+//!    whose truncation errors at `|r| = 1` are below 10⁻¹⁷, evaluated by
 //!    Estrin's scheme (a dependency chain of four multiply-adds), with
 //!    `r_lo` as a first-order correction;
 //! 4. the quadrant `k mod 4` swaps and negates the two.
@@ -54,6 +54,10 @@ const ROUNDER: f64 = 6755399441055744.0;
 
 /// The largest magnitude reduced here (`k < 2²⁰` with room to spare).
 const FAST_LIMIT: f64 = 524288.0;
+
+/// Up to this magnitude the polynomials take `x` itself (one radian: the
+/// truncation errors stay below 10⁻¹⁷ there).
+const NO_REDUCTION: f64 = 1.0;
 
 /// Below this magnitude `sin x` rounds to `x`: `x³/6 < ulp(x)/2`.
 const TINY: f64 = 1.0 / 67108864.0;
@@ -89,7 +93,7 @@ fn fma(a: f64, b: f64, c: f64) -> f64 {
     }
 }
 
-/// `(sin(r + lo), cos(r + lo))` for `|r| ≲ π/4` and `lo` within half an ulp
+/// `(sin(r + lo), cos(r + lo))` for `|r| ≤ 1` and `lo` within half an ulp
 /// of `r`.
 #[inline(always)]
 fn kernel(r: f64, lo: f64) -> (f64, f64) {
@@ -105,7 +109,7 @@ fn kernel(r: f64, lo: f64) -> (f64, f64) {
         -7.647163731819816e-13,
         2.8114572543455206e-15,
     ];
-    const C: [f64; 7] = [
+    const C: [f64; 8] = [
         0.041666666666666664,
         -0.001388888888888889,
         2.48015873015873e-05,
@@ -113,6 +117,7 @@ fn kernel(r: f64, lo: f64) -> (f64, f64) {
         2.08767569878681e-09,
         -1.1470745597729725e-11,
         4.779477332387385e-14,
+        -1.5619206968586225e-16,
     ];
     let z = r * r;
     let z2 = z * z;
@@ -126,7 +131,8 @@ fn kernel(r: f64, lo: f64) -> (f64, f64) {
     let c01 = fma(C[1], z, C[0]);
     let c23 = fma(C[3], z, C[2]);
     let c45 = fma(C[5], z, C[4]);
-    let cp = fma(fma(C[6], z2, c45), z4, fma(c23, z2, c01));
+    let c67 = fma(C[7], z, C[6]);
+    let cp = fma(fma(c67, z2, c45), z4, fma(c23, z2, c01));
     let half = 1.0 - 0.5 * z;
     // sin(r + lo) = r + (lo cos r + r z sp), with cos r ≈ 1 − z/2 in the
     // correction; cos(r + lo) = 1 − z/2 + (z² cp − lo sin r), sin r ≈ r.
@@ -178,7 +184,7 @@ pub fn cos(x: f64) -> f64 {
 pub fn sin_cos(x: f64) -> (f64, f64) {
     // |x| without `f64::abs`, which older `core` lacks.
     let m = f64::from_bits(x.to_bits() & !(1 << 63));
-    if m <= core::f64::consts::FRAC_PI_4 {
+    if m <= NO_REDUCTION {
         // No reduction: the polynomials' latency only.
         let (s, c) = kernel(x, 0.0);
         // Below 2⁻²⁶, sin x rounds to x itself (and −0 stays −0, which
@@ -254,6 +260,18 @@ mod tests {
         let (s, c) = worst(xs.into_iter());
         // The platform (glibc) is itself within about half an ulp, so an
         // error of one ulp here is the sum of both.
+        assert!(s <= 1.0 && c <= 1.0, "sin {s} ulps, cos {c} ulps");
+    }
+
+    #[test]
+    fn within_one_ulp_where_nothing_is_reduced() {
+        // Uniform up to the edge of the unreduced range and a little past
+        // it, where cos x is smallest there and the polynomials longest.
+        let mut state = 11;
+        let xs: Vec<f64> = (0..200_000)
+            .map(|_| 1.25 * (2.0 * uniform(&mut state) - 1.0))
+            .collect();
+        let (s, c) = worst(xs.into_iter());
         assert!(s <= 1.0 && c <= 1.0, "sin {s} ulps, cos {c} ulps");
     }
 
