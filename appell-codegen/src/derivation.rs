@@ -2764,7 +2764,7 @@ mod tests {
         let a = g.coordinate("a").unwrap();
         let b = g.coordinate("b").unwrap();
         let rates = [a.rate, b.rate];
-        let mut frame = |g: &mut appell_symbolic::Graph, rot: [[&str; 3]; 3], omega: [&str; 3]| {
+        let frame = |g: &mut appell_symbolic::Graph, rot: [[&str; 3]; 3], omega: [&str; 3]| {
             crate::model::Frame {
                 name: String::new(),
                 rot: rot.map(|row| row.map(|e| g.parse(e).unwrap())),
