@@ -1281,11 +1281,7 @@ fn balance_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst
     }
     impl Out {
         fn push(&mut self, graph: &Graph, inst: Inst, ready: Option<u32>) -> u32 {
-            let parameter = match &inst {
-                Inst::Const(_) => true,
-                Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
-                other => other.operands().iter().all(|&o| self.parameter[o as usize]),
-            };
+            let parameter = parameter_only(graph, &inst, &self.parameter);
             let r = if parameter {
                 0
             } else {
@@ -1410,14 +1406,20 @@ fn balance_sums(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst
 fn parameter_only_flags(graph: &Graph, insts: &[Inst]) -> Vec<bool> {
     let mut flags: Vec<bool> = Vec::with_capacity(insts.len());
     for inst in insts {
-        let p = match inst {
-            Inst::Const(_) => true,
-            Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
-            other => other.operands().iter().all(|&o| flags[o as usize]),
-        };
+        let p = parameter_only(graph, inst, &flags);
         flags.push(p);
     }
     flags
+}
+
+/// Whether `inst` depends on parameters (and constants) only, given the
+/// flags of the instructions before it.
+fn parameter_only(graph: &Graph, inst: &Inst, flags: &[bool]) -> bool {
+    match inst {
+        Inst::Const(_) => true,
+        Inst::Symbol(s) => graph.symbol_kind(*s) == SymbolKind::Parameter,
+        other => other.operands().iter().all(|&o| flags[o as usize]),
+    }
 }
 
 /// How many instructions (and outputs) read each instruction.
