@@ -9,11 +9,9 @@ fn expand_str(src: &str) -> String {
 
 const WHEEL_AXLE: &str = include_str!("../../examples/models/wheel_axle.rs");
 
+/// A model file holds the struct and a Default impl; keep the struct.
 fn wheel_axle_struct() -> String {
-    // The model file holds the struct and a Default impl; keep the struct.
-    let start = WHEEL_AXLE.find("#[derive(Appell").expect("derive");
-    let end = WHEEL_AXLE.find("impl Default").expect("impl");
-    WHEEL_AXLE[start..end].to_string()
+    model_struct(WHEEL_AXLE)
 }
 
 #[test]
@@ -47,11 +45,9 @@ fn several_mistakes_are_reported_together() {
 
 #[test]
 fn whipple_bicycle_expands() {
-    let src = include_str!("../../examples/models/whipple_bicycle.rs");
-    let start = src.find("#[derive(Appell").expect("derive");
-    let end = src.find("impl Default").expect("impl");
+    let src = model_struct(include_str!("../../examples/models/whipple_bicycle.rs"));
     let t = std::time::Instant::now();
-    let out = expand_str(&src[start..end]);
+    let out = expand_str(&src);
     println!(
         "whipple expansion: {:.3} s, {} bytes",
         t.elapsed().as_secs_f64(),
@@ -68,4 +64,30 @@ fn whipple_bicycle_expands() {
         "{}",
         &out[..out.len().min(2000)]
     );
+}
+
+fn model_struct(src: &str) -> String {
+    let start = src.find("#[derive(Appell").expect("derive");
+    let end = src.find("impl Default").expect("impl");
+    src[start..end].to_string()
+}
+
+#[test]
+fn ldlt_keeps_a_pivots_reciprocal_where_it_saves_a_division_or_waits_for_f() {
+    // No constraints: the first pivot divides l_10 and w_0 and is kept as
+    // a reciprocal; the last divides w_1 only and stays a division.
+    let out = expand_str(&model_struct(include_str!(
+        "../../examples/models/double_pendulum.rs"
+    )));
+    assert!(out.contains("__l_1_0 = __e_1_0 * __r_0"), "{out}");
+    assert!(out.contains("__w_0 = __z_0 * __r_0"), "{out}");
+    assert!(out.contains("__w_1 = __z_1 / __d_1"), "{out}");
+    assert!(!out.contains("__r_1"), "{out}");
+    // A numeric elimination: M is complete before f, so the last pivot's
+    // reciprocal is computed early and the solve that waits on f multiplies.
+    let out = expand_str(&model_struct(include_str!(
+        "../../examples/models/chaplygin_sleigh.rs"
+    )));
+    assert!(out.contains("__w_1 = __z_1 * __r_1"), "{out}");
+    assert!(!out.contains("__z_1 / __d_1"), "{out}");
 }
