@@ -1010,6 +1010,72 @@ fn rewrite(
     (out, outputs)
 }
 
+/// `prune` on a pair.
+fn prune_pair((insts, outputs): (Vec<Inst>, Vec<u32>)) -> (Vec<Inst>, Vec<u32>) {
+    prune(insts, outputs)
+}
+
+/// Cancels a term added and subtracted that only the instructions show.
+///
+/// The graph cancels equal terms, but two different forms of one value (a
+/// sum written out here and kept factored there) become the same
+/// instruction only after lowering, which shares them; `(a − b) − a` can
+/// then appear. Here it is `−b`, `a − (a − b)` is `b`, `(a + b) − a` is `b`,
+/// `(a − b) + b` is `a`, and a product by ±1 that this leaves is its factor
+/// or its negation. Values change only by the rounding the removed
+/// operations did (they are more accurate); the engine evaluates the same
+/// program the compiled code runs, so both still agree to the bit.
+fn cancel_terms(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+    // −v, folded into a constant or a negation it undoes.
+    fn negated(out: &mut Vec<Inst>, v: u32) -> u32 {
+        match out[v as usize] {
+            Inst::Const(c) => out.push(Inst::Const(-c)),
+            Inst::Neg(y) => return y,
+            _ => out.push(Inst::Neg(v)),
+        }
+        (out.len() - 1) as u32
+    }
+    rewrite(insts, outputs, |_, inst, out, map| {
+        let m = |x: u32| map[x as usize];
+        match *inst {
+            Inst::Sub(x, y) => {
+                let (x, y) = (m(x), m(y));
+                match (&out[x as usize], &out[y as usize]) {
+                    (&Inst::Sub(p, q), _) if p == y => Some(negated(out, q)),
+                    (_, &Inst::Sub(p, q)) if p == x => Some(q),
+                    (&Inst::Add(p, q), _) if p == y => Some(q),
+                    (&Inst::Add(p, q), _) if q == y => Some(p),
+                    _ => None,
+                }
+            }
+            Inst::Add(x, y) => {
+                let (x, y) = (m(x), m(y));
+                match (&out[x as usize], &out[y as usize]) {
+                    (&Inst::Sub(p, q), _) if q == y => Some(p),
+                    (_, &Inst::Sub(p, q)) if q == x => Some(p),
+                    _ => None,
+                }
+            }
+            Inst::Mul(x, y) => {
+                let (x, y) = (m(x), m(y));
+                let unit = |v: u32| match out[v as usize] {
+                    Inst::Const(c) if c.is_one() => Some(false),
+                    Inst::Const(c) if (-c).is_one() => Some(true),
+                    _ => None,
+                };
+                match (unit(x), unit(y)) {
+                    (_, Some(false)) => Some(x),
+                    (Some(false), _) => Some(y),
+                    (_, Some(true)) => Some(negated(out, x)),
+                    (Some(true), _) => Some(negated(out, y)),
+                    _ => None,
+                }
+            }
+            _ => None,
+        }
+    })
+}
+
 /// How deep a negation is carried through products and differences before
 /// it is given up (each step rewrites one more instruction).
 const MAX_SIGN_DEPTH: usize = 8;
@@ -1507,6 +1573,7 @@ impl Program {
         // their common factors are taken out): drop them first, so that
         // only live instructions count as uses below.
         let (insts, outputs) = prune(l.insts, outputs);
+        let (insts, outputs) = prune_pair(cancel_terms(insts, outputs));
         let (insts, outputs) = share_reciprocals(insts, outputs);
         let (insts, outputs) = share_products(graph, insts, outputs);
         let (insts, outputs) = prune(insts, outputs);
@@ -2366,6 +2433,50 @@ mod sharing_tests {
         let p = check(&mut g, &["(sin(y) + z)*w - w*sin(y) - w*z + x*d"]);
         let ops = p.op_count();
         assert_eq!(ops.total(), 1, "{ops}");
+    }
+
+    #[test]
+    fn terms_added_and_subtracted_cancel_between_instructions() {
+        let mut g = Graph::new();
+        let [x, y, z] = ["x", "y", "z"].map(|n| g.declare(n, SymbolKind::Auxiliary).unwrap());
+        use Inst::*;
+        // t = x·x − 1 shared; z·(t − x·x) is −z and y·(x·x − t) is y: the
+        // bicycle's front-contact rows had both (its rhs 991 → 968 ops).
+        let insts = vec![
+            Symbol(x),
+            Symbol(y),
+            Symbol(z),
+            Const(Number::ONE),
+            Mul(0, 0),
+            Sub(4, 3),
+            Sub(5, 4),
+            Mul(2, 6),
+            Sub(4, 5),
+            Mul(1, 8),
+            // (x + y) − x is y, and (y − z) + z is y.
+            Add(0, 1),
+            Sub(10, 0),
+            Sub(1, 2),
+            Add(12, 2),
+            Mul(11, 13),
+        ];
+        let outputs = vec![7, 9, 14];
+        let (after, outs) = prune_pair(cancel_terms(insts, outputs));
+        let program = Program {
+            parameter_only: vec![false; after.len()],
+            uses: use_counts(&after, &outs),
+            insts: after,
+            outputs: outs,
+        };
+        let got = program.eval(&values(&g)).unwrap();
+        assert_eq!(got, vec![-2.1, -1.3, 1.3 * 1.3]);
+        let ops = program.op_count();
+        // −z, y as is, and y·y: one negation and one product.
+        assert_eq!(
+            (ops.neg, ops.mul, ops.add, ops.total()),
+            (1, 1, 0, 2),
+            "{ops}"
+        );
     }
 
     #[test]
