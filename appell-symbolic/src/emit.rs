@@ -1076,6 +1076,174 @@ fn cancel_terms(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
     })
 }
 
+/// Arithmetic modulo the Mersenne prime 2⁶¹ − 1, where
+/// [`share_equal_values`] evaluates programs exactly.
+mod modp {
+    pub const P: u64 = (1 << 61) - 1;
+
+    pub fn add(a: u64, b: u64) -> u64 {
+        let s = a + b;
+        if s >= P {
+            s - P
+        } else {
+            s
+        }
+    }
+
+    pub fn neg(a: u64) -> u64 {
+        if a == 0 {
+            0
+        } else {
+            P - a
+        }
+    }
+
+    pub fn mul(a: u64, b: u64) -> u64 {
+        let t = a as u128 * b as u128;
+        let r = ((t & P as u128) + (t >> 61)) as u64;
+        if r >= P {
+            r - P
+        } else {
+            r
+        }
+    }
+
+    pub fn pow(mut a: u64, mut e: u64) -> u64 {
+        let mut r = 1;
+        while e > 0 {
+            if e & 1 == 1 {
+                r = mul(r, a);
+            }
+            a = mul(a, a);
+            e >>= 1;
+        }
+        r
+    }
+
+    /// The inverse, or None for zero.
+    pub fn inv(a: u64) -> Option<u64> {
+        (a != 0).then(|| pow(a, P - 2))
+    }
+
+    /// An integer's residue.
+    pub fn int(n: i128) -> u64 {
+        let r = (n.unsigned_abs() % P as u128) as u64;
+        if n < 0 {
+            neg(r)
+        } else {
+            r
+        }
+    }
+}
+
+/// Number of random points [`share_equal_values`] compares at.
+const VALUE_POINTS: usize = 2;
+
+/// One instruction for each value that several compute in different forms.
+///
+/// The graph's canonical forms leave some equal values apart (a sum kept
+/// factored in one place and multiplied out in another); after lowering,
+/// such a pair is two instructions. Every instruction is evaluated exactly,
+/// modulo the prime 2⁶¹ − 1, at [`VALUE_POINTS`] pseudo-random points: each
+/// symbol, each call other than sine, cosine and tangent (a square root,
+/// say), each `atan2` and each non-integer constant stands for an
+/// independent random residue, and the sine and cosine of one argument for
+/// a random point of the unit circle (rationally parametrized). Two
+/// instructions with the same residues (or opposite ones) at every point
+/// are then the same rational function of those variables, except with a
+/// probability of about (degree / 2⁶¹)² (Schwartz–Zippel), and so the same
+/// value at every state; the later one is replaced by the earlier (or its
+/// negation). Identities that need more of a function's meaning than
+/// sin² + cos² = 1 (the double angle, √x² = |x|) are not found, which only
+/// misses a merge. Values change only by the rounding of the form dropped.
+fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+    use modp::*;
+    let n = insts.len();
+    let mix = |mut z: u64| {
+        z = z.wrapping_add(0x9E37_79B9_7F4A_7C15);
+        z = (z ^ (z >> 30)).wrapping_mul(0xBF58_476D_1CE4_E5B9);
+        z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
+        (z ^ (z >> 31)) % P
+    };
+    // A residue per instruction and point; None where a division by zero
+    // (a probability of about 2⁻⁶¹) leaves it undefined.
+    let mut values: Vec<Option<[u64; VALUE_POINTS]>> = Vec::with_capacity(n);
+    for (i, inst) in insts.iter().enumerate() {
+        let mut out = [0u64; VALUE_POINTS];
+        let mut defined = true;
+        for (k, slot) in out.iter_mut().enumerate() {
+            let v = |x: u32| values[x as usize].map(|v| v[k]);
+            let fresh = |tag: u64| mix(tag.wrapping_mul(31).wrapping_add(k as u64 + 1));
+            let r = match *inst {
+                Inst::Const(c) => Some(match c {
+                    Number::Rational { num, den } => {
+                        mul(int(num), inv(int(den)).expect("a non-zero denominator"))
+                    }
+                    Number::Float(_) => fresh(c.to_f64().to_bits() ^ 0xF1),
+                }),
+                Inst::Symbol(s) => Some(fresh(((s.0 as u64) << 4) ^ 0x5)),
+                Inst::Add(a, b) => v(a).zip(v(b)).map(|(a, b)| add(a, b)),
+                Inst::Sub(a, b) => v(a).zip(v(b)).map(|(a, b)| add(a, neg(b))),
+                Inst::Mul(a, b) => v(a).zip(v(b)).map(|(a, b)| mul(a, b)),
+                Inst::Div(a, b) => v(a).zip(v(b).and_then(inv)).map(|(a, b)| mul(a, b)),
+                Inst::Neg(a) => v(a).map(neg),
+                Inst::Powi(a, e) => v(a).and_then(|a| {
+                    let base = if e < 0 { inv(a)? } else { a };
+                    Some(pow(base, e.unsigned_abs() as u64))
+                }),
+                // The sine and cosine of one argument are a point of the
+                // unit circle, (2t, 1 − t²)/(1 + t²) for a t drawn from the
+                // argument's residue, so sin² + cos² = 1 holds exactly.
+                Inst::Call(f @ (Func::Sin | Func::Cos | Func::Tan), a) => v(a).and_then(|a| {
+                    let t = fresh(a ^ 0x7A);
+                    let d = inv(add(1, mul(t, t)))?;
+                    let sin = mul(add(t, t), d);
+                    let cos = mul(add(1, neg(mul(t, t))), d);
+                    Some(match f {
+                        Func::Sin => sin,
+                        Func::Cos => cos,
+                        _ => mul(sin, inv(cos)?),
+                    })
+                }),
+                // Other calls and atan2 are variables of their own.
+                Inst::Call(..) | Inst::Atan2(..) => Some(fresh(((i as u64) << 4) ^ 0xC)),
+            };
+            match r {
+                Some(r) => *slot = r,
+                None => defined = false,
+            }
+        }
+        values.push(defined.then_some(out));
+    }
+    let mut first: FxHashMap<[u64; VALUE_POINTS], u32> = FxHashMap::default();
+    let mut replace: Vec<Option<(u32, bool)>> = vec![None; n];
+    for (j, inst) in insts.iter().enumerate() {
+        if matches!(inst, Inst::Const(_) | Inst::Symbol(_)) {
+            continue;
+        }
+        let Some(v) = values[j] else { continue };
+        if v.iter().all(|&x| x == 0) {
+            continue;
+        }
+        if let Some(&i) = first.get(&v) {
+            replace[j] = Some((i, false));
+        } else if let Some(&i) = first.get(&v.map(neg)) {
+            replace[j] = Some((i, true));
+        } else {
+            first.insert(v, j as u32);
+        }
+    }
+    rewrite(insts, outputs, |j, _, out, map| {
+        let (i, negated) = replace[j]?;
+        let at = map[i as usize];
+        if !negated {
+            return Some(at);
+        }
+        out.push(Inst::Neg(at));
+        Some((out.len() - 1) as u32)
+    })
+}
+
 /// How deep a negation is carried through products and differences before
 /// it is given up (each step rewrites one more instruction).
 const MAX_SIGN_DEPTH: usize = 8;
@@ -1574,6 +1742,7 @@ impl Program {
         // only live instructions count as uses below.
         let (insts, outputs) = prune(l.insts, outputs);
         let (insts, outputs) = prune_pair(cancel_terms(insts, outputs));
+        let (insts, outputs) = prune_pair(share_equal_values(insts, outputs));
         let (insts, outputs) = share_reciprocals(insts, outputs);
         let (insts, outputs) = share_products(graph, insts, outputs);
         let (insts, outputs) = prune(insts, outputs);
@@ -2394,6 +2563,7 @@ mod sharing_tests {
         let mut g = Graph::new();
         // x + y is found in three sums (once with the opposite sign):
         // computed once, then one operation per sum (4 in all, against 6).
+        // The third sum is the second's negation, and may be written so.
         let p = check(
             &mut g,
             &[
@@ -2403,7 +2573,7 @@ mod sharing_tests {
             ],
         );
         let ops = p.op_count();
-        assert_eq!((ops.add, ops.neg), (4, 0), "{ops}");
+        assert_eq!(ops.add + ops.neg, 4, "{ops}");
     }
 
     #[test]
@@ -2477,6 +2647,34 @@ mod sharing_tests {
             (1, 1, 0, 2),
             "{ops}"
         );
+    }
+
+    #[test]
+    fn a_value_computed_in_two_forms_is_computed_once() {
+        let mut g = Graph::new();
+        let [x, y] = ["x", "y"].map(|n| g.declare(n, SymbolKind::Auxiliary).unwrap());
+        use Inst::*;
+        let insts = vec![
+            Symbol(x),
+            Symbol(y),
+            // (x + y)(x − y), x·x − y·y and y·y − x·x.
+            Add(0, 1),
+            Sub(0, 1),
+            Mul(2, 3),
+            Mul(0, 0),
+            Mul(1, 1),
+            Sub(5, 6),
+            Sub(6, 5),
+            // √(x·x)·√(x·x) equals x·x but reads a square root: kept.
+            Call(Func::Sqrt, 5),
+            Mul(9, 9),
+        ];
+        let outputs = vec![4, 7, 8, 10, 5];
+        let (after, outs) = prune_pair(share_equal_values(insts, outputs));
+        assert_eq!(outs[1], outs[0], "{after:?}");
+        assert_eq!(after[outs[2] as usize], Neg(outs[0]), "{after:?}");
+        assert_ne!(outs[3], outs[4], "{after:?}");
+        assert!(matches!(after[outs[3] as usize], Mul(..)), "{after:?}");
     }
 
     #[test]
