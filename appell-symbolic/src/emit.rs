@@ -1175,12 +1175,12 @@ fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u3
             let v = |x: u32| values[x as usize].map(|v| v[k]);
             let fresh = |tag: u64| mix(tag.wrapping_mul(31).wrapping_add(k as u64 + 1));
             let r = match *inst {
-                Inst::Const(c) => Some(match c {
-                    Number::Rational { num, den } => {
-                        mul(int(num), inv(int(den)).expect("a non-zero denominator"))
-                    }
-                    Number::Float(_) => fresh(c.to_f64().to_bits() ^ 0xF1),
-                }),
+                Inst::Const(c) => match c {
+                    // (A denominator that is a multiple of the prime leaves
+                    // the value undefined, like a division by zero.)
+                    Number::Rational { num, den } => inv(int(den)).map(|d| mul(int(num), d)),
+                    Number::Float(_) => Some(fresh(c.to_f64().to_bits() ^ 0xF1)),
+                },
                 Inst::Symbol(s) => Some(fresh(((s.0 as u64) << 4) ^ 0x5)),
                 Inst::Add(a, b) => v(a).zip(v(b)).map(|(a, b)| add(a, b)),
                 Inst::Sub(a, b) => v(a).zip(v(b)).map(|(a, b)| add(a, neg(b))),
