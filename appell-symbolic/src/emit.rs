@@ -1010,70 +1010,20 @@ fn rewrite(
     (out, outputs)
 }
 
+/// `−v` appended to `out`, folded into a constant or into a negation it
+/// undoes; returns its index.
+fn negated(out: &mut Vec<Inst>, v: u32) -> u32 {
+    match out[v as usize] {
+        Inst::Const(c) => out.push(Inst::Const(-c)),
+        Inst::Neg(y) => return y,
+        _ => out.push(Inst::Neg(v)),
+    }
+    (out.len() - 1) as u32
+}
+
 /// `prune` on a pair.
 fn prune_pair((insts, outputs): (Vec<Inst>, Vec<u32>)) -> (Vec<Inst>, Vec<u32>) {
     prune(insts, outputs)
-}
-
-/// Cancels a term added and subtracted that only the instructions show.
-///
-/// The graph cancels equal terms, but two different forms of one value (a
-/// sum written out here and kept factored there) become the same
-/// instruction only after lowering, which shares them; `(a − b) − a` can
-/// then appear. Here it is `−b`, `a − (a − b)` is `b`, `(a + b) − a` is `b`,
-/// `(a − b) + b` is `a`, and a product by ±1 that this leaves is its factor
-/// or its negation. Values change only by the rounding the removed
-/// operations did (they are more accurate); the engine evaluates the same
-/// program the compiled code runs, so both still agree to the bit.
-fn cancel_terms(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
-    // −v, folded into a constant or a negation it undoes.
-    fn negated(out: &mut Vec<Inst>, v: u32) -> u32 {
-        match out[v as usize] {
-            Inst::Const(c) => out.push(Inst::Const(-c)),
-            Inst::Neg(y) => return y,
-            _ => out.push(Inst::Neg(v)),
-        }
-        (out.len() - 1) as u32
-    }
-    rewrite(insts, outputs, |_, inst, out, map| {
-        let m = |x: u32| map[x as usize];
-        match *inst {
-            Inst::Sub(x, y) => {
-                let (x, y) = (m(x), m(y));
-                match (&out[x as usize], &out[y as usize]) {
-                    (&Inst::Sub(p, q), _) if p == y => Some(negated(out, q)),
-                    (_, &Inst::Sub(p, q)) if p == x => Some(q),
-                    (&Inst::Add(p, q), _) if p == y => Some(q),
-                    (&Inst::Add(p, q), _) if q == y => Some(p),
-                    _ => None,
-                }
-            }
-            Inst::Add(x, y) => {
-                let (x, y) = (m(x), m(y));
-                match (&out[x as usize], &out[y as usize]) {
-                    (&Inst::Sub(p, q), _) if q == y => Some(p),
-                    (_, &Inst::Sub(p, q)) if q == x => Some(p),
-                    _ => None,
-                }
-            }
-            Inst::Mul(x, y) => {
-                let (x, y) = (m(x), m(y));
-                let unit = |v: u32| match out[v as usize] {
-                    Inst::Const(c) if c.is_one() => Some(false),
-                    Inst::Const(c) if (-c).is_one() => Some(true),
-                    _ => None,
-                };
-                match (unit(x), unit(y)) {
-                    (_, Some(false)) => Some(x),
-                    (Some(false), _) => Some(y),
-                    (_, Some(true)) => Some(negated(out, x)),
-                    (Some(true), _) => Some(negated(out, y)),
-                    _ => None,
-                }
-            }
-            _ => None,
-        }
-    })
 }
 
 /// Arithmetic modulo the Mersenne prime 2⁶¹ − 1, where
@@ -1146,17 +1096,27 @@ const VALUE_POINTS: usize = 2;
 /// such a pair is two instructions. Every instruction is evaluated exactly,
 /// modulo the prime 2⁶¹ − 1, at [`VALUE_POINTS`] pseudo-random points: each
 /// symbol, each call other than sine, cosine and tangent (a square root,
-/// say), each `atan2` and each non-integer constant stands for an
-/// independent random residue, and the sine and cosine of one argument for
-/// a random point of the unit circle (rationally parametrized). Two
-/// instructions with the same residues (or opposite ones) at every point
-/// are then the same rational function of those variables, except with a
-/// probability of about (degree / 2⁶¹)² (Schwartz–Zippel), and so the same
-/// value at every state; the later one is replaced by the earlier (or its
-/// negation). Identities that need more of a function's meaning than
-/// sin² + cos² = 1 (the double angle, √x² = |x|) are not found, which only
-/// misses a merge. Values change only by the rounding of the form dropped.
-fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
+/// say), each `atan2`, each non-integer constant and each rational constant
+/// too large for the prime stands for an independent random residue, and
+/// the sine and cosine of one argument for a random point of the unit
+/// circle (rationally parametrized). Every kind of variable draws from its
+/// own stream, so a sine's argument that is a small integer cannot tie it to
+/// a symbol. Two instructions with the same residues (or opposite ones) at
+/// every point are then the same rational function of those variables,
+/// except with a probability of about (degree / 2⁶¹)² (Schwartz–Zippel), and
+/// so the same value at every state; the later one is replaced by the
+/// earlier (or its negation), which may be a symbol or a constant: `(a − b)
+/// − a` becomes `−b`. Identities that need more of a function's meaning
+/// than sin² + cos² = 1 (the double angle, √x² = |x|) are not found, which
+/// only misses a merge.
+///
+/// The earlier form is used only where it reads no auxiliary symbol (the
+/// unknowns of a solve, which a staged program computes between stages) or
+/// acceleration the later one does not, and reads the state only if the
+/// later one does: a value stays in its stage, and a parameter-only value
+/// stays computed once per parameter set. Values change only by the
+/// rounding of the form dropped.
+fn share_equal_values(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u32>) {
     use modp::*;
     let n = insts.len();
     let mix = |mut z: u64| {
@@ -1165,6 +1125,46 @@ fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u3
         z = (z ^ (z >> 27)).wrapping_mul(0x94D0_49BB_1331_11EB);
         (z ^ (z >> 31)) % P
     };
+    // The streams the kinds of variable draw from.
+    const FLOAT: u64 = 0xF10A_7000_0000_0001;
+    const RATIONAL: u64 = 0x4A71_0000_0000_0002;
+    const SYMBOL: u64 = 0x5E4B_0000_0000_0003;
+    const CIRCLE: u64 = 0xC14C_1E00_0000_0004;
+    const CALL: u64 = 0xCA11_0000_0000_0005;
+    // What each instruction reads, directly or not, that an equal earlier
+    // form may not add: bit 0 for any symbol other than a parameter, then a
+    // bit per auxiliary symbol or acceleration; `words` words each.
+    let mut late_bit: FxHashMap<Symbol, usize> = FxHashMap::default();
+    for inst in &insts {
+        if let Inst::Symbol(s) = *inst {
+            if matches!(
+                graph.symbol_kind(s),
+                SymbolKind::Auxiliary | SymbolKind::Acceleration(_)
+            ) {
+                let next = late_bit.len() + 1;
+                late_bit.entry(s).or_insert(next);
+            }
+        }
+    }
+    let words = (late_bit.len() + 1).div_ceil(64);
+    let mut reads = vec![0u64; n * words];
+    for (i, inst) in insts.iter().enumerate() {
+        if let Inst::Symbol(s) = *inst {
+            if graph.symbol_kind(s) != SymbolKind::Parameter {
+                reads[i * words] |= 1;
+            }
+            if let Some(&bit) = late_bit.get(&s) {
+                reads[i * words + bit / 64] |= 1 << (bit % 64);
+            }
+        }
+        for x in inst.operands() {
+            for w in 0..words {
+                reads[i * words + w] |= reads[x as usize * words + w];
+            }
+        }
+    }
+    let reads_within =
+        |i: usize, j: usize| (0..words).all(|w| reads[i * words + w] & !reads[j * words + w] == 0);
     // A residue per instruction and point; None where a division by zero
     // (a probability of about 2⁻⁶¹) leaves it undefined.
     let mut values: Vec<Option<[u64; VALUE_POINTS]>> = Vec::with_capacity(n);
@@ -1173,15 +1173,23 @@ fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u3
         let mut defined = true;
         for (k, slot) in out.iter_mut().enumerate() {
             let v = |x: u32| values[x as usize].map(|v| v[k]);
-            let fresh = |tag: u64| mix(tag.wrapping_mul(31).wrapping_add(k as u64 + 1));
+            let fresh = |kind: u64, x: u64| mix(mix(x ^ kind).wrapping_add(k as u64 + 1));
             let r = match *inst {
                 Inst::Const(c) => match c {
-                    // (A denominator that is a multiple of the prime leaves
-                    // the value undefined, like a division by zero.)
-                    Number::Rational { num, den } => inv(int(den)).map(|d| mul(int(num), d)),
-                    Number::Float(_) => Some(fresh(c.to_f64().to_bits() ^ 0xF1)),
+                    Number::Rational { num, den }
+                        if num.unsigned_abs() < P as u128 && den.unsigned_abs() < P as u128 =>
+                    {
+                        inv(int(den)).map(|d| mul(int(num), d))
+                    }
+                    // Too large for the prime: two such constants could
+                    // share a residue, so each is a variable of its own.
+                    Number::Rational { num, den } => {
+                        let fold = |x: i128| mix(x as u64) ^ ((x >> 64) as u64);
+                        Some(fresh(RATIONAL, fold(num) ^ mix(fold(den))))
+                    }
+                    Number::Float(_) => Some(fresh(FLOAT, c.to_f64().to_bits())),
                 },
-                Inst::Symbol(s) => Some(fresh(((s.0 as u64) << 4) ^ 0x5)),
+                Inst::Symbol(s) => Some(fresh(SYMBOL, s.0 as u64)),
                 Inst::Add(a, b) => v(a).zip(v(b)).map(|(a, b)| add(a, b)),
                 Inst::Sub(a, b) => v(a).zip(v(b)).map(|(a, b)| add(a, neg(b))),
                 Inst::Mul(a, b) => v(a).zip(v(b)).map(|(a, b)| mul(a, b)),
@@ -1195,7 +1203,7 @@ fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u3
                 // unit circle, (2t, 1 − t²)/(1 + t²) for a t drawn from the
                 // argument's residue, so sin² + cos² = 1 holds exactly.
                 Inst::Call(f @ (Func::Sin | Func::Cos | Func::Tan), a) => v(a).and_then(|a| {
-                    let t = fresh(a ^ 0x7A);
+                    let t = fresh(CIRCLE, a);
                     let d = inv(add(1, mul(t, t)))?;
                     let sin = mul(add(t, t), d);
                     let cos = mul(add(1, neg(mul(t, t))), d);
@@ -1206,7 +1214,7 @@ fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u3
                     })
                 }),
                 // Other calls and atan2 are variables of their own.
-                Inst::Call(..) | Inst::Atan2(..) => Some(fresh(((i as u64) << 4) ^ 0xC)),
+                Inst::Call(..) | Inst::Atan2(..) => Some(fresh(CALL, i as u64)),
             };
             match r {
                 Some(r) => *slot = r,
@@ -1215,32 +1223,34 @@ fn share_equal_values(insts: Vec<Inst>, outputs: Vec<u32>) -> (Vec<Inst>, Vec<u3
         }
         values.push(defined.then_some(out));
     }
-    let mut first: FxHashMap<[u64; VALUE_POINTS], u32> = FxHashMap::default();
+    // The instructions met so far, by value, earliest first; constants and
+    // symbols are among them but are never replaced themselves.
+    let mut earlier: FxHashMap<[u64; VALUE_POINTS], Vec<u32>> = FxHashMap::default();
     let mut replace: Vec<Option<(u32, bool)>> = vec![None; n];
     for (j, inst) in insts.iter().enumerate() {
-        if matches!(inst, Inst::Const(_) | Inst::Symbol(_)) {
-            continue;
-        }
         let Some(v) = values[j] else { continue };
         if v.iter().all(|&x| x == 0) {
             continue;
         }
-        if let Some(&i) = first.get(&v) {
-            replace[j] = Some((i, false));
-        } else if let Some(&i) = first.get(&v.map(neg)) {
-            replace[j] = Some((i, true));
-        } else {
-            first.insert(v, j as u32);
+        let leaf = matches!(inst, Inst::Const(_) | Inst::Symbol(_));
+        if !leaf {
+            let usable = |key: &[u64; VALUE_POINTS]| {
+                earlier
+                    .get(key)
+                    .and_then(|c| c.iter().copied().find(|&i| reads_within(i as usize, j)))
+            };
+            replace[j] = usable(&v)
+                .map(|i| (i, false))
+                .or_else(|| usable(&v.map(neg)).map(|i| (i, true)));
+        }
+        if replace[j].is_none() {
+            earlier.entry(v).or_default().push(j as u32);
         }
     }
     rewrite(insts, outputs, |j, _, out, map| {
-        let (i, negated) = replace[j]?;
+        let (i, is_negated) = replace[j]?;
         let at = map[i as usize];
-        if !negated {
-            return Some(at);
-        }
-        out.push(Inst::Neg(at));
-        Some((out.len() - 1) as u32)
+        Some(if is_negated { negated(out, at) } else { at })
     })
 }
 
@@ -1741,8 +1751,7 @@ impl Program {
         // their common factors are taken out): drop them first, so that
         // only live instructions count as uses below.
         let (insts, outputs) = prune(l.insts, outputs);
-        let (insts, outputs) = prune_pair(cancel_terms(insts, outputs));
-        let (insts, outputs) = prune_pair(share_equal_values(insts, outputs));
+        let (insts, outputs) = prune_pair(share_equal_values(graph, insts, outputs));
         let (insts, outputs) = share_reciprocals(insts, outputs);
         let (insts, outputs) = share_products(graph, insts, outputs);
         let (insts, outputs) = prune(insts, outputs);
@@ -2631,7 +2640,7 @@ mod sharing_tests {
             Mul(11, 13),
         ];
         let outputs = vec![7, 9, 14];
-        let (after, outs) = prune_pair(cancel_terms(insts, outputs));
+        let (after, outs) = prune_pair(share_equal_values(&g, insts, outputs));
         let program = Program {
             parameter_only: vec![false; after.len()],
             uses: use_counts(&after, &outs),
@@ -2670,11 +2679,50 @@ mod sharing_tests {
             Mul(9, 9),
         ];
         let outputs = vec![4, 7, 8, 10, 5];
-        let (after, outs) = prune_pair(share_equal_values(insts, outputs));
+        let (after, outs) = prune_pair(share_equal_values(&g, insts, outputs));
         assert_eq!(outs[1], outs[0], "{after:?}");
         assert_eq!(after[outs[2] as usize], Neg(outs[0]), "{after:?}");
         assert_ne!(outs[3], outs[4], "{after:?}");
         assert!(matches!(after[outs[3] as usize], Mul(..)), "{after:?}");
+    }
+
+    #[test]
+    fn an_equal_earlier_form_that_reads_more_is_not_used() {
+        let mut g = Graph::new();
+        let p = g.parameter("p").unwrap();
+        let x = g.declare("x", SymbolKind::Coordinate).unwrap();
+        let a = g.declare("a", SymbolKind::Auxiliary).unwrap();
+        use Inst::*;
+        let insts = vec![
+            Symbol(p),
+            Symbol(x),
+            Symbol(a),
+            // (p + x)·p − x·p reads the state; p·p, later, is computed once
+            // per parameter set and stays so.
+            Add(0, 1),
+            Mul(3, 0),
+            Mul(1, 0),
+            Sub(4, 5),
+            Mul(0, 0),
+            // (x + a)·x − a·x reads the unknown a of a later stage; x·x,
+            // later, must not wait for it.
+            Add(1, 2),
+            Mul(8, 1),
+            Mul(2, 1),
+            Sub(9, 10),
+            Mul(1, 1),
+            // (x·x + a) − a reads x and a, like both forms of x·x before
+            // it: either may stand for it.
+            Add(12, 2),
+            Sub(13, 2),
+        ];
+        let outputs = vec![6, 7, 11, 12, 14];
+        let (after, outs) = prune_pair(share_equal_values(&g, insts, outputs));
+        assert_ne!(outs[1], outs[0], "{after:?}");
+        assert_eq!(after[outs[1] as usize], Mul(0, 0), "{after:?}");
+        assert_ne!(outs[3], outs[2], "{after:?}");
+        assert!([outs[2], outs[3]].contains(&outs[4]), "{after:?}");
+        assert_eq!(after.len(), 13, "{after:?}");
     }
 
     #[test]

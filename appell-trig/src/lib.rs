@@ -2,7 +2,11 @@
 //! appell. The engine (`appell-symbolic`, which evaluates and folds
 //! expressions) and the runtime (whose scalar trait the generated code
 //! calls) both use this crate, so the engine's numbers and the compiled
-//! code's agree to the bit.
+//! code's agree to the bit when both are built with the same target
+//! features and with `std` (the kernel uses FMA only then). A build for
+//! `--target` with other features than the host's, which builds the macro
+//! for the host, or a runtime without `std`, agrees to rounding: a few
+//! ulps.
 //!
 //! Every angle a model reads enters the rhs through its sine and cosine,
 //! and everything after depends on them, so their latency opens the
