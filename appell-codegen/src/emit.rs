@@ -607,9 +607,20 @@ impl Emitter<'_> {
     /// long before f, the division runs while f is computed, and the
     /// substitution that waits on f multiplies (about 4 cycles) instead of
     /// dividing (about 14): the bicycle's rhs 1.5–2% faster natively than
-    /// with that division kept, and 3–5% faster than with none kept.
+    /// with that division kept, and 3–5% faster than with none kept. With a
+    /// constant M the factors are computed once per parameter set, so every
+    /// reciprocal is kept there and the rhs divides by no pivot.
     fn pivot_reciprocal(&self, j: usize) -> bool {
-        j + 1 < self.d.l || matches!(self.d.elimination, Elimination::Numeric(_))
+        j + 1 < self.d.l
+            || matches!(self.d.elimination, Elimination::Numeric(_))
+            || self.constant_mass()
+    }
+
+    /// Whether M depends on parameters only: its factorization then moves
+    /// into `prepare`, and the rhs keeps only the two triangular solves.
+    fn constant_mass(&self) -> bool {
+        let d = self.d;
+        d.l > 0 && d.mass.iter().all(|&e| d.model.g.is_parameter_only(e))
     }
 
     /// `value / d_j`, as a product with `__r_j` when it is kept.
@@ -788,9 +799,7 @@ impl Emitter<'_> {
         let qdot = &d.qdot;
 
         // --- rhs: M, f and the retained coordinates' rates, hoisted. ---
-        // When M depends on parameters only, its factorization moves into
-        // `prepare` and the rhs keeps only the two triangular solves.
-        let constant_mass = l > 0 && d.mass.iter().all(|&e| g.is_parameter_only(e));
+        let constant_mass = self.constant_mass();
         let mut tri_roots: Vec<Id> = Vec::new();
         for i in 0..l {
             for j in 0..=i {

@@ -90,4 +90,11 @@ fn ldlt_keeps_a_pivots_reciprocal_where_it_saves_a_division_or_waits_for_f() {
     )));
     assert!(out.contains("__w_1 = __z_1 * __r_1"), "{out}");
     assert!(!out.contains("__z_1 / __d_1"), "{out}");
+    // A constant M: the factors, the last pivot's reciprocal among them,
+    // are computed in `prepare`, and the rhs divides by no pivot.
+    let out = expand_str(&wheel_axle_struct());
+    assert!(out.contains("let __r_1 = "), "{out}");
+    assert!(out.contains("__w_1 = __z_1 * __r_1"), "{out}");
+    assert!(!out.contains("__z_0 / __d_0"), "{out}");
+    assert!(!out.contains("__z_1 / __d_1"), "{out}");
 }
