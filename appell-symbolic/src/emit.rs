@@ -1132,8 +1132,10 @@ fn share_equal_values(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Ve
     const CIRCLE: u64 = 0xC14C_1E00_0000_0004;
     const CALL: u64 = 0xCA11_0000_0000_0005;
     // What each instruction reads, directly or not, that an equal earlier
-    // form may not add: bit 0 for any symbol other than a parameter, then a
-    // bit per auxiliary symbol or acceleration; `words` words each.
+    // form may not add: the state (`parameter_only_flags`), and the
+    // auxiliary symbols and accelerations, a bit each, `words` words per
+    // instruction.
+    let parameter = parameter_only_flags(graph, &insts);
     let mut late_bit: FxHashMap<Symbol, usize> = FxHashMap::default();
     for inst in &insts {
         if let Inst::Symbol(s) = *inst {
@@ -1141,30 +1143,30 @@ fn share_equal_values(graph: &Graph, insts: Vec<Inst>, outputs: Vec<u32>) -> (Ve
                 graph.symbol_kind(s),
                 SymbolKind::Auxiliary | SymbolKind::Acceleration(_)
             ) {
-                let next = late_bit.len() + 1;
+                let next = late_bit.len();
                 late_bit.entry(s).or_insert(next);
             }
         }
     }
-    let words = (late_bit.len() + 1).div_ceil(64);
-    let mut reads = vec![0u64; n * words];
+    let words = late_bit.len().div_ceil(64).max(1);
+    let mut late = vec![0u64; n * words];
     for (i, inst) in insts.iter().enumerate() {
-        if let Inst::Symbol(s) = *inst {
-            if graph.symbol_kind(s) != SymbolKind::Parameter {
-                reads[i * words] |= 1;
-            }
-            if let Some(&bit) = late_bit.get(&s) {
-                reads[i * words + bit / 64] |= 1 << (bit % 64);
-            }
+        if let Some(&bit) = match *inst {
+            Inst::Symbol(s) => late_bit.get(&s),
+            _ => None,
+        } {
+            late[i * words + bit / 64] |= 1 << (bit % 64);
         }
         for x in inst.operands() {
             for w in 0..words {
-                reads[i * words + w] |= reads[x as usize * words + w];
+                late[i * words + w] |= late[x as usize * words + w];
             }
         }
     }
-    let reads_within =
-        |i: usize, j: usize| (0..words).all(|w| reads[i * words + w] & !reads[j * words + w] == 0);
+    let reads_within = |i: usize, j: usize| {
+        (parameter[i] || !parameter[j])
+            && (0..words).all(|w| late[i * words + w] & !late[j * words + w] == 0)
+    };
     // A residue per instruction and point; None where a division by zero
     // (a probability of about 2⁻⁶¹) leaves it undefined.
     let mut values: Vec<Option<[u64; VALUE_POINTS]>> = Vec::with_capacity(n);
