@@ -1,0 +1,146 @@
+//! Every model in the repository, expanded, against a committed snapshot.
+//!
+//! The derive's output is its contract with the compiled code: a
+//! restructuring of the derivation must keep every expansion byte-identical,
+//! and a change that means to alter generated code shows here as a diff.
+//! The models are found, not listed: every struct deriving `Appell` in the
+//! workspace's examples, tests (UI cases included, whose expansion is the
+//! error) and benches. A struct written inside a `macro_rules!` body (the
+//! gyroscopes of `tests/composite_bodies.rs`) is not seen.
+//!
+//! `APPELL_BLESS=1 cargo test -p appell-codegen --test snapshots` writes the
+//! snapshots anew; review the diff before committing it.
+
+use std::path::{Path, PathBuf};
+
+use syn::visit::Visit;
+
+/// Folders searched for models, relative to the workspace root.
+const SOURCES: &[&str] = &["examples", "tests", "benches", "appell-nostd-check/src"];
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace root")
+        .to_path_buf()
+}
+
+fn snapshot_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/snapshots")
+}
+
+fn rust_files(dir: &Path, out: &mut Vec<PathBuf>) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    let mut paths: Vec<PathBuf> = entries.map(|e| e.expect("entry").path()).collect();
+    paths.sort();
+    for p in paths {
+        if p.is_dir() {
+            rust_files(&p, out);
+        } else if p.extension().is_some_and(|e| e == "rs") {
+            out.push(p);
+        }
+    }
+}
+
+/// Structs deriving `Appell`, wherever they sit in a file (modules and
+/// function bodies included).
+#[derive(Default)]
+struct Models(Vec<syn::ItemStruct>);
+
+impl<'ast> Visit<'ast> for Models {
+    fn visit_item_struct(&mut self, item: &'ast syn::ItemStruct) {
+        let derives_appell = item.attrs.iter().any(|a| {
+            a.path().is_ident("derive")
+                && a.parse_args_with(
+                    syn::punctuated::Punctuated::<syn::Path, syn::Token![,]>::parse_terminated,
+                )
+                .is_ok_and(|paths| {
+                    paths
+                        .iter()
+                        .any(|p| p.segments.last().is_some_and(|s| s.ident == "Appell"))
+                })
+        });
+        if derives_appell {
+            self.0.push(item.clone());
+        }
+        syn::visit::visit_item_struct(self, item);
+    }
+}
+
+/// The expansion as text, one statement a line so a change reads as a diff.
+fn expansion_text(item: &syn::ItemStruct) -> String {
+    let input = syn::DeriveInput::from(item.clone());
+    let text = appell_codegen::expand(&input).to_string();
+    let mut out = text.replace("; ", ";\n");
+    out.push('\n');
+    out
+}
+
+/// Every model: (snapshot name, expansion).
+fn expansions() -> Vec<(String, String)> {
+    let root = workspace_root();
+    let mut files = Vec::new();
+    for dir in SOURCES {
+        rust_files(&root.join(dir), &mut files);
+    }
+    let mut out = Vec::new();
+    for file in files {
+        let src = std::fs::read_to_string(&file).expect("read");
+        let Ok(parsed) = syn::parse_file(&src) else {
+            continue;
+        };
+        let mut models = Models::default();
+        models.visit_file(&parsed);
+        let rel = file.strip_prefix(&root).expect("inside root");
+        let stem = rel
+            .with_extension("")
+            .to_string_lossy()
+            .replace(['/', '\\'], "__");
+        for item in &models.0 {
+            out.push((format!("{stem}__{}.txt", item.ident), expansion_text(item)));
+        }
+    }
+    out
+}
+
+#[test]
+fn every_models_expansion_matches_its_snapshot() {
+    let dir = snapshot_dir();
+    let bless = std::env::var_os("APPELL_BLESS").is_some();
+    let all = expansions();
+    assert!(all.len() >= 40, "found only {} models", all.len());
+    let mut failures = Vec::new();
+    for (name, text) in &all {
+        let path = dir.join(name);
+        if bless {
+            std::fs::create_dir_all(&dir).expect("snapshot dir");
+            std::fs::write(&path, text).expect("write snapshot");
+            continue;
+        }
+        match std::fs::read_to_string(&path) {
+            Ok(old) if old == *text => {}
+            Ok(old) => {
+                let line = old
+                    .lines()
+                    .zip(text.lines())
+                    .position(|(a, b)| a != b)
+                    .unwrap_or(old.lines().count().min(text.lines().count()));
+                failures.push(format!("{name}: differs from line {}", line + 1));
+            }
+            Err(_) => failures.push(format!("{name}: no snapshot (run with APPELL_BLESS=1)")),
+        }
+    }
+    if !bless {
+        let known: std::collections::BTreeSet<&str> = all.iter().map(|(n, _)| n.as_str()).collect();
+        for entry in std::fs::read_dir(&dir).expect("snapshot dir") {
+            let name = entry.expect("entry").file_name();
+            let name = name.to_string_lossy();
+            if !known.contains(name.as_ref()) {
+                failures.push(format!("{name}: snapshot of a model that no longer exists"));
+            }
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
