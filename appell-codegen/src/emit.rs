@@ -145,7 +145,12 @@ impl Emitter<'_> {
         let d = self.d;
         let model = &d.model;
         let mut s = String::new();
-        let mut names: Vec<String> = d.retained.iter().map(|&r| self.coord(r)).collect();
+        let mut names: Vec<String> = d
+            .reduction
+            .retained
+            .iter()
+            .map(|&r| self.coord(r))
+            .collect();
         names.extend(model.speed_specs.iter().map(|sp| {
             let name = d.model.g.symbol_name(sp.symbol).to_string();
             match sp.coordinate {
@@ -177,7 +182,12 @@ impl Emitter<'_> {
         // retained coordinates and the parameters only (so the state
         // determines it).
         let g = &model.g;
-        let retained: Vec<Symbol> = d.retained.iter().map(|&r| model.coords[r].1.q).collect();
+        let retained: Vec<Symbol> = d
+            .reduction
+            .retained
+            .iter()
+            .map(|&r| model.coords[r].1.q)
+            .collect();
         let checked: Vec<&(Id, String)> = model
             .norms
             .iter()
@@ -201,7 +211,7 @@ impl Emitter<'_> {
                     .params_as(true)
                     .replace("        let ", "                let "),
             );
-            for (k, &r) in d.retained.iter().enumerate() {
+            for (k, &r) in d.reduction.retained.iter().enumerate() {
                 let _ = writeln!(s, "                let {} = __state[{k}];", self.coord(r));
             }
             for st in c.prepare.iter().chain(&c.body) {
@@ -620,7 +630,11 @@ impl Emitter<'_> {
     /// into `prepare`, and the rhs keeps only the two triangular solves.
     fn constant_mass(&self) -> bool {
         let d = self.d;
-        d.l > 0 && d.mass.iter().all(|&e| d.model.g.is_parameter_only(e))
+        d.l > 0
+            && d.equations
+                .mass
+                .iter()
+                .all(|&e| d.model.g.is_parameter_only(e))
     }
 
     /// `value / d_j`, as a product with `__r_j` when it is kept.
@@ -741,15 +755,15 @@ impl Emitter<'_> {
             params = list(model.params.iter().map(|p| p.ident.to_string()).collect()),
             all = coords(&(0..d.n).collect::<Vec<_>>()),
             speeds = list(model.speed_specs.iter().map(|sp| sp.name.clone()).collect()),
-            dependent = coords(&d.dependent),
-            cyclic = coords(&d.cyclic),
-            ignorable = coords(&d.ignorable),
-            retained = coords(&d.retained),
+            dependent = coords(&d.speeds.dependent),
+            cyclic = coords(&d.reduction.cyclic),
+            ignorable = coords(&d.reduction.ignorable),
+            retained = coords(&d.reduction.retained),
             inputs = list(model.inputs.iter().map(|(i, _)| i.to_string()).collect()),
             effects = list(model.effects.clone()),
             outputs = list(model.outputs.clone()),
             row_sources = d
-                .row_sources
+                .constraints.sources
                 .iter()
                 .map(|r| match r {
                     RowSource::Holonomic(i) => format!("{P}::RowSource::Holonomic {{ index: {i} }}"),
@@ -773,7 +787,7 @@ impl Emitter<'_> {
                 ))
                 .collect::<Vec<_>>()
                 .join(", "),
-            holo = d.holonomic.len(),
+            holo = d.constraints.holonomic.len(),
             m = d.m,
             bodies = bodies.join(", "),
             nf = model.forces.len(),
@@ -794,16 +808,16 @@ impl Emitter<'_> {
         let (n, m, l) = (d.n, d.m, d.l);
         let ni = model.inputs.len();
         let np = model.params.len();
-        let ns = d.retained.len() + l;
+        let ns = d.reduction.retained.len() + l;
         let g = &model.g;
-        let qdot = &d.qdot;
+        let qdot = &d.map.qdot;
 
         // --- rhs: M, f and the retained coordinates' rates, hoisted. ---
         let constant_mass = self.constant_mass();
         let mut tri_roots: Vec<Id> = Vec::new();
         for i in 0..l {
             for j in 0..=i {
-                tri_roots.push(d.mass[i * l + j]);
+                tri_roots.push(d.equations.mass[i * l + j]);
             }
         }
         let mut roots: Vec<Id> = if constant_mass {
@@ -811,8 +825,8 @@ impl Emitter<'_> {
         } else {
             tri_roots.clone()
         };
-        roots.extend(&d.forcing);
-        for &r in &d.retained {
+        roots.extend(&d.equations.forcing);
+        for &r in &d.reduction.retained {
             roots.push(qdot[r]);
         }
         let (rhs, rhs_text, elim_ops) = self.staged_rhs(&roots);
@@ -868,7 +882,7 @@ impl Emitter<'_> {
         let ldlt = format!("{factor_text}{solve_text}");
         let ldlt_ops = factor_ops + solve_ops;
         let mut bind_state = String::new();
-        for (k, &r) in d.retained.iter().enumerate() {
+        for (k, &r) in d.reduction.retained.iter().enumerate() {
             let _ = writeln!(bind_state, "        let {} = __state[{k}];", self.coord(r));
         }
         for (k, spec) in model.speed_specs.iter().enumerate() {
@@ -876,11 +890,11 @@ impl Emitter<'_> {
                 bind_state,
                 "        let {} = __state[{}];",
                 g.symbol_name(spec.symbol),
-                d.retained.len() + k
+                d.reduction.retained.len() + k
             );
         }
         let mut write_out = String::new();
-        for (k, _) in d.retained.iter().enumerate() {
+        for (k, _) in d.reduction.retained.iter().enumerate() {
             let _ = writeln!(
                 write_out,
                 "        __dstate[{k}] = {};",
@@ -891,7 +905,7 @@ impl Emitter<'_> {
             let _ = writeln!(
                 write_out,
                 "        __dstate[{}] = __y_{k};",
-                d.retained.len() + k
+                d.reduction.retained.len() + k
             );
         }
         let mut prepare = String::new();
@@ -910,26 +924,26 @@ impl Emitter<'_> {
         let info = self.info(rhs.ops, ldlt_ops + elim_ops);
 
         // --- mass matrix and forcing ---
-        let mut mf_roots = d.mass.clone();
-        mf_roots.extend(&d.forcing);
+        let mut mf_roots = d.equations.mass.clone();
+        mf_roots.extend(&d.equations.forcing);
         let mf = code(d, &mf_roots, &options(false));
         let (elim_full, _) = self.elimination(true);
         let (elim_pos, _) = self.elimination(false);
 
         // --- speed transform, coordinate rates, kinetic energy ---
-        let mut ct_roots = d.c.clone();
-        ct_roots.extend(&d.c0);
+        let mut ct_roots = d.map.c.clone();
+        ct_roots.extend(&d.map.c0);
         let ct = code(d, &ct_roots, &options(false));
         let cr = code(d, qdot, &options(false));
-        let ke = code(d, &[d.kinetic], &options(false));
-        let pe = code(d, &[d.potential], &options(false));
-        let ip = code(d, &[d.input_power], &options(false));
-        let mut sd_roots = d.speed_w.clone();
-        sd_roots.extend(&d.speed_w0);
+        let ke = code(d, &[d.energies.kinetic], &options(false));
+        let pe = code(d, &[d.energies.potential], &options(false));
+        let ip = code(d, &[d.energies.input_power], &options(false));
+        let mut sd_roots = d.speeds.w.clone();
+        sd_roots.extend(&d.speeds.w0);
         let sd = code(d, &sd_roots, &options(false));
 
         // --- constraint residuals: holonomic f(q,t), rows D q̇ + d ---
-        let mut res_roots = d.holonomic.clone();
+        let mut res_roots = d.constraints.holonomic.clone();
         res_roots.extend(&d.velocity_residuals);
         let res = code(d, &res_roots, &options(false));
 
@@ -958,8 +972,8 @@ impl Emitter<'_> {
             }
         }
         let poses = code(d, &pose_roots, &options(false));
-        let mut rows_roots = d.d_rows.clone();
-        rows_roots.extend(&d.d0);
+        let mut rows_roots = d.constraints.d.clone();
+        rows_roots.extend(&d.constraints.d0);
         let rows = code(d, &rows_roots, &options(false));
         let mut geo_roots = Vec::new();
         for f in &model.forces {
@@ -985,7 +999,7 @@ impl Emitter<'_> {
         for r in &model.rolling {
             contact_roots.extend(r.contact);
         }
-        for src in &d.row_sources {
+        for src in &d.constraints.sources {
             match *src {
                 RowSource::Rolling { contact, direction } => match &model.rolling[contact].along {
                     Some(dirs) => contact_roots.extend(dirs[direction]),
@@ -1155,7 +1169,7 @@ impl Emitter<'_> {
             chk_c0 = self.check("__c0", n),
             chk_qdot = self.check("__qdot", n),
             chk_qdot_in = self.check("__qdot", n),
-            chk_hol = self.check("__holonomic", d.holonomic.len()),
+            chk_hol = self.check("__holonomic", d.constraints.holonomic.len()),
             chk_vel = self.check("__velocity", m),
             chk_w = self.check("__w", l * n),
             chk_w0 = self.check("__w0", l),
@@ -1216,7 +1230,7 @@ impl Emitter<'_> {
             res_body = statements(&res),
             res_out = {
                 let mut s = String::new();
-                let nh = d.holonomic.len();
+                let nh = d.constraints.holonomic.len();
                 for i in 0..nh {
                     let _ = writeln!(s, "        __holonomic[{i}] = {};", res.outputs[i]);
                 }

@@ -17,6 +17,7 @@
 // index loops keep the formulas recognisable.
 #![allow(clippy::needless_range_loop)]
 
+pub mod algebra;
 pub mod ast;
 pub mod ctxt;
 pub mod derivation;

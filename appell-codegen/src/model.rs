@@ -12,13 +12,11 @@ use appell_symbolic::{
     Coordinate, Graph, Id, Number, RateRules, Symbol, SymbolKind, SymbolicError,
 };
 
+use crate::algebra::{cross, dot, mat_mul, mat_t_vec};
 use crate::ast::*;
 use crate::ctxt::{did_you_mean, Ctxt};
 
-/// A vector in N components.
-pub type Vec3 = [Id; 3];
-/// A 3×3 matrix, row-major.
-pub type Mat3 = [[Id; 3]; 3];
+pub use crate::algebra::{Mat3, Vec3};
 
 /// A parameter (struct field).
 #[derive(Clone)]
@@ -197,12 +195,6 @@ pub struct Model {
     pub twin: Option<Box<Model>>,
     /// The twin's direction-cosine symbols (empty in the model itself).
     pub cuts: Vec<Cut>,
-    /// Fold composites and rotors even where that costs operations (for
-    /// tests that compare folded and unfolded equations).
-    pub fold_always: bool,
-    /// Write every rotor's terms whole (`Some(true)`) or split
-    /// (`Some(false)`) instead of the cheaper (for tests of both forms).
-    pub rotor_form: Option<bool>,
 }
 
 /// A direction cosine standing as a symbol in the twin model: its rate is a
@@ -569,8 +561,6 @@ fn build_in(cx: &Ctxt, ast: &ModelAst, mut g: Graph, cut_from: Option<Vec<Mat3>>
         norms: b.norms,
         twin: None,
         cuts: b.cuts,
-        fold_always: false,
-        rotor_form: None,
     })
 }
 
@@ -885,7 +875,7 @@ impl Builder<'_> {
     /// evaluate counts as not fixed).
     fn fixed_in(&mut self, u: Vec3, rot: &Mat3) -> Result<bool, SymbolicError> {
         let g = &mut self.g;
-        let local = mat_vec3(g, rot, u, true)?;
+        let local = mat_t_vec(g, rot, u)?;
         let rules = RateRules::coordinates();
         let rates = [
             g.time_derivative(local[0], &rules)?,
@@ -1581,55 +1571,7 @@ fn simple_rotation(g: &mut Graph, k: usize, c: Id, s: Id) -> Result<Mat3, Symbol
     })
 }
 
-/// `a · b` of 3×3 matrices.
-pub fn mat_mul(g: &mut Graph, a: &Mat3, b: &Mat3) -> Result<Mat3, SymbolicError> {
-    let zero = g.int(0)?;
-    let mut out = [[zero; 3]; 3];
-    for i in 0..3 {
-        for j in 0..3 {
-            let t: Vec<Id> = (0..3)
-                .map(|k| g.mul(a[i][k], b[k][j]))
-                .collect::<Result<_, _>>()?;
-            out[i][j] = g.sum(&t)?;
-        }
-    }
-    Ok(out)
-}
-
-/// `a · b` of vectors.
-pub fn dot(g: &mut Graph, a: Vec3, b: Vec3) -> Result<Id, SymbolicError> {
-    let t: Vec<Id> = (0..3)
-        .map(|k| g.mul(a[k], b[k]))
-        .collect::<Result<_, _>>()?;
-    g.sum(&t)
-}
-
-/// `a × b`.
-pub fn cross(g: &mut Graph, a: Vec3, b: Vec3) -> Result<Vec3, SymbolicError> {
-    let c = |g: &mut Graph, i: usize, j: usize| -> Result<Id, SymbolicError> {
-        let x = g.mul(a[i], b[j])?;
-        let y = g.mul(a[j], b[i])?;
-        g.sub(x, y)
-    };
-    Ok([c(g, 1, 2)?, c(g, 2, 0)?, c(g, 0, 1)?])
-}
-
 /// Whether a symbol is of a kind that may appear in a parameter-only value.
 pub fn is_parameter(g: &Graph, s: Symbol) -> bool {
     g.symbol_kind(s) == SymbolKind::Parameter
-}
-
-/// `m v`, or `mᵀ v` when `transpose`.
-fn mat_vec3(g: &mut Graph, m: &Mat3, v: Vec3, transpose: bool) -> Result<Vec3, SymbolicError> {
-    let mut out = v;
-    for i in 0..3 {
-        let t: Vec<Id> = (0..3)
-            .map(|k| {
-                let e = if transpose { m[k][i] } else { m[i][k] };
-                g.mul(e, v[k])
-            })
-            .collect::<Result<_, _>>()?;
-        out[i] = g.sum(&t)?;
-    }
-    Ok(out)
 }

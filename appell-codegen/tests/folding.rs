@@ -4,7 +4,7 @@
 //! otherwise be chosen (a particle bolted to a rigid arm; a gyroscope).
 
 use appell_codegen::ctxt::Ctxt;
-use appell_codegen::derivation::{derive, pseudo_value};
+use appell_codegen::derivation::{derive_with, pseudo_value, Options};
 use appell_codegen::{model, parse};
 use appell_symbolic::Tape;
 
@@ -22,13 +22,15 @@ fn equations_with(
     let input: syn::DeriveInput = syn::parse_str(src).expect("valid Rust");
     let cx = Ctxt::new();
     let ast = parse::parse(&cx, &input);
-    let mut m = model::build(&cx, &ast).expect("model");
-    m.fold_always = fold_always;
-    m.rotor_form = rotor_form;
-    let d = derive(&cx, m).expect("derivation");
+    let m = model::build(&cx, &ast).expect("model");
+    let options = Options {
+        fold_always,
+        rotor_form,
+    };
+    let d = derive_with(&cx, m, &options).expect("derivation");
     cx.check().expect("no errors");
-    let mut roots = d.mass.clone();
-    roots.extend(&d.forcing);
+    let mut roots = d.equations.mass.clone();
+    roots.extend(&d.equations.forcing);
     let tape = Tape::new(&d.model.g, &roots);
     let values = (0..5u64)
         .map(|trial| {

@@ -1,0 +1,85 @@
+//! Stage 11: the energies the generated code reports.
+//!
+//! T = ½ Σ (m v·v + ω·I ω), from the partial velocities (v = Σ β̄_k ẏ_k + β̄);
+//! V = −Σ F·r over the `gravity` effect's constant forces; and the power of
+//! the loads that depend on an input, F·v_P + L·ω, whose integral closes the
+//! energy balance of a driven system.
+
+use appell_symbolic::{Id, Number, SymbolSet, SymbolicError};
+
+use super::partials::PartialVelocities;
+use super::speed_map::SpeedMap;
+use crate::algebra::{combine, dot, expanded, mat_vec};
+use crate::model::Model;
+
+/// The output of stage 11.
+pub struct Energies {
+    /// Kinetic energy T.
+    pub kinetic: Id,
+    /// Potential energy V of the gravity effect's loads.
+    pub potential: Id,
+    /// Power of the loads that depend on inputs.
+    pub input_power: Id,
+    /// The power of each input-dependent load, with its effect (for scenes).
+    pub power_terms: Vec<(String, Id)>,
+}
+
+/// Stage 11.
+pub fn energies(
+    model: &mut Model,
+    partials: &PartialVelocities,
+    map: &SpeedMap,
+) -> Result<Energies, SymbolicError> {
+    let g = &mut model.g;
+    let speed_rates = &map.speed_rates;
+    let mut ke_terms = Vec::new();
+    for (bi, b) in model.bodies.iter().enumerate() {
+        let t = &partials.bodies[bi];
+        let v = combine(g, &t.beta, t.beta0, speed_rates)?;
+        let vv = dot(g, v, v)?;
+        ke_terms.push(g.mul(b.mass, vv)?);
+        if b.frame.is_some() {
+            let iw = mat_vec(g, &b.inertia, t.omega_b)?;
+            ke_terms.push(dot(g, t.omega_b, iw)?);
+        }
+    }
+    let ke = g.sum(&ke_terms)?;
+    let kinetic = g.scale(ke, Number::ratio(1, 2).expect("1/2"))?;
+    let kinetic = expanded(g, kinetic)?;
+    let mut v_terms = Vec::new();
+    for f in model.forces.iter().filter(|f| f.effect == "gravity") {
+        let w = dot(g, f.vector, f.point)?;
+        v_terms.push(g.neg(w)?);
+    }
+    let potential = g.sum(&v_terms)?;
+    let potential = expanded(g, potential)?;
+    let inputs_set = SymbolSet::from_symbols(model.inputs.iter().map(|(_, s)| *s));
+    let mut p_terms = Vec::new();
+    let mut power_terms: Vec<(String, Id)> = Vec::new();
+    for (fi, f) in model.forces.iter().enumerate() {
+        if f.vector.iter().any(|&c| g.depends_on_any(c, &inputs_set)) {
+            let at = &partials.forces[fi];
+            let v = combine(g, &at.parts, at.rest, speed_rates)?;
+            let p = dot(g, f.vector, v)?;
+            p_terms.push(p);
+            power_terms.push((f.effect.clone(), p));
+        }
+    }
+    for (ti, t) in model.torques.iter().enumerate() {
+        if t.vector.iter().any(|&c| g.depends_on_any(c, &inputs_set)) {
+            let at = &partials.torques[ti];
+            let w = combine(g, &at.parts, at.rest, speed_rates)?;
+            let p = dot(g, t.vector, w)?;
+            p_terms.push(p);
+            power_terms.push((t.effect.clone(), p));
+        }
+    }
+    let input_power = g.sum(&p_terms)?;
+    let input_power = expanded(g, input_power)?;
+    Ok(Energies {
+        kinetic,
+        potential,
+        input_power,
+        power_terms,
+    })
+}

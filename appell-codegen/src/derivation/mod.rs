@@ -1,0 +1,340 @@
+//! Appell's equations by Method II (Wang & Pao 2003, Secs. III B-C and
+//! IV B), in the symbolic engine, one module per stage:
+//!
+//! | stage | module | input → output |
+//! | --- | --- | --- |
+//! | 1. velocity constraints D q̇ + d = 0 (eq. 25) | [`rows`] | `Model` → [`ConstraintRows`] |
+//! | 2. privileged speeds, u = W q̇ + w | [`speeds`] | rows → [`SpeedDefinitions`] |
+//! | 3. elimination of the unknown rates (eq. 27) | [`elimination`] | D, d, speeds → [`SolvedRates`] |
+//! | 4. q̇ = C ẏ + c (eqs. 30-31) | [`speed_map`] | solved rates → [`SpeedMap`], [`Rates`] |
+//! | 5. numeric elimination, S X = R, S w = (Ṙ − Ṡ X)[ẏ; 1] | [`numeric`] | [`SchurComplement`] → [`NumericElimination`] |
+//! | 6. partial velocities β̄_k, γ̄_k (eq. 54) | [`partials`] | speed map → [`PartialVelocities`] |
+//! | 7. acceleration remainders (eq. 37) | [`remainders`] | partials → [`Remainders`] |
+//! | 8. M and f's inertial terms (eq. 56) | [`assembly`] | partials, remainders → [`Assembled`] |
+//! | 9. composites and rotors, by cost | [`folding`] | assembler → [`Folded`] |
+//! | 10. loads; M and f final | [`loads`] | folded → [`Equations`] |
+//! | 11. energies | [`energies`] | partials → [`Energies`] |
+//! | 12. reduced state, cyclic coordinates (eq. 42) | [`reduction`] | equations → [`Reduction`] |
+//!
+//! Scenes ([`scenes`]) re-derive only stages 10-12 from a full derivation.
+//! [`algebra`](crate::algebra) holds the vector helpers, [`probe`] the
+//! numeric identity and rank tests, [`structure`] the sparsity analysis of
+//! square systems, [`text`] the readable equations.
+//!
+//! Every expression lives in the model's one graph, whose node ids follow
+//! construction order and decide the order of terms in sums: the stages run
+//! in a fixed order, and a change of that order changes the generated code
+//! (the snapshot test of every model's expansion shows it).
+
+pub mod assembly;
+pub mod elimination;
+pub mod energies;
+pub mod folding;
+pub mod loads;
+pub mod numeric;
+pub mod partials;
+pub mod probe;
+pub mod reduction;
+pub mod remainders;
+pub mod rows;
+pub mod scenes;
+pub mod speed_map;
+pub mod speeds;
+pub mod structure;
+pub mod text;
+
+use appell_symbolic::{Id, RateRules, Substitution, Symbol, SymbolicError};
+
+pub use assembly::Assembled;
+pub use elimination::{SchurComplement, SolvedRates};
+pub use energies::Energies;
+pub use folding::Folded;
+pub use loads::Equations;
+pub use numeric::{Elimination, NumericElimination};
+pub use partials::{BodyTerms, PartialVelocities};
+pub use probe::pseudo_value;
+pub use reduction::Reduction;
+pub use remainders::Remainders;
+pub use rows::{ConstraintRows, RowSource};
+pub use scenes::derive_scene;
+pub use speed_map::{Rates, SpeedMap};
+pub use speeds::SpeedDefinitions;
+pub use structure::{singleton_rows, SingletonOrder};
+
+use crate::ctxt::Ctxt;
+use crate::model::Model;
+
+/// Choices the derivation makes by operation count, forced for tests that
+/// compare the forms.
+#[derive(Clone, Copy, Debug, Default)]
+pub struct Options {
+    /// Fold composites and rotors even where that costs operations.
+    pub fold_always: bool,
+    /// Write every rotor's terms whole (`Some(true)`) or split
+    /// (`Some(false)`) instead of the cheaper.
+    pub rotor_form: Option<bool>,
+}
+
+/// The derivatives every stage takes: d/dt under the coordinates' rules,
+/// and the twin (the kinematics again with direction cosines as symbols),
+/// used where expressions are differentiated along q̇ and not expanded;
+/// `uncut` puts the values back.
+pub struct Calculus {
+    /// q → q̇ → q̈, t → 1.
+    pub rules: RateRules,
+    /// The twin, when the model has one.
+    pub twin: Option<Box<Model>>,
+    /// The twin's rate rules (direction cosines turning with their frames).
+    pub twin_rules: Option<RateRules>,
+    /// Direction-cosine symbols → their values.
+    pub uncut: Substitution,
+}
+
+impl Calculus {
+    /// Takes the twin out of `model`.
+    pub fn take_from(model: &mut Model) -> Calculus {
+        let twin = model.twin.take();
+        let twin_rules = twin.as_ref().map(|t| t.rate_rules());
+        let uncut = twin
+            .as_ref()
+            .map_or_else(Substitution::new, |t| t.uncut_substitution());
+        Calculus {
+            rules: RateRules::coordinates(),
+            twin,
+            twin_rules,
+            uncut,
+        }
+    }
+}
+
+/// The derived equations and everything the emitter needs.
+pub struct Derivation {
+    /// The model (its graph holds every expression below).
+    pub model: Model,
+    /// Number of coordinates n.
+    pub n: usize,
+    /// Number of constraint rows m.
+    pub m: usize,
+    /// Number of privileged speeds l.
+    pub l: usize,
+    /// D, d and where each row comes from (stage 1).
+    pub constraints: ConstraintRows,
+    /// D q̇ + d, with q̇ the coordinate rate symbols.
+    pub velocity_residuals: Vec<Id>,
+    /// W, w and the unknowns (stage 2).
+    pub speeds: SpeedDefinitions,
+    /// C, c and q̇ = C ẏ + c (stage 4).
+    pub map: SpeedMap,
+    /// How B and b are computed (stage 5), with the ignorable coordinates
+    /// fixed.
+    pub elimination: Elimination,
+    /// M and f (stage 10), with the ignorable coordinates fixed.
+    pub equations: Equations,
+    /// T, V and the input power (stage 11).
+    pub energies: Energies,
+    /// The reduced state (stage 12).
+    pub reduction: Reduction,
+    /// M and the elimination before the ignorable coordinates were fixed
+    /// (what scenes start from).
+    pub unreduced: Unreduced,
+    /// Bodies whose terms were folded together (composites and rotors), as
+    /// readable lines.
+    pub folded: Vec<String>,
+    /// Readable equations.
+    pub text: String,
+}
+
+/// M and the elimination before stage 12 fixed the coordinates they do not
+/// depend on.
+#[derive(Clone)]
+pub struct Unreduced {
+    /// M (l×l).
+    pub mass: Vec<Id>,
+    /// The elimination.
+    pub elimination: Elimination,
+}
+
+/// Runs the derivation; errors go to `cx`.
+pub fn derive(cx: &Ctxt, model: Model) -> Option<Derivation> {
+    derive_with(cx, model, &Options::default())
+}
+
+/// [`derive`] with the cost-driven choices forced by `options`.
+pub fn derive_with(cx: &Ctxt, mut model: Model, options: &Options) -> Option<Derivation> {
+    match stages(cx, &mut model, options) {
+        Ok(Some(d)) => Some(d.finish(model)),
+        Ok(None) => None,
+        Err(e) => {
+            cx.error_at(
+                model.name.span(),
+                format!("deriving the equations failed: {e}"),
+            );
+            None
+        }
+    }
+}
+
+/// The stage outputs before they are bound to the model.
+struct Stages {
+    constraints: ConstraintRows,
+    velocity_residuals: Vec<Id>,
+    speeds: SpeedDefinitions,
+    map: SpeedMap,
+    elimination: Elimination,
+    equations: Equations,
+    energies: Energies,
+    reduction: Reduction,
+    unreduced: Unreduced,
+    folded: Vec<String>,
+}
+
+impl Stages {
+    fn finish(self, model: Model) -> Derivation {
+        let mut d = Derivation {
+            n: model.coords.len(),
+            m: self.constraints.d0.len(),
+            l: model.speed_specs.len(),
+            model,
+            constraints: self.constraints,
+            velocity_residuals: self.velocity_residuals,
+            speeds: self.speeds,
+            map: self.map,
+            elimination: self.elimination,
+            equations: self.equations,
+            energies: self.energies,
+            reduction: self.reduction,
+            unreduced: self.unreduced,
+            folded: self.folded,
+            text: String::new(),
+        };
+        d.text = text::equations_text(&d);
+        d
+    }
+}
+
+/// Stages 1 to 12 in order.
+fn stages(
+    cx: &Ctxt,
+    model: &mut Model,
+    options: &Options,
+) -> Result<Option<Stages>, SymbolicError> {
+    let mut calculus = Calculus::take_from(model);
+    let Some(constraints) = rows::constraint_rows(cx, model, &calculus)? else {
+        return Ok(None);
+    };
+    let Some(speeds) = speeds::speed_definitions(cx, model, &constraints)? else {
+        return Ok(None);
+    };
+    let Some(solved) = elimination::eliminate(cx, model, &constraints.d, &constraints.d0, &speeds)?
+    else {
+        return Ok(None);
+    };
+    let (mut map, mut rates) = speed_map::speed_map(model, &speeds, &solved, &calculus)?;
+    let mut elimination = match solved.schur {
+        Some(schur) => Elimination::Numeric(numeric::numeric_elimination(
+            model,
+            schur,
+            numeric::NumericInputs {
+                rows: &constraints,
+                dependent: &speeds.dependent,
+                map: &map,
+                vanishing: &solved.vanishing,
+            },
+            &mut rates,
+            &mut calculus.uncut,
+        )?),
+        None => Elimination::Symbolic,
+    };
+    let partials = partials::partial_velocities(model, &map, &calculus.rules, &rates.fixed)?;
+    let mut remainders = remainders::remainders(
+        model,
+        &speeds.dependent,
+        &map,
+        &partials,
+        &mut rates,
+        &mut calculus,
+    )?;
+    let assume = elimination::assumptions(model);
+    let coordinate_rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let folded = {
+        let mut assembler = assembly::Assembler {
+            bodies: &model.bodies,
+            partials: &partials,
+            remainders: &mut remainders,
+            map: &map,
+            rates: &mut rates,
+            calculus: &mut calculus,
+            coordinate_rates,
+        };
+        folding::fold(
+            &mut model.g,
+            (&model.bodies, &model.frames, &model.coords),
+            &mut assembler,
+            &partials.rotations,
+            &assume,
+            options,
+        )?
+    };
+    let mut equations = loads::equations(
+        model,
+        folded.assembled,
+        &folded.composites,
+        &partials,
+        &map,
+        &calculus.rules,
+    )?;
+    let mut energies = energies::energies(model, &partials, &map)?;
+    reduction::drop_vanishing(
+        &mut model.g,
+        &solved.vanishing,
+        &mut map,
+        &mut equations,
+        &mut energies,
+        &mut elimination,
+    )?;
+    let unreduced = Unreduced {
+        mass: equations.mass.clone(),
+        elimination: elimination.clone(),
+    };
+    let reduction = reduction::reduce_state(
+        &mut model.g,
+        reduction::ReductionInputs {
+            coords: &model.coords,
+            quadrature: &model.quadrature,
+            qdot: &map.qdot,
+            dependent: &speeds.dependent,
+        },
+        &mut equations.mass,
+        &mut equations.forcing,
+        &mut elimination,
+    )?;
+    let velocity_residuals = velocity_residuals(model, &constraints)?;
+    Ok(Some(Stages {
+        constraints,
+        velocity_residuals,
+        speeds,
+        map,
+        elimination,
+        equations,
+        energies,
+        reduction,
+        unreduced,
+        folded: folded.lines,
+    }))
+}
+
+/// D q̇ + d, row by row, with q̇ the coordinate rate symbols.
+fn velocity_residuals(model: &mut Model, rows: &ConstraintRows) -> Result<Vec<Id>, SymbolicError> {
+    let n = model.coords.len();
+    let g = &mut model.g;
+    let mut out = Vec::with_capacity(rows.d0.len());
+    for i in 0..rows.d0.len() {
+        let mut terms = vec![rows.d0[i]];
+        for (r, (_, coord)) in model.coords.iter().enumerate() {
+            let q = g.sym(coord.rate)?;
+            terms.push(g.mul(rows.d[i * n + r], q)?);
+        }
+        out.push(g.sum(&terms)?);
+    }
+    Ok(out)
+}

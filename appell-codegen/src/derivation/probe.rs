@@ -1,0 +1,137 @@
+//! Numeric probes: questions about expressions answered by evaluating them
+//! at pseudo-random points.
+//!
+//! The derivation asks three kinds of question the engine's canonical
+//! forms cannot settle: are two expressions the same function (an identity
+//! like sin² + cos² = 1 hidden in a product), is a row of D a combination of
+//! the others, and does a value depend on a coordinate. Each is answered in
+//! f64 at a few points fixed by the symbol and the trial number: parameters
+//! in [0.5, 1.5] (the physical sign of a mass or a length), everything else
+//! in [−1, 1]. The engine's exact test (`share_equal_values`, residues
+//! modulo 2⁶¹ − 1) works on lowered instructions, not on graph nodes, and
+//! does not see functions other than sine and cosine as it needs to here
+//! (square roots of sums are independent residues there); these probes
+//! evaluate the expressions themselves, square roots included, and report
+//! an evaluation that fails (a square root of a negative number at a test
+//! point) as "unknown" rather than guess.
+
+use appell_symbolic::{Graph, Id, Symbol, SymbolKind, Tape};
+
+/// A value in [0.5, 1.5] for parameters and [−1, 1] for everything else,
+/// fixed by the symbol and the trial number (the numeric rank and
+/// independence checks evaluate at such points).
+///
+/// ```
+/// use appell_codegen::derivation::pseudo_value;
+/// let mut g = appell_symbolic::Graph::new();
+/// let m = g.parameter("m").unwrap();
+/// let q = g.coordinate("q").unwrap().q;
+/// assert!((0.5..=1.5).contains(&pseudo_value(&g, m, 0)));
+/// assert!((-1.0..=1.0).contains(&pseudo_value(&g, q, 0)));
+/// assert_eq!(pseudo_value(&g, q, 3), pseudo_value(&g, q, 3));
+/// ```
+pub fn pseudo_value(g: &Graph, s: Symbol, trial: u64) -> f64 {
+    let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    h ^= h >> 31;
+    h = h.wrapping_mul(0x94d0_49bb_1331_11eb);
+    h ^= h >> 29;
+    let u = (h >> 11) as f64 / (1u64 << 53) as f64;
+    match g.symbol_kind(s) {
+        SymbolKind::Parameter => 0.5 + u,
+        _ => 2.0 * u - 1.0,
+    }
+}
+
+/// Whether `a` and `b` are the same function: equal to 1e-10, relative, at
+/// three pseudo-random points (see [`pseudo_value`]) where they are not
+/// zero. `None` when some evaluation fails.
+pub fn same_function(g: &Graph, a: Id, b: Id) -> Option<bool> {
+    let tape = Tape::new(g, &[a, b]);
+    for trial in 0..3u64 {
+        let v = tape.eval(&|s| Some(pseudo_value(g, s, trial))).ok()?;
+        let (x, y) = (v[0], v[1]);
+        if !(x.is_finite() && y.is_finite()) {
+            return None;
+        }
+        if x.abs() < 1e-6 || (x - y).abs() > 1e-10 * x.abs().max(y.abs()) {
+            return Some(false);
+        }
+    }
+    Some(true)
+}
+
+/// The first row of D that is numerically a combination of the rows before
+/// it at every one of three pseudo-random configurations (parameters in
+/// [0.5, 1.5], coordinates and rates in [−1, 1]). A dependence that holds only
+/// at special configurations is not reported.
+pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
+    if m < 2 {
+        return None;
+    }
+    let tape = Tape::new(g, d);
+    let mut first_dependent: Option<usize> = None;
+    let mut trials = 0;
+    for trial in 0..6u64 {
+        let value = |s: Symbol| {
+            let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+                ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+            h ^= h >> 31;
+            let u = (h >> 11) as f64 / (1u64 << 53) as f64;
+            Some(match g.symbol_kind(s) {
+                SymbolKind::Parameter => 0.5 + u,
+                _ => 2.0 * u - 1.0,
+            })
+        };
+        let Ok(vals) = tape.eval(&value) else {
+            continue;
+        };
+        trials += 1;
+        // Incremental Gram–Schmidt rank test, row by row.
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut dep = None;
+        for r in 0..m {
+            let mut v: Vec<f64> = vals[r * n..(r + 1) * n].to_vec();
+            let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            for b in &basis {
+                let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+                for (x, y) in v.iter_mut().zip(b) {
+                    *x -= p * y;
+                }
+            }
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm <= 1e-9 * norm0.max(1e-300) {
+                dep = Some(r);
+                break;
+            }
+            basis.push(v.iter().map(|x| x / norm).collect());
+        }
+        match dep {
+            None => return None,
+            Some(r) => first_dependent = Some(first_dependent.map_or(r, |f: usize| f.min(r))),
+        }
+        if trials == 3 {
+            break;
+        }
+    }
+    first_dependent
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn same_function_sees_identities_the_expansion_does_not() {
+        let mut g = Graph::new();
+        g.coordinate("q").unwrap();
+        g.parameter("r").unwrap();
+        let a = g.parse("r*sin(q)^2 + r*cos(q)^2").unwrap();
+        let b = g.parse("r").unwrap();
+        let c = g.parse("r*sin(q)").unwrap();
+        assert_eq!(same_function(&g, a, b), Some(true));
+        assert_eq!(same_function(&g, a, c), Some(false));
+        let nan = g.parse("sqrt(-r)").unwrap();
+        assert_eq!(same_function(&g, nan, nan), None);
+    }
+}

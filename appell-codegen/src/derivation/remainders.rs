@@ -1,0 +1,158 @@
+//! Stage 7: acceleration remainders, the accelerations with ÿ = 0 (eq. 37,
+//! corrected; see the paper's notes).
+//!
+//! For a velocity v(q, q̇, t) linear in q̇ the remainder is
+//! Σ_s ∂v/∂q_s q̇_s + ∂v/∂t (the directional derivative along q̇, rates held
+//! fixed, then replaced by C ẏ + c) plus Σ_d ∂v/∂q̇_d r_d, with r_d the
+//! dependent rates' own remainders (w for a numeric elimination).
+//! Differentiating each β̄_k through C instead would multiply every partial
+//! derivative by q̇ = C ẏ + c once per speed. The directional derivative is
+//! taken on the twin, whose direction cosines are symbols, and the values
+//! are put back afterwards.
+//!
+//! Angular acceleration remainders α are kept in each body's frame; a body
+//! whose γ̄ were turned from an earlier body's takes that body's α, turned,
+//! plus ω × ω_rel and the relative rates' own remainders.
+
+use appell_symbolic::{Id, Substitution, Symbol, SymbolicError};
+
+use super::partials::PartialVelocities;
+use super::speed_map::{Rates, SpeedMap};
+use super::Calculus;
+use crate::algebra::{cross, expanded3, mat_t_vec, turned, Vec3};
+use crate::model::Model;
+
+/// The output of stage 7.
+pub struct Remainders {
+    /// ÿ_k → 0.
+    pub zero_accels: Substitution,
+    /// Each dependent rate's symbol and its own remainder r_d.
+    pub dependent: Vec<(Symbol, Id)>,
+    /// The coordinates of `dependent`, in order.
+    pub coordinates: Vec<usize>,
+    /// Per body: α with ÿ = 0 in its frame (None for a particle).
+    pub alphas: Vec<Option<Vec3>>,
+}
+
+impl Remainders {
+    /// The remainder of a velocity `v` (the twin's, when there is one).
+    /// `parts`, when given, are the partial velocities ∂v/∂q̇_r already
+    /// built for β̄ (the same values): the dependent rates' terms reuse
+    /// them. Left factored: a remainder enters f only through dot products
+    /// with the partial velocities.
+    pub fn of_velocity(
+        &self,
+        g: &mut appell_symbolic::Graph,
+        rates: &mut Rates,
+        uncut: &mut Substitution,
+        v: Vec3,
+        parts: Option<&[Vec3]>,
+    ) -> Result<Vec3, SymbolicError> {
+        let zero = g.int(0)?;
+        let mut out = [zero; 3];
+        for i in 0..3 {
+            let along = g.time_derivative(v[i], &rates.along)?;
+            let along = uncut.apply(g, along)?;
+            let mut terms = vec![rates.fixed.apply(g, along)?];
+            for (&(rate, r), &d) in self.dependent.iter().zip(&self.coordinates) {
+                let c = match parts {
+                    Some(p) => p[d][i],
+                    None => {
+                        let c = g.diff(v[i], rate)?;
+                        let c = uncut.apply(g, c)?;
+                        rates.fixed.apply(g, c)?
+                    }
+                };
+                if g.is_zero(c) {
+                    continue;
+                }
+                terms.push(g.mul(c, r)?);
+            }
+            out[i] = g.sum(&terms)?;
+        }
+        Ok(out)
+    }
+}
+
+/// Stage 7: the dependent rates' remainders and each body's α.
+pub fn remainders(
+    model: &mut Model,
+    dependent: &[usize],
+    map: &SpeedMap,
+    partials: &PartialVelocities,
+    rates: &mut Rates,
+    calculus: &mut Calculus,
+) -> Result<Remainders, SymbolicError> {
+    let g = &mut model.g;
+    let zero = g.int(0)?;
+    let mut zero_accels = Substitution::new();
+    for spec in &model.speed_specs {
+        zero_accels.insert(spec.accel, zero);
+    }
+    let mut dependent_remainders = Vec::new();
+    for &d in dependent {
+        let e = g.time_derivative(map.qdot[d], &rates.reduced)?;
+        let e = zero_accels.apply(g, e)?;
+        dependent_remainders.push((model.coords[d].1.rate, e));
+    }
+    let mut out = Remainders {
+        zero_accels,
+        dependent: dependent_remainders,
+        coordinates: dependent.to_vec(),
+        alphas: Vec::new(),
+    };
+    for (bi, b) in model.bodies.iter().enumerate() {
+        let alpha = match &partials.rotations[bi] {
+            Some(rot) => match &partials.relative[bi] {
+                Some(relative) if out.alphas[relative.body].is_some() => {
+                    let omega_b = partials.bodies[bi].omega_b;
+                    Some(turned_alpha(g, &out, relative, omega_b, rates)?)
+                }
+                _ => {
+                    let f = b.frame.expect("rigid");
+                    let omega = calculus
+                        .twin
+                        .as_ref()
+                        .map_or(model.frames[f].omega, |t| t.frames[f].omega);
+                    let alpha_n = out.of_velocity(g, rates, &mut calculus.uncut, omega, None)?;
+                    let alpha_b = mat_t_vec(g, rot, alpha_n)?;
+                    Some(expanded3(g, alpha_b)?)
+                }
+            },
+            None => None,
+        };
+        out.alphas.push(alpha);
+    }
+    Ok(out)
+}
+
+/// α = (the earlier body's α, turned) + ω × ω_rel + the relative rates'
+/// own remainders (dependent ones).
+fn turned_alpha(
+    g: &mut appell_symbolic::Graph,
+    done: &Remainders,
+    relative: &super::partials::RelativeFrame,
+    omega_b: Vec3,
+    rates: &mut Rates,
+) -> Result<Vec3, SymbolicError> {
+    let zero = g.int(0)?;
+    let parent = done.alphas[relative.body].expect("rigid");
+    let dw = relative.omega;
+    let mut w_rel = [zero; 3];
+    for i in 0..3 {
+        w_rel[i] = rates.fixed.apply(g, dw[i])?;
+    }
+    let spin = cross(g, omega_b, w_rel)?;
+    let mut alpha = turned(g, &relative.rel, parent, spin)?;
+    for i in 0..3 {
+        let mut terms = vec![alpha[i]];
+        for &(rate, r) in &done.dependent {
+            let c = g.diff(dw[i], rate)?;
+            if !g.is_zero(c) {
+                terms.push(g.mul(c, r)?);
+            }
+        }
+        alpha[i] = g.sum(&terms)?;
+    }
+    Ok(alpha)
+}

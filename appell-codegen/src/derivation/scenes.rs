@@ -1,0 +1,107 @@
+//! Scenes: a derived model with some effects' loads only, and its own
+//! outputs.
+//!
+//! A scene reuses the full derivation's stages 1 to 9 (kinematics, the
+//! elimination, M and f's inertial terms) and derives again only what its
+//! effects change: f from the inertial terms and its effects' load terms
+//! (stage 10), the potential and input power (stage 11), and the reduced
+//! state, which its quadrature outputs may extend (stage 12).
+
+use appell_symbolic::{Id, SymbolicError};
+
+use super::energies::Energies;
+use super::loads::Equations;
+use super::reduction::{reduce_state, ReductionInputs};
+use super::{text, Derivation};
+use crate::algebra::expanded;
+use crate::ctxt::Ctxt;
+use crate::model::Scene;
+
+/// Derives `scene` of `full`; errors go to `cx`, spanned by the scene's
+/// name.
+pub fn derive_scene(cx: &Ctxt, full: &Derivation, scene: &Scene) -> Option<Derivation> {
+    match scene_derivation(full, scene) {
+        Ok(d) => Some(d),
+        Err(e) => {
+            cx.error_spanned_by(
+                &scene.name,
+                format!("deriving scene `{}` failed: {e}", scene.name),
+            );
+            None
+        }
+    }
+}
+
+fn scene_derivation(full: &Derivation, scene: &Scene) -> Result<Derivation, SymbolicError> {
+    let mut model = crate::model::scene_model(&full.model, scene);
+    let g = &mut model.g;
+    let l = full.l;
+    let mut mass = full.unreduced.mass.clone();
+    let mut forcing = Vec::with_capacity(l);
+    for k in 0..l {
+        let mut terms = full.equations.inertial_terms[k].clone();
+        for (effect, per_k) in &full.equations.load_terms {
+            if scene.effects.contains(effect) {
+                terms.push(per_k[k]);
+            }
+        }
+        let sum = g.sum(&terms)?;
+        forcing.push(expanded(g, sum)?);
+    }
+    let mut elimination = full.unreduced.elimination.clone();
+    let potential = if scene.effects.iter().any(|e| e == "gravity") {
+        full.energies.potential
+    } else {
+        g.int(0)?
+    };
+    let scene_power: Vec<Id> = full
+        .energies
+        .power_terms
+        .iter()
+        .filter(|(e, _)| scene.effects.contains(e))
+        .map(|(_, p)| *p)
+        .collect();
+    let input_power = g.sum(&scene_power)?;
+    let input_power = expanded(g, input_power)?;
+    let reduction = reduce_state(
+        g,
+        ReductionInputs {
+            coords: &model.coords,
+            quadrature: &model.quadrature,
+            qdot: &full.map.qdot,
+            dependent: &full.speeds.dependent,
+        },
+        &mut mass,
+        &mut forcing,
+        &mut elimination,
+    )?;
+    let mut d = Derivation {
+        model,
+        n: full.n,
+        m: full.m,
+        l,
+        constraints: full.constraints.clone(),
+        velocity_residuals: full.velocity_residuals.clone(),
+        speeds: full.speeds.clone(),
+        map: full.map.clone(),
+        elimination,
+        equations: Equations {
+            mass,
+            forcing,
+            inertial_terms: full.equations.inertial_terms.clone(),
+            load_terms: Vec::new(),
+        },
+        energies: Energies {
+            kinetic: full.energies.kinetic,
+            potential,
+            input_power,
+            power_terms: Vec::new(),
+        },
+        reduction,
+        unreduced: full.unreduced.clone(),
+        folded: full.folded.clone(),
+        text: String::new(),
+    };
+    d.text = text::equations_text(&d);
+    Ok(d)
+}

@@ -1,0 +1,123 @@
+//! Stage 4: q̇ = C ẏ + c (eqs. 30-31) and the rate rules of the reduced
+//! system.
+//!
+//! C_rk and c_r come from the elimination's [B | b] for the unknowns and
+//! from unit columns for the privileged coordinates. The stage also builds
+//! the three ways later stages differentiate:
+//!
+//! - `reduced`: d/dt on the reduced system (q → C ẏ + c, a quasi-velocity
+//!   → its acceleration symbol, and, once the numeric elimination adds
+//!   them, X → its rate);
+//! - `along`: the directional derivative along q̇ with every rate held
+//!   constant (the twin's direction cosines turning with their frames);
+//! - `fixed`: the substitution of the dependent rates by C ẏ + c, applied
+//!   after `along`.
+
+use appell_symbolic::{Id, RateRules, Substitution, Symbol, SymbolicError};
+
+use super::elimination::SolvedRates;
+use super::speeds::SpeedDefinitions;
+use super::Calculus;
+use crate::model::Model;
+
+/// C, c and q̇ = C ẏ + c.
+#[derive(Clone)]
+pub struct SpeedMap {
+    /// C (n×l), row-major.
+    pub c: Vec<Id>,
+    /// c (n).
+    pub c0: Vec<Id>,
+    /// q̇_r = Σ C_rk ẏ_k + c_r.
+    pub qdot: Vec<Id>,
+    /// The symbols ẏ_k.
+    pub speed_rates: Vec<Symbol>,
+    /// The symbols ÿ_k.
+    pub accels: Vec<Symbol>,
+}
+
+/// The rate rules later stages differentiate with (see the module docs).
+pub struct Rates {
+    /// d/dt on the reduced system.
+    pub reduced: RateRules,
+    /// The directional derivative along q̇, rates held constant.
+    pub along: RateRules,
+    /// The dependent rates replaced by C ẏ + c.
+    pub fixed: Substitution,
+}
+
+/// Stage 4.
+pub fn speed_map(
+    model: &mut Model,
+    speeds: &SpeedDefinitions,
+    solved: &SolvedRates,
+    calculus: &Calculus,
+) -> Result<(SpeedMap, Rates), SymbolicError> {
+    let n = model.coords.len();
+    let l = model.speed_specs.len();
+    let g = &mut model.g;
+    let zero = g.int(0)?;
+    let one = g.int(1)?;
+    let mut c = vec![zero; n * l];
+    let mut c0 = vec![zero; n];
+    if !speeds.quasi {
+        for (k, &s) in model.speeds.iter().enumerate() {
+            c[s * l + k] = one;
+        }
+    }
+    for (i, &r) in speeds.dependent.iter().enumerate() {
+        for k in 0..l {
+            c[r * l + k] = solved.x[i * (l + 1) + k];
+        }
+        c0[r] = solved.x[i * (l + 1) + l];
+    }
+    let speed_rates: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
+    let accels: Vec<Symbol> = model.speed_specs.iter().map(|s| s.accel).collect();
+    let mut qdot = Vec::with_capacity(n);
+    for r in 0..n {
+        let mut terms = vec![c0[r]];
+        for k in 0..l {
+            let y = g.sym(speed_rates[k])?;
+            terms.push(g.mul(c[r * l + k], y)?);
+        }
+        qdot.push(g.sum(&terms)?);
+    }
+    let mut reduced = RateRules::coordinates();
+    for (r, (_, coord)) in model.coords.iter().enumerate() {
+        reduced = reduced.with(coord.q, qdot[r]);
+    }
+    for spec in model.speed_specs.iter().filter(|s| s.definition.is_some()) {
+        let a = g.sym(spec.accel)?;
+        reduced = reduced.with(spec.symbol, a);
+    }
+    let mut along = RateRules::coordinates();
+    for (_, coord) in &model.coords {
+        along = along.constant(coord.rate);
+    }
+    for &r in &speed_rates {
+        along = along.constant(r);
+    }
+    if let Some(t) = &calculus.twin {
+        for c in &t.cuts {
+            along = along.with(c.symbol, c.rate);
+        }
+    }
+    let mut fixed = Substitution::new();
+    for &r in &speeds.dependent {
+        fixed.insert(model.coords[r].1.rate, qdot[r]);
+    }
+    let map = SpeedMap {
+        c,
+        c0,
+        qdot,
+        speed_rates,
+        accels,
+    };
+    Ok((
+        map,
+        Rates {
+            reduced,
+            along,
+            fixed,
+        },
+    ))
+}

@@ -1,0 +1,184 @@
+//! Stage 2: the privileged speeds ẏ_k and the unknown rates.
+//!
+//! Each speed is defined by u = W q̇ + w: a unit row of W for a coordinate
+//! rate (Method II), or the defining combination of a quasi-velocity
+//! (Method III, eq. 56), which must be linear in q̇. The stage checks that
+//! the constraint rows are independent, that l + m = n, that [D; W] is
+//! invertible with quasi-velocities, and that each holonomic constraint
+//! involves a dependent coordinate. The unknowns are the dependent rates ż
+//! (Method II) or every rate (Method III, [D; W] q̇ = [−d; u − w]).
+
+use appell_symbolic::{Id, Symbol, SymbolKind, SymbolicError};
+
+use super::probe::dependent_row;
+use super::rows::ConstraintRows;
+use crate::ctxt::Ctxt;
+use crate::model::{Model, SpeedSpec};
+
+/// The output of stage 2.
+#[derive(Clone)]
+pub struct SpeedDefinitions {
+    /// W (l×n), row-major.
+    pub w: Vec<Id>,
+    /// w (l).
+    pub w0: Vec<Id>,
+    /// Whether some speed is a quasi-velocity (Method III).
+    pub quasi: bool,
+    /// The coordinates whose rates are unknowns: the dependent ones, or
+    /// every coordinate with quasi-velocities.
+    pub dependent: Vec<usize>,
+}
+
+/// Stage 2. `None` when errors were recorded in `cx`.
+pub fn speed_definitions(
+    cx: &Ctxt,
+    model: &mut Model,
+    rows: &ConstraintRows,
+) -> Result<Option<SpeedDefinitions>, SymbolicError> {
+    let n = model.coords.len();
+    let m = rows.d0.len();
+    let l = model.speed_specs.len();
+    let quasi = model.speed_specs.iter().any(|s| s.definition.is_some());
+    let (zero, one) = (model.g.int(0)?, model.g.int(1)?);
+    let mut w = Vec::with_capacity(l * n);
+    let mut w0 = Vec::with_capacity(l);
+    for spec in model.speed_specs.clone() {
+        match (spec.coordinate, spec.definition) {
+            (Some(r), _) => {
+                w.extend((0..n).map(|c| if c == r { one } else { zero }));
+                w0.push(zero);
+            }
+            (None, Some(def)) => {
+                if let Some((row, rest)) = quasi_velocity_row(cx, model, &spec, def) {
+                    w.extend(row);
+                    w0.push(rest);
+                }
+            }
+            (None, None) => unreachable!("a speed is a coordinate or a definition"),
+        }
+    }
+    if cx.has_errors() {
+        return Ok(None);
+    }
+    if let Some(row) = dependent_row(&model.g, &rows.d, n, m) {
+        cx.error_spanned_by(
+            &rows.at[row],
+            "this constraint row is a linear combination of the others (the velocity constraints are linearly dependent); drop it, or give a rolling contact `along = [...]` directions",
+        );
+        return Ok(None);
+    }
+    if l + m != n {
+        cx.error_spanned_by(
+            &model.speeds_at,
+            format!(
+                "{l} privileged speed(s) with {m} velocity constraint(s) on {n} coordinates: the constraints leave {} independent speed(s), so `speeds(...)` must name {}",
+                n.saturating_sub(m),
+                n.saturating_sub(m)
+            ),
+        );
+        return Ok(None);
+    }
+    if quasi {
+        let mut full = rows.d.clone();
+        full.extend(&w);
+        if let Some(row) = dependent_row(&model.g, &full, n, n) {
+            let name = &model.speed_specs[row.saturating_sub(m).min(l - 1)].name;
+            cx.error_spanned_by(
+                &model.speeds_at,
+                format!("the speeds' definitions are not invertible: with the constraints they do not determine the coordinate rates ([D; W] is singular; `{name}` depends on the others)"),
+            );
+            return Ok(None);
+        }
+    }
+    let dependent: Vec<usize> = if quasi {
+        (0..n).collect()
+    } else {
+        (0..n).filter(|i| !model.speeds.contains(i)).collect()
+    };
+    check_holonomic_involve_dependent(cx, model, &dependent);
+    if cx.has_errors() {
+        return Ok(None);
+    }
+    Ok(Some(SpeedDefinitions {
+        w,
+        w0,
+        quasi,
+        dependent,
+    }))
+}
+
+/// A quasi-velocity's row of W and entry of w; `None` (with an error
+/// recorded) when its definition is not a linear combination of q̇.
+fn quasi_velocity_row(
+    cx: &Ctxt,
+    model: &mut Model,
+    spec: &SpeedSpec,
+    def: Id,
+) -> Option<(Vec<Id>, Id)> {
+    let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let bad: Vec<String> = model
+        .g
+        .dependencies(def)
+        .iter()
+        .filter(|s| {
+            matches!(
+                model.g.symbol_kind(*s),
+                SymbolKind::Input | SymbolKind::Acceleration(_) | SymbolKind::Auxiliary
+            )
+        })
+        .map(|s| model.g.symbol_name(s).to_string())
+        .collect();
+    if !bad.is_empty() {
+        cx.error_spanned_by(
+            &model.speeds_at,
+            format!(
+                "the quasi-velocity `{}` cannot depend on {}",
+                spec.name,
+                bad.join(", ")
+            ),
+        );
+        return None;
+    }
+    match model.g.linear_coefficients(def, &rates) {
+        Ok(form) => {
+            if form.coefficients.iter().all(|c| model.g.is_zero(*c)) {
+                cx.error_spanned_by(
+                    &model.speeds_at,
+                    format!(
+                        "the quasi-velocity `{}` involves no coordinate rate",
+                        spec.name
+                    ),
+                );
+                return None;
+            }
+            Some((form.coefficients, form.remainder))
+        }
+        Err(SymbolicError::NonLinear { symbol, .. }) => {
+            cx.error_spanned_by(
+                &model.speeds_at,
+                format!("the quasi-velocity `{}` must be linear in the coordinate rates (Method III, eq. 56), and it is not linear in `{symbol}`", spec.name),
+            );
+            None
+        }
+        Err(e) => {
+            cx.error_spanned_by(&model.speeds_at, e);
+            None
+        }
+    }
+}
+
+/// A holonomic constraint among privileged coordinates only would restrict
+/// the privileged speeds, which must stay independent.
+fn check_holonomic_involve_dependent(cx: &Ctxt, model: &Model, dependent: &[usize]) {
+    for c in &model.holonomic {
+        let involves_dependent = dependent
+            .iter()
+            .any(|&i| model.g.depends_on(c.residual, model.coords[i].1.q));
+        if !involves_dependent {
+            cx.error_spanned_by(
+                &c.at,
+                "this holonomic constraint involves no dependent coordinate: it would restrict the privileged speeds, which must stay independent; leave one of its coordinates out of `speeds(...)`",
+            );
+        }
+    }
+}

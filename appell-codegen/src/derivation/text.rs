@@ -1,0 +1,118 @@
+//! The readable form of the derived equations: what the generated
+//! `equations()` returns, and what a user reads to see which speeds are
+//! dependent, what was folded and which coordinates are ignorable.
+
+use std::fmt::Write;
+
+use appell_symbolic::Id;
+
+use super::{Derivation, Elimination};
+
+/// The readable form of the derived equations.
+pub fn equations_text(d: &Derivation) -> String {
+    let g = &d.model.g;
+    let name = |i: usize| d.model.coords[i].0.to_string();
+    let show = |e: Id| -> String {
+        if g.dag_size(&[e]) > 400 {
+            format!(
+                "<expression of {} nodes; see the generated code>",
+                g.dag_size(&[e])
+            )
+        } else {
+            g.display(e).to_string()
+        }
+    };
+    let mut s = String::new();
+    let _ = writeln!(
+        s,
+        "{}: Appell's equations (Wang & Pao 2003, eq. 56), reduced (eq. 42)",
+        d.model.name
+    );
+    let _ = writeln!(
+        s,
+        "coordinates q: {}",
+        (0..d.n).map(name).collect::<Vec<_>>().join(", ")
+    );
+    let speeds: Vec<String> = d
+        .model
+        .speed_specs
+        .iter()
+        .map(|sp| g.symbol_name(sp.symbol).to_string())
+        .collect();
+    let _ = writeln!(s, "privileged speeds: {}", speeds.join(", "));
+    for (k, sp) in d.model.speed_specs.iter().enumerate() {
+        if let Some(def) = sp.definition {
+            let _ = writeln!(s, "  {} = {} (quasi-velocity)", speeds[k], show(def));
+        }
+    }
+    if !d.speeds.dependent.is_empty() {
+        let how = match d.elimination {
+            Elimination::Symbolic => "solved symbolically",
+            Elimination::Numeric(_) => {
+                "solved numerically at run time (no provably non-zero pivot)"
+            }
+        };
+        let _ = writeln!(s, "dependent speeds (q_dot = C y_dot + c, {how}):");
+        for &r in &d.speeds.dependent {
+            let mut terms = Vec::new();
+            for k in 0..d.l {
+                let c = d.map.c[r * d.l + k];
+                if !g.is_zero(c) {
+                    terms.push(format!("({}) * {}", show(c), speeds[k]));
+                }
+            }
+            if !g.is_zero(d.map.c0[r]) {
+                terms.push(show(d.map.c0[r]));
+            }
+            if terms.is_empty() {
+                terms.push("0".into());
+            }
+            let _ = writeln!(s, "  {}_dot = {}", name(r), terms.join(" + "));
+        }
+    }
+    let list = |v: &[usize]| {
+        if v.is_empty() {
+            "none".to_string()
+        } else {
+            v.iter().map(|&i| name(i)).collect::<Vec<_>>().join(", ")
+        }
+    };
+    for line in &d.folded {
+        let _ = writeln!(s, "{line}");
+    }
+    let _ = writeln!(s, "cyclic coordinates: {}", list(&d.reduction.cyclic));
+    let _ = writeln!(
+        s,
+        "ignorable coordinates (not integrated): {}",
+        list(&d.reduction.ignorable)
+    );
+    let mut state: Vec<String> = d.reduction.retained.iter().map(|&i| name(i)).collect();
+    state.extend(speeds.iter().cloned());
+    let _ = writeln!(s, "reduced state: ({})", state.join(", "));
+    let accels: Vec<String> = d
+        .model
+        .speed_specs
+        .iter()
+        .map(|sp| g.symbol_name(sp.accel).to_string())
+        .collect();
+    let _ = writeln!(
+        s,
+        "M(q) y_ddot = f(q, y_dot, t) with y_ddot = ({}):",
+        accels.join(", ")
+    );
+    for k in 0..d.l {
+        for j in k..d.l {
+            let _ = writeln!(
+                s,
+                "  M[{}, {}] = {}",
+                speeds[k],
+                speeds[j],
+                show(d.equations.mass[k * d.l + j])
+            );
+        }
+    }
+    for k in 0..d.l {
+        let _ = writeln!(s, "  f[{}] = {}", speeds[k], show(d.equations.forcing[k]));
+    }
+    s
+}
