@@ -294,3 +294,29 @@ impl Assembler<'_> {
         })
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+    use super::super::Options;
+
+    #[test]
+    fn the_pendulums_mass_is_m_l_squared_and_its_inertial_forcing_vanishes() {
+        // M = m β̄·β̄ = m l²; −m a_rem·β̄ = −m l² q̇² (−sin q cos q + cos q sin q) = 0.
+        let mut run = testing::run(testing::PENDULUM);
+        let later = run.later(&Options::default());
+        let g = &mut run.model.g;
+        assert_agrees(g, later.equations.mass[0], "m*l^2");
+        let inertial = g.sum(&later.equations.inertial_terms[0]).unwrap();
+        assert_agrees(g, inertial, "0");
+    }
+
+    #[test]
+    fn a_rigid_body_adds_its_rotational_inertia() {
+        // The disc: m β̄·β̄ + γ̄·I γ̄ = m r² + j.
+        let mut run = testing::run(testing::DISC_ON_A_LINE);
+        let later = run.later(&Options::default());
+        let g = &mut run.model.g;
+        assert_agrees(g, later.equations.mass[0], "m*r^2 + j");
+    }
+}

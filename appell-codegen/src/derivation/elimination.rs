@@ -227,3 +227,62 @@ fn solved_rates(
         vanishing,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+    use super::*;
+
+    #[test]
+    fn a_constant_pivot_is_eliminated_symbolically() {
+        // ẋ + r φ̇ = 0 → ẋ = −r φ̇: [B | b] = [−r, 0].
+        let (mut m, _, _, _, solved) = testing::solve(testing::DISC_ON_A_LINE);
+        assert!(solved.schur.is_none());
+        assert_agrees(&mut m.g, solved.x[0], "-r");
+        assert!(m.g.is_zero(solved.x[1]));
+        assert!(solved.vanishing.is_empty());
+    }
+
+    #[test]
+    fn a_pivot_not_provably_nonzero_is_left_to_the_numeric_solve() {
+        // The knife edge: cos θ ẏ = sin θ ẋ. S = [cos θ], R = [sin θ, 0, 0]
+        // (columns ẋ, θ̇, 1); X is a symbol where R can be non-zero, zero in
+        // the θ̇ column, and a vanishing symbol in the last.
+        let (mut m, _, _, _, solved) = testing::solve(testing::SLEIGH);
+        let schur = solved.schur.expect("a numeric part");
+        assert_eq!((schur.k, schur.free.clone()), (1, vec![0]));
+        assert_agrees(&mut m.g, schur.s[0], "cos(theta)");
+        assert_agrees(&mut m.g, schur.r[0], "sin(theta)");
+        assert!(m.g.is_zero(schur.r[1]) && m.g.is_zero(schur.r[2]));
+        let names: Vec<&str> = schur.x.iter().map(|s| m.g.symbol_name(*s)).collect();
+        assert_eq!(names, vec!["__x_0_0", "__x_0_1", "__x_0_2"]);
+        assert!(!m.g.is_zero(schur.x_values[0]));
+        assert!(m.g.is_zero(schur.x_values[1]));
+        assert_eq!(solved.vanishing, vec![schur.x[2]]);
+        // T: the one row is the constraint row itself.
+        assert_agrees(&mut m.g, schur.row_ops[0], "1");
+    }
+
+    #[test]
+    fn an_unknown_no_row_reaches_is_reported() {
+        let src = r#"
+            #[appell(coordinates(x, y, z), speeds(x))]
+            #[appell(point(P = O + x * N.x + y * N.y + z * N.z), particle(P, mass = m))]
+            #[appell(nonholonomic(dt(y) == dt(x)), nonholonomic(dt(y) == 2 * dt(x)))]
+            struct Bad { m: f64 }
+        "#;
+        let mut model = testing::model(src);
+        let cx = Ctxt::new();
+        let calculus = super::super::Calculus::take_from(&mut model);
+        let rows = super::super::rows::constraint_rows(&cx, &mut model, &calculus)
+            .unwrap()
+            .unwrap();
+        let speeds = super::super::speeds::speed_definitions(&cx, &mut model, &rows)
+            .unwrap()
+            .unwrap();
+        let solved = eliminate(&cx, &mut model, &rows.d, &rows.d0, &speeds).unwrap();
+        assert!(solved.is_none());
+        let err = cx.check().expect_err("an error").to_string();
+        assert!(err.contains("cannot determine the rate of `z`"), "{err}");
+    }
+}

@@ -83,3 +83,30 @@ pub fn energies(
         power_terms,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+    use super::super::Options;
+
+    #[test]
+    fn the_pendulums_energies() {
+        let mut run = testing::run(testing::PENDULUM);
+        let later = run.later(&Options::default());
+        let g = &mut run.model.g;
+        assert_agrees(g, later.energies.kinetic, "m*l^2*q_dot^2/2");
+        assert_agrees(g, later.energies.potential, "-m*g*l*cos(q)");
+        assert!(g.is_zero(later.energies.input_power));
+    }
+
+    #[test]
+    fn an_input_forces_power_is_kept_with_its_effect() {
+        // T = ½ (m r² + j) φ̇², P = f ẋ = −r f φ̇.
+        let mut run = testing::run(testing::DISC_ON_A_LINE);
+        let later = run.later(&Options::default());
+        let g = &mut run.model.g;
+        assert_agrees(g, later.energies.kinetic, "(m*r^2 + j)*phi_dot^2/2");
+        assert_agrees(g, later.energies.input_power, "-r*f*phi_dot");
+        assert_eq!(later.energies.power_terms[0].0, "push");
+    }
+}

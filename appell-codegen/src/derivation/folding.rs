@@ -367,3 +367,76 @@ fn assembled_ops(g: &mut Graph, a: &Assembled, l: usize) -> Result<usize, Symbol
     }
     Ok(g.op_count(&roots)?.total())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+    use super::*;
+
+    /// A gimbal B (yaw, then pitch) carrying a rotor D that spins about B.y,
+    /// with its centre fixed in B.
+    const GYROSCOPE: &str = r#"
+        #[appell(coordinates(yaw, pitch, spin), speeds(yaw, pitch, spin), positive(mb, md))]
+        #[appell(frame(A = N.rotate_z(yaw)), frame(B = A.rotate_x(pitch)), frame(D = B.rotate_y(spin)))]
+        #[appell(point(Bo = O + a * B.z), point(Do = O + h * B.z))]
+        #[appell(body(gimbal, center = Bo, frame = B, mass = mb, inertia = principal(i1, i2, i3)))]
+        #[appell(body(rotor, center = Do, frame = D, mass = md, inertia = principal(j1, j2, j1)))]
+        #[appell(gravity(-g * N.z))]
+        struct Gyro { a: f64, h: f64, mb: f64, md: f64, i1: f64, i2: f64, i3: f64, j1: f64, j2: f64, g: f64 }
+    "#;
+
+    #[test]
+    fn a_symmetric_body_spinning_about_a_carrier_axis_is_a_rotor() {
+        let mut m = testing::model(GYROSCOPE);
+        let found = rotors(&mut m.g, &m.bodies, &m.frames, &m.coords).unwrap();
+        assert!(found[0].is_none());
+        let r = found[1].expect("the rotor");
+        assert_eq!((r.carrier, r.axis, r.coordinate), (0, 1, 2));
+        assert_agrees(&mut m.g, r.axial, "j2");
+    }
+
+    #[test]
+    fn centres_fixed_in_one_frame_form_a_composite_at_their_mass_centre() {
+        let mut m = testing::model(GYROSCOPE);
+        let rotations: Vec<Option<Mat3>> = m
+            .bodies
+            .iter()
+            .map(|b| b.frame.map(|f| m.frames[f].rot))
+            .collect();
+        let assume = super::super::elimination::assumptions(&m);
+        let found = composite_bodies(&mut m.g, &m.bodies, &rotations, &assume).unwrap();
+        assert!(matches!(found[1], Composite::Member(0)));
+        let Composite::Leader { mass, shift, .. } = &found[0] else {
+            panic!("the gimbal leads");
+        };
+        // G − r_gimbal = md (h − a) / (mb + md) along B.z.
+        assert_agrees(&mut m.g, *mass, "mb + md");
+        assert_agrees(&mut m.g, shift[2], "md*(h - a)/(mb + md)");
+    }
+
+    #[test]
+    fn forced_folding_keeps_the_same_equations_and_says_so() {
+        let forced = Options {
+            fold_always: true,
+            rotor_form: None,
+        };
+        let mut plain = testing::run(GYROSCOPE);
+        let a = plain.later(&Options::default());
+        let mut folded = testing::run(GYROSCOPE);
+        let b = folded.later(&forced);
+        assert!(b
+            .folded_lines
+            .iter()
+            .any(|l| l.starts_with("composite: `gimbal`")));
+        assert!(b
+            .folded_lines
+            .iter()
+            .any(|l| l.starts_with("rotor: `rotor`")));
+        // Both graphs were built the same way up to here: compare by value.
+        let g = &mut folded.model.g;
+        for k in 0..9 {
+            let text = plain.model.g.display(a.equations.mass[k]).to_string();
+            assert_agrees(g, b.equations.mass[k], &text);
+        }
+    }
+}

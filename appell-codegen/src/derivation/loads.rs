@@ -173,3 +173,30 @@ fn torque_terms(
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+    use super::super::Options;
+
+    #[test]
+    fn gravity_gives_the_pendulums_restoring_force() {
+        // f = (−m g N.y)·β̄ = −m g l sin q.
+        let mut run = testing::run(testing::PENDULUM);
+        let later = run.later(&Options::default());
+        let g = &mut run.model.g;
+        assert_agrees(g, later.equations.forcing[0], "-m*g*l*sin(q)");
+        assert_eq!(later.equations.load_terms.len(), 1);
+        assert_eq!(later.equations.load_terms[0].0, "gravity");
+    }
+
+    #[test]
+    fn an_input_force_enters_through_the_dependent_rate() {
+        // F = f N.x at the centre, β̄ = (−r, 0, 0): f_φ = −r f.
+        let mut run = testing::run(testing::DISC_ON_A_LINE);
+        let later = run.later(&Options::default());
+        let g = &mut run.model.g;
+        assert_agrees(g, later.equations.forcing[0], "-r*f");
+        assert_eq!(later.equations.load_terms[0].0, "push");
+    }
+}

@@ -338,3 +338,6 @@ fn velocity_residuals(model: &mut Model, rows: &ConstraintRows) -> Result<Vec<Id
     }
     Ok(out)
 }
+
+#[cfg(test)]
+mod testing;

@@ -303,3 +303,54 @@ fn schur_as_written(
     }
     Ok(Some((s, r)))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees_with};
+    use super::*;
+
+    fn numeric(run: &testing::Run) -> &NumericElimination {
+        match &run.elimination {
+            Elimination::Numeric(ne) => ne,
+            Elimination::Symbolic => panic!("a numeric elimination"),
+        }
+    }
+
+    #[test]
+    fn the_knife_edge_solves_for_x_and_w() {
+        // S X = R: cos θ X = sin θ, so X = tan θ; w = Ẋ ẋ = θ̇ ẋ / cos² θ, and
+        // S w = θ̇ ẋ / cos θ.
+        let mut run = testing::run(testing::SLEIGH);
+        let ne = numeric(&run).clone();
+        let g = &mut run.model.g;
+        assert_eq!(ne.columns, vec![0]);
+        let x = g.parse("__x_0_0").unwrap();
+        let s_x = g.mul(ne.dp[0], x).unwrap();
+        let tan = [("__x_0_0", "sin(theta)/cos(theta)")];
+        assert_agrees_with(g, s_x, "sin(theta)", &tan);
+        assert_agrees_with(g, ne.rhs[0], "sin(theta)", &tan);
+        assert_agrees_with(
+            g,
+            ne.rhs_rate[0],
+            "theta_dot*x_dot/cos(theta)",
+            &[("__x_0_0", "sin(theta)/cos(theta)"), ("__x_0_2", "0")],
+        );
+        assert_eq!(g.symbol_name(ne.w[0]), "__w_0");
+    }
+
+    #[test]
+    fn the_cartesian_pendulum_has_the_circles_acceleration_remainder() {
+        // x ẋ + y ẏ = 0: ẏ = −x ẋ / y, and with ẍ = 0 the remainder of ÿ
+        // is −(ẋ² + ẏ²) / y: w = (S w) / S.
+        let mut run = testing::run(testing::CARTESIAN);
+        let ne = numeric(&run).clone();
+        let g = &mut run.model.g;
+        let w = g.div(ne.rhs_rate[0], ne.dp[0]).unwrap();
+        assert_agrees_with(
+            g,
+            w,
+            "-(x_dot^2 + (x*x_dot/y)^2)/y",
+            &[("__x_0_0", "-x/y"), ("__x_0_1", "0")],
+        );
+    }
+}

@@ -356,3 +356,39 @@ mod tests {
         assert!(simple_turn(&mut g, &h, &f, &rates).unwrap().is_none());
     }
 }
+
+#[cfg(test)]
+mod stage_tests {
+    use super::super::testing::{self, assert_agrees};
+
+    #[test]
+    fn the_pendulums_partial_velocity_is_tangent_to_its_circle() {
+        // v = l q̇ (cos q, sin q, 0).
+        let mut run = testing::run(testing::PENDULUM);
+        let p = run.partials();
+        let g = &mut run.model.g;
+        let b = &p.bodies[0];
+        assert_agrees(g, b.beta[0][0], "l*cos(q)");
+        assert_agrees(g, b.beta[0][1], "l*sin(q)");
+        assert!(g.is_zero(b.beta[0][2]));
+        assert!(b.beta0.iter().all(|e| g.is_zero(*e)));
+        assert!(p.rotations[0].is_none());
+    }
+
+    #[test]
+    fn a_rolling_discs_partials_go_through_c() {
+        // ẋ = −r φ̇: β̄ = (−r, 0, 0); γ̄ = B.z, in B's components (0, 0, 1);
+        // the force at the centre has the centre's β̄.
+        let mut run = testing::run(testing::DISC_ON_A_LINE);
+        let p = run.partials();
+        let g = &mut run.model.g;
+        let b = &p.bodies[0];
+        assert_agrees(g, b.beta[0][0], "-r");
+        assert!(g.is_zero(b.beta[0][1]));
+        assert_agrees(g, b.gamma_b[0][2], "1");
+        assert!(g.is_zero(b.gamma_b[0][0]) && g.is_zero(b.gamma_b[0][1]));
+        assert_agrees(g, b.omega_b[2], "phi_dot");
+        assert_agrees(g, p.forces[0].parts[0][0], "-r");
+        assert_agrees(g, p.center_parts[0][0][0], "1");
+    }
+}

@@ -135,3 +135,23 @@ mod tests {
         assert_eq!(same_function(&g, nan, nan), None);
     }
 }
+
+#[cfg(test)]
+mod rank_tests {
+    use super::*;
+
+    #[test]
+    fn a_row_that_combines_earlier_rows_is_found() {
+        let mut g = Graph::new();
+        g.coordinate("q").unwrap();
+        g.parameter("r").unwrap();
+        // Rows of D (m = 3, n = 2): the third is r times the first plus the
+        // second, at every configuration.
+        let d: Vec<Id> = ["cos(q)", "sin(q)", "1", "r", "r*cos(q) + 1", "r*sin(q) + r"]
+            .iter()
+            .map(|t| g.parse(t).unwrap())
+            .collect();
+        assert_eq!(dependent_row(&g, &d, 2, 3), Some(2));
+        assert_eq!(dependent_row(&g, &d[..4], 2, 2), None);
+    }
+}

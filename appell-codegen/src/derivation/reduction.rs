@@ -258,3 +258,43 @@ pub fn drop_vanishing(
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing;
+    use super::super::{derive, Derivation};
+    use crate::ctxt::Ctxt;
+
+    fn derived(src: &str) -> Derivation {
+        let cx = Ctxt::new();
+        let d = derive(&cx, testing::model(src));
+        cx.check().expect("no errors");
+        d.expect("a derivation")
+    }
+
+    #[test]
+    fn the_pendulum_keeps_its_angle() {
+        let d = derived(testing::PENDULUM);
+        assert_eq!(d.reduction.retained, vec![0]);
+        assert!(d.reduction.ignorable.is_empty() && d.reduction.cyclic.is_empty());
+    }
+
+    #[test]
+    fn a_dependent_coordinate_nothing_reads_is_cyclic() {
+        // The disc on a line: M and f read neither x nor φ; x is dependent.
+        let d = derived(testing::DISC_ON_A_LINE);
+        assert!(d.reduction.retained.is_empty());
+        assert_eq!(d.reduction.ignorable, vec![0, 1]);
+        assert_eq!(d.reduction.cyclic, vec![0]);
+    }
+
+    #[test]
+    fn the_sleigh_keeps_its_heading_only() {
+        // Through X = tan θ the equations read θ; x and y are ignorable, and
+        // y, dependent, is cyclic.
+        let d = derived(testing::SLEIGH);
+        assert_eq!(d.reduction.retained, vec![2]);
+        assert_eq!(d.reduction.ignorable, vec![0, 1]);
+        assert_eq!(d.reduction.cyclic, vec![1]);
+    }
+}

@@ -156,3 +156,49 @@ fn turned_alpha(
     }
     Ok(alpha)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+
+    #[test]
+    fn the_pendulums_remainder_is_its_centripetal_acceleration() {
+        // a = l q̈ (cos q, sin q) + l q̇² (−sin q, cos q): the remainder is the
+        // second part, l q̇² towards the pivot.
+        let mut run = testing::run(testing::PENDULUM);
+        let (p, r) = run.remainders();
+        let g = &mut run.model.g;
+        let zero = g.int(0).unwrap();
+        let center = run.model.bodies[0].center;
+        let mut v = [zero; 3];
+        for i in 0..3 {
+            v[i] = g.time_derivative(center[i], &run.calculus.rules).unwrap();
+        }
+        let a = r
+            .of_velocity(
+                g,
+                &mut run.rates,
+                &mut run.calculus.uncut,
+                v,
+                Some(&p.center_parts[0]),
+            )
+            .unwrap();
+        assert_agrees(g, a[0], "-l*q_dot^2*sin(q)");
+        assert_agrees(g, a[1], "l*q_dot^2*cos(q)");
+        assert!(r.dependent.is_empty());
+        assert_eq!(r.alphas, vec![None]);
+    }
+
+    #[test]
+    fn a_numeric_dependent_rates_remainder_is_w() {
+        // The knife edge: ÿ's remainder is w (the numeric solve's), and the
+        // sleigh turning at a constant rate has no angular remainder.
+        let mut run = testing::run(testing::SLEIGH);
+        let (_, r) = run.remainders();
+        let g = &mut run.model.g;
+        assert_eq!(r.coordinates, vec![1]);
+        assert_agrees(g, r.dependent[0].1, "__w_0");
+        let alpha = r.alphas[0].expect("a rigid body");
+        assert!(alpha.iter().all(|e| g.is_zero(*e)));
+    }
+}

@@ -422,3 +422,94 @@ pub(super) fn rolling_components(
         None => Ok(v.to_vec()),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+    use super::*;
+
+    fn rows_of(src: &str) -> (Model, ConstraintRows) {
+        let mut model = testing::model(src);
+        let calculus = Calculus::take_from(&mut model);
+        let cx = Ctxt::new();
+        let rows = constraint_rows(&cx, &mut model, &calculus)
+            .expect("rows")
+            .expect("no errors");
+        cx.check().expect("no errors");
+        (model, rows)
+    }
+
+    #[test]
+    fn a_holonomic_constraint_enters_through_its_time_derivative() {
+        // x² + y² − l² = 0 → 2x ẋ + 2y ẏ = 0.
+        let (mut m, rows) = rows_of(testing::CARTESIAN);
+        assert_eq!(rows.sources, vec![RowSource::Holonomic(0)]);
+        assert_eq!(rows.d.len(), 2);
+        assert_agrees(&mut m.g, rows.d[0], "2*x");
+        assert_agrees(&mut m.g, rows.d[1], "2*y");
+        assert!(m.g.is_zero(rows.d0[0]));
+        assert_agrees(&mut m.g, rows.holonomic[0], "x^2 + y^2 - l^2");
+        assert_agrees(&mut m.g, rows.as_written[0], "2*x*x_dot + 2*y*y_dot");
+    }
+
+    #[test]
+    fn a_knife_edge_is_one_nonholonomic_row() {
+        // ẏ cos θ − ẋ sin θ = 0: D = [−sin θ, cos θ, 0], d = 0.
+        let (mut m, rows) = rows_of(testing::SLEIGH);
+        assert_eq!(rows.sources, vec![RowSource::Nonholonomic(0)]);
+        assert_agrees(&mut m.g, rows.d[0], "-sin(theta)");
+        assert_agrees(&mut m.g, rows.d[1], "cos(theta)");
+        assert!(m.g.is_zero(rows.d[2]));
+        assert!(m.g.is_zero(rows.d0[0]));
+        assert!(rows.contacts.is_empty());
+    }
+
+    #[test]
+    fn a_rolling_disc_on_a_line_gives_one_row_per_nonzero_component() {
+        // v(material point at P) = (ẋ + r φ̇) N.x: the N.y and N.z rows are
+        // identically zero and dropped.
+        let (mut m, rows) = rows_of(
+            r#"
+            #[appell(coordinates(x, phi), speeds(phi))]
+            #[appell(frame(B = N.rotate_z(phi)))]
+            #[appell(point(D = O + x * N.x + r * N.y), point(P = D - r * N.y))]
+            #[appell(body(disc, center = D, frame = B, mass = m, inertia = principal(i, i, j)))]
+            #[appell(rolls(disc, contact = P))]
+            struct Disc { m: f64, r: f64, i: f64, j: f64 }
+            "#,
+        );
+        assert_eq!(
+            rows.sources,
+            vec![RowSource::Rolling {
+                contact: 0,
+                direction: 0
+            }]
+        );
+        assert_agrees(&mut m.g, rows.d[0], "1");
+        assert_agrees(&mut m.g, rows.d[1], "r");
+        assert!(rows.contacts[0].complete);
+        assert!(rows.directions[0].is_some_and(|(c, _)| c == 0));
+        assert_agrees(&mut m.g, rows.contacts[0].velocity[0], "x_dot + r*phi_dot");
+    }
+
+    #[test]
+    fn a_row_with_no_rate_is_reported() {
+        let mut model = testing::model(
+            r#"
+            #[appell(coordinates(x, y), speeds(x))]
+            #[appell(point(P = O + x * N.x + y * N.y), particle(P, mass = m))]
+            #[appell(nonholonomic(x == 0))]
+            struct Bad { m: f64 }
+            "#,
+        );
+        let calculus = Calculus::take_from(&mut model);
+        let cx = Ctxt::new();
+        let rows = constraint_rows(&cx, &mut model, &calculus).expect("no engine error");
+        assert!(rows.is_none());
+        let err = cx.check().expect_err("an error").to_string();
+        assert!(
+            err.contains("does not involve any coordinate rate"),
+            "{err}"
+        );
+    }
+}

@@ -105,3 +105,30 @@ fn scene_derivation(full: &Derivation, scene: &Scene) -> Result<Derivation, Symb
     d.text = text::equations_text(&d);
     Ok(d)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::derive;
+    use super::super::testing::{self, assert_agrees};
+    use super::*;
+
+    #[test]
+    fn a_scene_keeps_its_effects_loads_only() {
+        // Gravity does no work along the line: without the push, f = 0.
+        let src = testing::DISC_ON_A_LINE
+            .replace(
+                "#[appell(rolls(disc, contact = P))]",
+                "#[appell(rolls(disc, contact = P), gravity(-g * N.y))]\n#[appell(scene(falling, effects(gravity)))]",
+            )
+            .replace("j: f64 }", "j: f64, g: f64 }");
+        let cx = Ctxt::new();
+        let full = derive(&cx, testing::model(&src)).expect("derivation");
+        let scene = derive_scene(&cx, &full, &full.model.scenes[0]).expect("scene");
+        cx.check().expect("no errors");
+        let mut g = scene.model.g.clone();
+        assert_agrees(&mut g, full.equations.forcing[0], "-r*f");
+        assert_agrees(&mut g, scene.equations.forcing[0], "0");
+        assert!(g.is_zero(scene.energies.input_power));
+        assert_eq!(scene.equations.mass, full.equations.mass);
+    }
+}

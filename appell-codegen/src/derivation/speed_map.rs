@@ -121,3 +121,33 @@ pub fn speed_map(
         },
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::testing::{self, assert_agrees};
+
+    #[test]
+    fn c_has_unit_rows_for_the_speeds_and_the_solution_for_the_rest() {
+        // ẋ = −r φ̇, φ̇ = φ̇: C = [−r; 1], c = 0.
+        let mut run = testing::run(testing::DISC_ON_A_LINE);
+        let g = &mut run.model.g;
+        assert_agrees(g, run.map.c[0], "-r");
+        assert_agrees(g, run.map.c[1], "1");
+        assert!(run.map.c0.iter().all(|e| g.is_zero(*e)));
+        assert_agrees(g, run.map.qdot[0], "-r*phi_dot");
+        assert_agrees(g, run.map.qdot[1], "phi_dot");
+    }
+
+    #[test]
+    fn a_numeric_unknown_stands_as_its_symbol_in_c() {
+        // The knife edge: ẏ = X ẋ + X_l, with X_l the vanishing symbol.
+        let mut run = testing::run(testing::SLEIGH);
+        let g = &mut run.model.g;
+        let l = 2;
+        assert_agrees(g, run.map.c[0], "1");
+        assert_agrees(g, run.map.c[l], "__x_0_0");
+        assert!(g.is_zero(run.map.c[l + 1]));
+        assert_agrees(g, run.map.c[2 * l + 1], "1");
+        assert_agrees(g, run.map.qdot[1], "__x_0_0*x_dot + __x_0_2");
+    }
+}

@@ -182,3 +182,70 @@ fn check_holonomic_involve_dependent(cx: &Ctxt, model: &Model, dependent: &[usiz
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::rows::constraint_rows;
+    use super::super::testing::{self, assert_agrees};
+    use super::super::Calculus;
+    use super::*;
+
+    fn definitions(src: &str) -> (Model, Option<SpeedDefinitions>, Result<(), String>) {
+        let mut model = testing::model(src);
+        let calculus = Calculus::take_from(&mut model);
+        let cx = Ctxt::new();
+        let rows = constraint_rows(&cx, &mut model, &calculus)
+            .expect("rows")
+            .expect("no errors");
+        let speeds = speed_definitions(&cx, &mut model, &rows).expect("no engine error");
+        let checked = cx.check().map_err(|e| e.to_string());
+        (model, speeds, checked)
+    }
+
+    #[test]
+    fn coordinate_speeds_are_unit_rows_of_w() {
+        let (m, speeds, ok) = definitions(testing::SLEIGH);
+        ok.expect("no errors");
+        let s = speeds.expect("definitions");
+        let one = |e: &Id| m.g.as_number(*e).map(|n| n.to_f64());
+        let w: Vec<Option<f64>> = s.w.iter().map(one).collect();
+        let (o, z) = (Some(1.0), Some(0.0));
+        assert_eq!(w, vec![o, z, z, z, z, o]);
+        assert!(s.w0.iter().all(|e| m.g.is_zero(*e)));
+        assert!(!s.quasi);
+        assert_eq!(s.dependent, vec![1]);
+    }
+
+    #[test]
+    fn a_quasi_velocity_is_its_defining_row_and_every_rate_is_unknown() {
+        // v = velocity(P)·B.x = ẋ cos θ + ẏ sin θ, w = θ̇ (Method III).
+        let (mut m, speeds, ok) = definitions(
+            r#"
+            #[appell(coordinates(x, y, theta), positive(m, b))]
+            #[appell(speeds(v = dot(velocity(P), B.x), w = dot(omega(B), N.z)))]
+            #[appell(frame(B = N.rotate_z(theta)))]
+            #[appell(point(P = O + x * N.x + y * N.y), point(C = P + b * B.x))]
+            #[appell(body(sleigh, center = C, frame = B, mass = m, inertia = principal(i0, i0, i0)))]
+            #[appell(nonholonomic(dt(y) * cos(theta) - dt(x) * sin(theta) == 0))]
+            struct Sleigh { m: f64, b: f64, i0: f64 }
+            "#,
+        );
+        ok.expect("no errors");
+        let s = speeds.expect("definitions");
+        assert!(s.quasi);
+        assert_eq!(s.dependent, vec![0, 1, 2]);
+        assert_agrees(&mut m.g, s.w[0], "cos(theta)");
+        assert_agrees(&mut m.g, s.w[1], "sin(theta)");
+        assert!(m.g.is_zero(s.w[2]));
+        assert_agrees(&mut m.g, s.w[5], "1");
+    }
+
+    #[test]
+    fn a_wrong_number_of_speeds_is_reported_with_the_right_count() {
+        let (_, speeds, checked) =
+            definitions(&testing::SLEIGH.replace("speeds(x, theta)", "speeds(x, y, theta)"));
+        assert!(speeds.is_none());
+        let err = checked.expect_err("an error");
+        assert!(err.contains("must name 2"), "{err}");
+    }
+}

@@ -153,3 +153,24 @@ mod tests {
         assert_eq!(nz[2], vec![true, false, true]);
     }
 }
+
+#[cfg(test)]
+mod matching_tests {
+    use super::*;
+
+    #[test]
+    fn an_unknown_no_row_can_be_matched_to_is_found() {
+        let mut g = Graph::new();
+        // Rows 0 and 1 both read only unknown 0: unknown 1 has no row.
+        let a: Vec<Id> = ["a", "0", "b", "0"]
+            .iter()
+            .map(|t| g.parse(t).unwrap())
+            .collect();
+        assert_eq!(unmatched_column(&g, &a, 2), Some(1));
+        let a: Vec<Id> = ["0", "a", "b", "c"]
+            .iter()
+            .map(|t| g.parse(t).unwrap())
+            .collect();
+        assert_eq!(unmatched_column(&g, &a, 2), None);
+    }
+}

@@ -116,3 +116,25 @@ pub fn equations_text(d: &Derivation) -> String {
     }
     s
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::{derive, testing};
+    use crate::ctxt::Ctxt;
+
+    #[test]
+    fn the_text_names_the_dependent_speeds_and_the_reduced_state() {
+        let cx = Ctxt::new();
+        let d = derive(&cx, testing::model(testing::DISC_ON_A_LINE)).expect("derivation");
+        cx.check().expect("no errors");
+        assert!(
+            d.text
+                .contains("dependent speeds (q_dot = C y_dot + c, solved symbolically):"),
+            "{}",
+            d.text
+        );
+        assert!(d.text.contains("x_dot = "), "{}", d.text);
+        assert!(d.text.contains("cyclic coordinates: x"), "{}", d.text);
+        assert!(d.text.contains("reduced state: (phi_dot)"), "{}", d.text);
+    }
+}
