@@ -8,6 +8,8 @@
 //! error) and benches. A struct written inside a `macro_rules!` body (the
 //! gyroscopes of `tests/composite_bodies.rs`) is not seen.
 //!
+//! The expansion is compared as formatted Rust (see [`expansion_text`]).
+//!
 //! `APPELL_BLESS=1 cargo test -p appell-codegen --test snapshots` writes the
 //! snapshots anew; review the diff before committing it.
 
@@ -69,13 +71,15 @@ impl<'ast> Visit<'ast> for Models {
     }
 }
 
-/// The expansion as text, one statement a line so a change reads as a diff.
+/// The expansion as formatted Rust: the syntax the compiler sees, one
+/// statement a line so a change reads as a diff. Formatting the syntax tree
+/// leaves out what only the token stream carries (spans, and whether two
+/// punctuation marks were written together), which is no change of code.
 fn expansion_text(item: &syn::ItemStruct) -> String {
     let input = syn::DeriveInput::from(item.clone());
-    let text = appell_codegen::expand(&input).to_string();
-    let mut out = text.replace("; ", ";\n");
-    out.push('\n');
-    out
+    let tokens = appell_codegen::expand(&input);
+    let file: syn::File = syn::parse2(tokens).expect("the expansion parses as Rust items");
+    prettyplease::unparse(&file)
 }
 
 /// Every model: (snapshot name, expansion).
