@@ -1,0 +1,104 @@
+//! Straight-line programs from the engine, as tokens.
+//!
+//! Each numeric function of the generated implementation is one program the
+//! engine lowers (shared subexpressions bound once) and writes: statements
+//! computing parameter-only values (`prepare`), the per-call statements
+//! (`body`, or split into `stages` around numeric solves) and one
+//! expression per output. This module asks the engine for them with the
+//! options the generated code needs and hands them on as tokens.
+
+use std::str::FromStr;
+
+use appell_symbolic::{EmitOptions, Id, OpCount, Program, RustCode};
+use proc_macro2::TokenStream;
+
+use crate::derivation::Derivation;
+
+/// The scalar the program is written for.
+#[derive(Clone, Copy)]
+pub enum Target {
+    /// The generic scalar `__T`, constants through `Scalar::from_f64`;
+    /// `hoist` moves parameter-only work into `prepare`.
+    Generic {
+        /// Whether parameter-only work is hoisted.
+        hoist: bool,
+    },
+    /// Plain `f64` (the mass properties), nothing hoisted.
+    F64,
+}
+
+/// An engine program as tokens.
+pub struct Code {
+    /// Statements computing the hoisted values.
+    pub prepare: Vec<TokenStream>,
+    /// The hoisted values' names.
+    pub hoisted: Vec<TokenStream>,
+    /// The per-call statements.
+    pub body: Vec<TokenStream>,
+    /// The per-call statements by stage (see `EmitOptions::symbol_stage`).
+    pub stages: Vec<Vec<TokenStream>>,
+    /// One expression per root.
+    pub outputs: Vec<TokenStream>,
+    /// Operations per call.
+    pub ops: OpCount,
+}
+
+impl Code {
+    /// `prepare` and `body`, in order.
+    pub fn statements(&self) -> TokenStream {
+        let (prepare, body) = (&self.prepare, &self.body);
+        quote::quote!(#(#prepare)* #(#body)*)
+    }
+}
+
+/// The engine's options for `target`.
+pub fn options(target: Target) -> EmitOptions {
+    match target {
+        Target::Generic { hoist } => EmitOptions {
+            scalar: "__T".into(),
+            constant: "<__T as ::appell::__private::Scalar>::from_f64({lit})".into(),
+            cse: true,
+            hoist_parameters: hoist,
+            symbol_text: Default::default(),
+            symbol_stage: Default::default(),
+            fused: true,
+        },
+        Target::F64 => EmitOptions {
+            scalar: "f64".into(),
+            constant: "{lit}_f64".into(),
+            cse: true,
+            hoist_parameters: false,
+            symbol_text: Default::default(),
+            symbol_stage: Default::default(),
+            fused: false,
+        },
+    }
+}
+
+/// The program computing `roots`, written for `target`.
+pub fn code(d: &Derivation, roots: &[Id], target: Target) -> Code {
+    code_with(d, roots, &options(target))
+}
+
+/// The program computing `roots`, written with `options`.
+pub fn code_with(d: &Derivation, roots: &[Id], options: &EmitOptions) -> Code {
+    let g = &d.model.g;
+    from_text(&Program::lower(g, roots).to_rust(g, options))
+}
+
+fn from_text(c: &RustCode) -> Code {
+    let all = |v: &[String]| v.iter().map(|s| tokens(s)).collect::<Vec<_>>();
+    Code {
+        prepare: all(&c.prepare),
+        hoisted: all(&c.hoisted),
+        body: all(&c.body),
+        stages: c.stages.iter().map(|s| all(s)).collect(),
+        outputs: all(&c.outputs),
+        ops: c.ops,
+    }
+}
+
+/// One statement or expression of the engine's writer as tokens.
+fn tokens(text: &str) -> TokenStream {
+    TokenStream::from_str(text).expect("the engine writes valid Rust")
+}

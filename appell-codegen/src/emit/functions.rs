@@ -1,0 +1,472 @@
+//! The `Model` trait's methods.
+//!
+//! `prepare` and `rhs` carry the reduced equations (see [`Emitter::rhs`]);
+//! the other methods each evaluate one group of the derivation's
+//! expressions at a full state: M and f, C and c, q̇, the constraint
+//! residuals and rows, W and w, the energies and input power, and the
+//! kinematic description the multiplier oracle and the constraint-force
+//! outputs read (mass properties, body poses, load geometry and values,
+//! contact geometry). Every slice argument's length is checked first.
+
+use appell_symbolic::{Id, Symbol, SymbolKind};
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+use super::code::{code, Code, Target};
+use super::{int, p, Emitter};
+use crate::derivation::RowSource;
+
+/// `target[i] = output_i;` for the outputs `range`, from index 0.
+fn outputs_into(c: &Code, target: &str, range: std::ops::Range<usize>) -> TokenStream {
+    let target = format_ident!("{}", target);
+    let stores = c.outputs[range].iter().enumerate().map(|(i, o)| {
+        let i = int(i);
+        quote!(#target[#i] = #o;)
+    });
+    quote!(#(#stores)*)
+}
+
+/// `target[k] = [outputs...];` for `count` groups of `width` outputs from
+/// `offset`.
+fn groups_into(c: &Code, target: &str, offset: usize, count: usize, width: usize) -> TokenStream {
+    let target = format_ident!("{}", target);
+    let stores = (0..count).map(|k| {
+        let items = &c.outputs[offset + k * width..offset + (k + 1) * width];
+        let k = int(k);
+        quote!(#target[#k] = [#(#items),*];)
+    });
+    quote!(#(#stores)*)
+}
+
+/// Statements every method's body shares.
+pub(super) struct Common {
+    pub(super) params_t: TokenStream,
+    params_f: TokenStream,
+    pub(super) positivity: TokenStream,
+    bind_q: TokenStream,
+    bind_qdot: TokenStream,
+    bind_u: TokenStream,
+    pub(super) bind_inputs: TokenStream,
+    /// S X = R and S w = … solved (M and f need w).
+    elim_full: TokenStream,
+    /// S X = R solved.
+    elim_pos: TokenStream,
+}
+
+impl Emitter<'_> {
+    /// The `ModelInfo` static and the `Model` implementation.
+    pub(super) fn implementation(&self) -> TokenStream {
+        let p = p();
+        let common = Common {
+            params_t: self.params_as(true),
+            params_f: self.params_as(false),
+            positivity: self.positivity(),
+            bind_q: self.bind_q("__q"),
+            bind_qdot: self.bind_qdot("__qdot"),
+            bind_u: self.bind_u("__u"),
+            bind_inputs: self.bind_inputs("__inputs"),
+            elim_full: self.elimination(true),
+            elim_pos: self.elimination(false),
+        };
+        let rhs = self.rhs(&common);
+        let info = &rhs.info;
+        let (info_ident, name) = (&self.info_ident, &self.type_name);
+        let (scene_infos, scene_rhs) = (&self.scene_infos, &self.scene_rhs);
+        let h = int(rhs.hoisted);
+        let (prepare, rhs_fn) = (&rhs.prepare, &rhs.rhs);
+        let parameters = self.parameter_access();
+        let equations = self.equations_functions(&common);
+        let kinematics = self.kinematics_functions(&common);
+        quote! {
+            static #info_ident: #p::ModelInfo = #info;
+            #[automatically_derived]
+            #[allow(unused_variables, unused_parens, non_snake_case, clippy::all)]
+            impl #p::Model for #name {
+                type Prepared<__T: #p::Scalar> = [__T; #h];
+                fn info() -> &'static #p::ModelInfo { &#info_ident }
+                fn scene_infos() -> &'static [&'static #p::ModelInfo] { #scene_infos }
+                #scene_rhs
+                #parameters
+                #prepare
+                #rhs_fn
+                #equations
+                #kinematics
+            }
+        }
+    }
+
+    /// `parameter_values` and `set_parameter`.
+    fn parameter_access(&self) -> TokenStream {
+        let p = p();
+        let this = &self.this;
+        let params = &self.d.model.params;
+        let check = self.check("__out", params.len());
+        let gets = params.iter().enumerate().map(|(k, prm)| {
+            let (f, k) = (&prm.ident, int(k));
+            quote!(__out[#k] = #this.#f;)
+        });
+        let sets = params.iter().map(|prm| {
+            let f = &prm.ident;
+            let name = f.to_string();
+            quote!(#name => { #this.#f = __value; true })
+        });
+        quote! {
+            fn parameter_values(&self, __out: &mut [f64]) -> #p::Result<(), #p::ModelError> {
+                #check
+                #(#gets)*
+                #p::Ok(())
+            }
+            fn set_parameter(&mut self, __name: &str, __value: f64) -> bool {
+                match __name {
+                    #(#sets,)*
+                    _ => false,
+                }
+            }
+        }
+    }
+
+    /// M and f, C and c, q̇, the constraint residuals, W and w, the input
+    /// power and the energies.
+    fn equations_functions(&self, c: &Common) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let (n, m, l) = (d.n, d.m, d.l);
+        let Common {
+            params_t,
+            positivity: pos,
+            bind_q,
+            bind_qdot,
+            bind_u,
+            bind_inputs,
+            elim_full,
+            elim_pos,
+            ..
+        } = c;
+        let ni = d.model.inputs.len();
+        let nh = d.constraints.holonomic.len();
+        let chk = |arg: &str, len: usize| self.check(arg, len);
+        let (chk_q, chk_u, chk_inputs) = (chk("__q", n), chk("__u", l), chk("__inputs", ni));
+        let generic = Target::Generic { hoist: false };
+        let mut mf_roots = d.equations.mass.clone();
+        mf_roots.extend(&d.equations.forcing);
+        let mf = code(d, &mf_roots, generic);
+        let (mf_body, mf_m, mf_f) = (
+            mf.statements(),
+            outputs_into(&mf, "__m", 0..l * l),
+            outputs_into(&mf, "__f", l * l..l * l + l),
+        );
+        let mut ct_roots = d.map.c.clone();
+        ct_roots.extend(&d.map.c0);
+        let ct = code(d, &ct_roots, generic);
+        let (ct_body, ct_c, ct_c0) = (
+            ct.statements(),
+            outputs_into(&ct, "__c", 0..n * l),
+            outputs_into(&ct, "__c0", n * l..n * l + n),
+        );
+        let cr = code(d, &d.map.qdot, generic);
+        let (cr_body, cr_out) = (cr.statements(), outputs_into(&cr, "__qdot", 0..n));
+        let mut res_roots = d.constraints.holonomic.clone();
+        res_roots.extend(&d.velocity_residuals);
+        let res = code(d, &res_roots, generic);
+        let (res_body, res_h, res_v) = (
+            res.statements(),
+            outputs_into(&res, "__holonomic", 0..nh),
+            outputs_into(&res, "__velocity", nh..nh + m),
+        );
+        let mut sd_roots = d.speeds.w.clone();
+        sd_roots.extend(&d.speeds.w0);
+        let sd = code(d, &sd_roots, generic);
+        let (sd_body, sd_w, sd_w0) = (
+            sd.statements(),
+            outputs_into(&sd, "__w", 0..l * n),
+            outputs_into(&sd, "__w0", l * n..l * n + l),
+        );
+        let single = |e: Id| {
+            let c = code(d, &[e], generic);
+            (c.statements(), c.outputs[0].clone())
+        };
+        let (ip_body, ip_out) = single(d.energies.input_power);
+        let (pe_body, pe_out) = single(d.energies.potential);
+        let (ke_body, ke_out) = single(d.energies.kinetic);
+        let checks_mf = [chk("__m", l * l), chk("__f", l)];
+        let checks_ct = [chk("__c", n * l), chk("__c0", n)];
+        let chk_qdot = chk("__qdot", n);
+        let checks_res = [chk("__holonomic", nh), chk("__velocity", m)];
+        let checks_sd = [chk("__w", l * n), chk("__w0", l)];
+        quote! {
+            fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #elim_full #mf_body #mf_m #mf_f
+                #p::Ok(())
+            }
+            fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_ct)* #pos #params_t #bind_q #elim_pos #ct_body #ct_c #ct_c0
+                #p::Ok(())
+            }
+            fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #elim_pos #cr_body #cr_out
+                #p::Ok(())
+            }
+            fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_qdot #(#checks_res)* #params_t #bind_q #bind_qdot #res_body #res_h #res_v
+                #p::Ok(())
+            }
+            fn speed_definitions<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_sd)* #params_t #bind_q #sd_body #sd_w #sd_w0
+                #p::Ok(())
+            }
+            fn input_power<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                #chk_q #chk_u #chk_inputs #params_t #bind_q #bind_u #bind_inputs #elim_pos #ip_body
+                #p::Ok(#ip_out)
+            }
+            fn potential_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                #chk_q #params_t #bind_q #pe_body
+                #p::Ok(#pe_out)
+            }
+            fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                #chk_q #chk_u #pos #params_t #bind_q #bind_u #elim_pos #ke_body
+                #p::Ok(#ke_out)
+            }
+        }
+    }
+
+    /// The kinematic description: mass properties, body poses, constraint
+    /// rows, load geometry, contact geometry and load values.
+    fn kinematics_functions(&self, c: &Common) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let model = &d.model;
+        let g = &model.g;
+        let (n, m) = (d.n, d.m);
+        let Common {
+            params_t,
+            params_f,
+            bind_q,
+            bind_qdot,
+            bind_inputs,
+            ..
+        } = c;
+        let generic = Target::Generic { hoist: false };
+        let chk = |arg: &str, len: usize| self.check(arg, len);
+        let chk_q = chk("__q", n);
+        let (nb, nf, nt, nc) = (
+            model.bodies.len(),
+            model.forces.len(),
+            model.torques.len(),
+            model.rolling.len(),
+        );
+        let mut mp_roots = Vec::new();
+        for b in &model.bodies {
+            mp_roots.push(b.mass);
+            for row in &b.inertia {
+                mp_roots.extend(row);
+            }
+        }
+        let mp = code(d, &mp_roots, Target::F64);
+        let mp_out = (0..nb).map(|k| {
+            let mass = &mp.outputs[k * 10];
+            let inertia = &mp.outputs[k * 10 + 1..k * 10 + 10];
+            let k = int(k);
+            quote!(__masses[#k] = #mass; __inertias[#k] = [#(#inertia),*];)
+        });
+        let zero = g
+            .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ZERO))
+            .expect("zero exists");
+        let one = g
+            .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ONE))
+            .expect("one exists");
+        let identity = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
+        let mut pose_roots = Vec::new();
+        for b in &model.bodies {
+            pose_roots.extend(b.center);
+            let r = b.frame.map(|f| model.frames[f].rot).unwrap_or(identity);
+            for row in &r {
+                pose_roots.extend(row);
+            }
+        }
+        let poses = code(d, &pose_roots, generic);
+        let poses_out = (0..nb).map(|k| {
+            let position = &poses.outputs[k * 12..k * 12 + 3];
+            let rotation = &poses.outputs[k * 12 + 3..k * 12 + 12];
+            let k = int(k);
+            quote!(__positions[#k] = [#(#position),*]; __rotations[#k] = [#(#rotation),*];)
+        });
+        let mut rows_roots = d.constraints.d.clone();
+        rows_roots.extend(&d.constraints.d0);
+        let rows = code(d, &rows_roots, generic);
+        let (rows_d, rows_d0) = (
+            outputs_into(&rows, "__d", 0..m * n),
+            outputs_into(&rows, "__d0", m * n..m * n + m),
+        );
+        let mut geo_roots = Vec::new();
+        for f in &model.forces {
+            geo_roots.extend(f.point);
+        }
+        for t in &model.torques {
+            for row in &model.frames[t.frame].rot {
+                geo_roots.extend(row);
+            }
+        }
+        let geo = code(d, &geo_roots, generic);
+        let (geo_points, geo_frames) = (
+            groups_into(&geo, "__points", 0, nf, 3),
+            groups_into(&geo, "__frames", nf * 3, nt, 9),
+        );
+        let mut load_roots = Vec::new();
+        for f in &model.forces {
+            load_roots.extend(f.vector);
+        }
+        for t in &model.torques {
+            load_roots.extend(t.vector);
+        }
+        let loads = code(d, &load_roots, generic);
+        let (loads_forces, loads_torques) = (
+            groups_into(&loads, "__forces", 0, nf, 3),
+            groups_into(&loads, "__torques", nf * 3, nt, 3),
+        );
+        // Contact points, then the direction of every rolling row.
+        let mut contact_roots = Vec::new();
+        for r in &model.rolling {
+            contact_roots.extend(r.contact);
+        }
+        for src in &d.constraints.sources {
+            match *src {
+                RowSource::Rolling { contact, direction } => match &model.rolling[contact].along {
+                    Some(dirs) => contact_roots.extend(dirs[direction]),
+                    None => contact_roots.extend(identity[direction]),
+                },
+                _ => contact_roots.extend([zero; 3]),
+            }
+        }
+        let contacts = code(d, &contact_roots, generic);
+        let (contacts_points, contacts_dirs) = (
+            groups_into(&contacts, "__points", 0, nc, 3),
+            groups_into(&contacts, "__directions", nc * 3, m, 3),
+        );
+        let checks_mp = [chk("__masses", nb), chk("__inertias", nb)];
+        let checks_poses = [chk("__positions", nb), chk("__rotations", nb)];
+        let checks_rows = [chk("__d", m * n), chk("__d0", m)];
+        let checks_geo = [chk("__points", nf), chk("__frames", nt)];
+        let checks_contacts = [chk("__points", nc), chk("__directions", m)];
+        let checks_loads = [
+            chk("__qdot", n),
+            chk("__inputs", model.inputs.len()),
+            chk("__forces", nf),
+            chk("__torques", nt),
+        ];
+        let (mp_body, poses_body, rows_body) =
+            (mp.statements(), poses.statements(), rows.statements());
+        let (geo_body, contacts_body, loads_body) =
+            (geo.statements(), contacts.statements(), loads.statements());
+        quote! {
+            fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
+                #(#checks_mp)* #params_f #mp_body #(#mp_out)*
+                #p::Ok(())
+            }
+            fn body_poses<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __positions: &mut [[__T; 3]], __rotations: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_poses)* #params_t #bind_q #poses_body #(#poses_out)*
+                #p::Ok(())
+            }
+            fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_rows)* #params_t #bind_q #rows_body #rows_d #rows_d0
+                #p::Ok(())
+            }
+            fn load_geometry<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __frames: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_geo)* #params_t #bind_q #geo_body #geo_points #geo_frames
+                #p::Ok(())
+            }
+            fn contact_geometry<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __directions: &mut [[__T; 3]]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_contacts)* #params_t #bind_q #contacts_body #contacts_points #contacts_dirs
+                #p::Ok(())
+            }
+            fn load_values<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __inputs: &[__T], __forces: &mut [[__T; 3]], __torques: &mut [[__T; 3]]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_loads)* #params_t #bind_q #bind_qdot #bind_inputs #loads_body #loads_forces #loads_torques
+                #p::Ok(())
+            }
+        }
+    }
+
+    /// Statements returning `NonFinite` naming the first state component,
+    /// input or parameter of the rhs that is NaN or infinite, or a
+    /// zero-length `norm`/`unit` argument that the state determines.
+    pub(super) fn non_finite_diagnosis(&self) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let model = &d.model;
+        let this = &self.this;
+        let mut names: Vec<String> = d
+            .reduction
+            .retained
+            .iter()
+            .map(|&r| self.coord(r).to_string())
+            .collect();
+        names.extend(model.speed_specs.iter().map(|sp| {
+            let name = d.model.g.symbol_name(sp.symbol).to_string();
+            match sp.coordinate {
+                Some(_) => name,
+                None => sp.name.clone(),
+            }
+        }));
+        let mut out = TokenStream::new();
+        for (k, name) in names.iter().enumerate() {
+            let (k, what) = (int(k), format!("state component `{name}`"));
+            out.extend(quote!(if !#p::Scalar::re(__state[#k]).is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
+        }
+        for (k, (name, _)) in model.inputs.iter().enumerate() {
+            let (k, what) = (int(k), format!("input `{name}`"));
+            out.extend(quote!(if !#p::Scalar::re(__inputs[#k]).is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
+        }
+        for prm in &model.params {
+            let f = &prm.ident;
+            let what = format!("parameter `{f}`");
+            out.extend(quote!(if !#this.#f.is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
+        }
+        out.extend(self.zero_length_checks());
+        out
+    }
+
+    /// A zero-length `norm`/`unit` argument, where it depends on the
+    /// retained coordinates and the parameters only (so the state
+    /// determines it).
+    fn zero_length_checks(&self) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let model = &d.model;
+        let g = &model.g;
+        let retained: Vec<Symbol> = d
+            .reduction
+            .retained
+            .iter()
+            .map(|&r| model.coords[r].1.q)
+            .collect();
+        let checked: Vec<&(Id, String)> = model
+            .norms
+            .iter()
+            .filter(|(n2, _)| {
+                g.dependencies(*n2)
+                    .iter()
+                    .all(|sym| match g.symbol_kind(sym) {
+                        SymbolKind::Parameter | SymbolKind::Time => true,
+                        SymbolKind::Coordinate => retained.contains(&sym),
+                        _ => false,
+                    })
+                    && !g.is_parameter_only(*n2)
+            })
+            .collect();
+        if checked.is_empty() {
+            return TokenStream::new();
+        }
+        let roots: Vec<Id> = checked.iter().map(|(n2, _)| *n2).collect();
+        let c = code(d, &roots, Target::Generic { hoist: false });
+        let params_t = self.params_as(true);
+        let binds = d.reduction.retained.iter().enumerate().map(|(k, &r)| {
+            let (q, k) = (self.coord(r), int(k));
+            quote!(let #q = __state[#k];)
+        });
+        let statements = c.statements();
+        let tests = checked.iter().enumerate().map(|(k, (_, label))| {
+            let (value, what) = (&c.outputs[k], format!("{label} has zero length"));
+            quote!(if !(#p::Scalar::re(#value) > 1e-20) { return #p::Err(#p::ModelError::NonFinite { what: #what }); })
+        });
+        quote!({ #params_t #(#binds)* #statements #(#tests)* })
+    }
+}

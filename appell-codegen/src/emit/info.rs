@@ -1,0 +1,96 @@
+//! The `ModelInfo` a generated model describes itself with: names of its
+//! parameters, coordinates, speeds and inputs, how the derivation sorted
+//! the coordinates, where each constraint row comes from, the rolling
+//! contacts and bodies, the rhs's operation count and the equations text.
+
+use appell_symbolic::OpCount;
+use proc_macro2::TokenStream;
+use quote::quote;
+
+use super::{int, p, Emitter};
+use crate::derivation::{Elimination, RowSource};
+
+impl Emitter<'_> {
+    /// The `ModelInfo` value; `extra_ops` are the rhs's operations outside
+    /// the engine's program (the numeric solves and the LDLᵀ).
+    pub(super) fn info(&self, rhs_ops: OpCount, extra_ops: usize) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let model = &d.model;
+        let names = |idx: &[usize]| {
+            let names = idx.iter().map(|&i| self.coord(i).to_string());
+            quote!(&[#(#names),*])
+        };
+        let strings = |v: Vec<String>| quote!(&[#(#v),*]);
+        let bodies = model.bodies.iter().map(|b| {
+            let (name, rigid) = (&b.name, b.frame.is_some());
+            quote!(#p::BodyInfo { name: #name, rigid: #rigid })
+        });
+        let row_sources = d.constraints.sources.iter().map(|r| match *r {
+            RowSource::Holonomic(i) => {
+                let i = int(i);
+                quote!(#p::RowSource::Holonomic { index: #i })
+            }
+            RowSource::Nonholonomic(i) => {
+                let i = int(i);
+                quote!(#p::RowSource::Nonholonomic { index: #i })
+            }
+            RowSource::Rolling { contact, direction } => {
+                let (c, k) = (int(contact), int(direction));
+                quote!(#p::RowSource::Rolling { contact: #c, direction: #k })
+            }
+        });
+        let contacts = model.rolling.iter().map(|r| {
+            let (body, point, along) = (int(r.body), &r.point, r.along.is_some());
+            quote!(#p::ContactInfo { body: #body, point: #point, along: #along })
+        });
+        let name = &model.info_name;
+        let params = strings(model.params.iter().map(|p| p.ident.to_string()).collect());
+        let all = names(&(0..d.n).collect::<Vec<_>>());
+        let speeds = strings(model.speed_specs.iter().map(|sp| sp.name.clone()).collect());
+        let dependent = names(&d.speeds.dependent);
+        let cyclic = names(&d.reduction.cyclic);
+        let ignorable = names(&d.reduction.ignorable);
+        let retained = names(&d.reduction.retained);
+        let inputs = strings(model.inputs.iter().map(|(i, _)| i.to_string()).collect());
+        let effects = strings(model.effects.clone());
+        let outputs = strings(model.outputs.clone());
+        let holonomic = int(d.constraints.holonomic.len());
+        let m = int(d.m);
+        let (nf, nt) = (int(model.forces.len()), int(model.torques.len()));
+        let symbolic = matches!(d.elimination, Elimination::Symbolic);
+        let (add, mul, div, calls) = (
+            int(rhs_ops.add),
+            int(rhs_ops.mul),
+            int(rhs_ops.div),
+            int(rhs_ops.calls),
+        );
+        let total = int(rhs_ops.total() + extra_ops);
+        let text = &d.text;
+        quote! {
+            #p::ModelInfo {
+                name: #name,
+                parameters: #params,
+                coordinates: #all,
+                speeds: #speeds,
+                dependent: #dependent,
+                cyclic: #cyclic,
+                ignorable: #ignorable,
+                retained: #retained,
+                inputs: #inputs,
+                effects: #effects,
+                outputs: #outputs,
+                holonomic: #holonomic,
+                constraints: #m,
+                row_sources: &[#(#row_sources),*],
+                contacts: &[#(#contacts),*],
+                bodies: &[#(#bodies),*],
+                force_points: #nf,
+                torques: #nt,
+                symbolic_elimination: #symbolic,
+                rhs_ops: #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
+                equations: #text,
+            }
+        }
+    }
+}

@@ -1,0 +1,159 @@
+//! The `Model` implementation, built with `quote!`.
+//!
+//! Every numeric function is one straight-line program lowered by the engine
+//! (shared subexpressions bound once, see [`code`]), generic over the scalar
+//! `__T`. The reduced rhs reads parameter-only values from `Prepared`,
+//! computed once per parameter set, solves the numeric part of the
+//! elimination ([`solve`]) and Appell's equations by an unrolled LDLᵀ
+//! factorization ([`ldlt`]). [`info`] writes the `ModelInfo` metadata and
+//! [`functions`] the trait's methods. Paths go through `::appell::__private`;
+//! everything is wrapped in `const _: () = { ... };`, beside the scene
+//! newtypes ([`scenes`]).
+
+pub mod code;
+pub mod functions;
+pub mod info;
+pub mod ldlt;
+pub mod rhs;
+pub mod scenes;
+pub mod solve;
+
+use proc_macro2::{Literal, TokenStream};
+use quote::{format_ident, quote};
+
+use crate::derivation::Derivation;
+
+pub use scenes::{emit, stub};
+
+/// The runtime's items, as the generated code reaches them.
+fn p() -> TokenStream {
+    quote!(::appell::__private)
+}
+
+/// An integer literal without a suffix (`3`, not `3usize`).
+fn int(i: usize) -> Literal {
+    Literal::usize_unsuffixed(i)
+}
+
+/// One `Model` implementation: the full model's or a scene's.
+pub struct Emitter<'a> {
+    d: &'a Derivation,
+    /// The type the implementation is for.
+    type_name: syn::Ident,
+    /// How the parameters are reached (`self`, or `self.0` for a scene).
+    this: TokenStream,
+    /// The name of the `ModelInfo` static.
+    info_ident: syn::Ident,
+    /// The scene infos the full model lists (`&[]` for a scene).
+    scene_infos: TokenStream,
+    /// The full model's `scene_rhs` and `visit_scene` (empty for a scene).
+    scene_rhs: TokenStream,
+}
+
+impl Emitter<'_> {
+    fn coord(&self, i: usize) -> syn::Ident {
+        self.d.model.coords[i].0.clone()
+    }
+
+    fn ident(&self, name: &str) -> syn::Ident {
+        syn::Ident::new(name, proc_macro2::Span::call_site())
+    }
+
+    /// The parameters bound as locals: as `__T` when `scalar`, else `f64`.
+    fn params_as(&self, scalar: bool) -> TokenStream {
+        let (p, this) = (p(), &self.this);
+        let fields = self.d.model.params.iter().map(|prm| &prm.ident);
+        if scalar {
+            quote!(#(let #fields: __T = <__T as #p::Scalar>::from_f64(#this.#fields);)*)
+        } else {
+            quote!(#(let #fields: f64 = #this.#fields;)*)
+        }
+    }
+
+    /// An early `NonPositiveParameter` for each parameter declared
+    /// `positive`.
+    fn positivity(&self) -> TokenStream {
+        let (p, this) = (p(), &self.this);
+        let checks = self.d.model.params.iter().filter(|prm| prm.positive).map(|prm| {
+            let f = &prm.ident;
+            let name = f.to_string();
+            quote!(if !(#this.#f > 0.0) { return #p::Err(#p::ModelError::NonPositiveParameter { name: #name, value: #this.#f }); })
+        });
+        quote!(#(#checks)*)
+    }
+
+    /// `let q_i = slice[i];` for every coordinate.
+    fn bind_q(&self, slice: &str) -> TokenStream {
+        let slice = self.ident(slice);
+        let binds = (0..self.d.n).map(|i| {
+            let (q, i) = (self.coord(i), int(i));
+            quote!(let #q = #slice[#i];)
+        });
+        quote!(#(#binds)*)
+    }
+
+    /// `let q_i_dot = slice[i];` for every coordinate.
+    fn bind_qdot(&self, slice: &str) -> TokenStream {
+        let slice = self.ident(slice);
+        let binds = (0..self.d.n).map(|i| {
+            let (q, i) = (format_ident!("{}_dot", self.coord(i)), int(i));
+            quote!(let #q = #slice[#i];)
+        });
+        quote!(#(#binds)*)
+    }
+
+    /// `let u_k = slice[k];` for every privileged speed.
+    fn bind_u(&self, slice: &str) -> TokenStream {
+        let slice = self.ident(slice);
+        let g = &self.d.model.g;
+        let binds = self
+            .d
+            .model
+            .speed_specs
+            .iter()
+            .enumerate()
+            .map(|(k, spec)| {
+                let (u, k) = (self.ident(g.symbol_name(spec.symbol)), int(k));
+                quote!(let #u = #slice[#k];)
+            });
+        quote!(#(#binds)*)
+    }
+
+    /// `let input_k = slice[k];` for every input.
+    fn bind_inputs(&self, slice: &str) -> TokenStream {
+        let slice = self.ident(slice);
+        let binds = self
+            .d
+            .model
+            .inputs
+            .iter()
+            .enumerate()
+            .map(|(k, (name, _))| {
+                let k = int(k);
+                quote!(let #name = #slice[#k];)
+            });
+        quote!(#(#binds)*)
+    }
+
+    /// `check_len(arg, arg, len)?;`: a slice argument of the wrong length
+    /// is a typed error.
+    fn check(&self, arg: &str, len: usize) -> TokenStream {
+        let p = p();
+        let (ident, len) = (self.ident(arg), int(len));
+        quote!(#p::check_len(#arg, #ident, #len)?;)
+    }
+}
+
+/// `track_check` → `TrackCheck`.
+fn camel(s: &str) -> String {
+    s.split('_')
+        .filter(|p| !p.is_empty())
+        .map(|p| {
+            let mut c = p.chars();
+            match c.next() {
+                Some(f) => f.to_uppercase().collect::<String>() + c.as_str(),
+                None => String::new(),
+            }
+        })
+        .collect()
+}

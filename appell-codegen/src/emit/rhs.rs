@@ -1,0 +1,210 @@
+//! `prepare` and `rhs`: the reduced equations as the integrators call them.
+//!
+//! `prepare` computes every parameter-only value once per parameter set
+//! (and the LDLᵀ factors of a constant M); `rhs` reads them from the
+//! `Prepared` array, solves the numeric elimination and M ÿ = f, and writes
+//! the retained coordinates' rates and ÿ. Its work runs in a closure so
+//! that an error path can name a NaN or infinite input (see
+//! [`Emitter::non_finite_diagnosis`]) without slowing the path that
+//! succeeds.
+
+use appell_symbolic::Id;
+use proc_macro2::TokenStream;
+use quote::{format_ident, quote};
+
+use super::code::{code, Target};
+use super::{int, p, Emitter};
+
+/// The pieces of the reduced equations the implementation is made of.
+pub(super) struct RhsParts {
+    /// The `ModelInfo` value.
+    pub info: TokenStream,
+    /// `fn prepare`.
+    pub prepare: TokenStream,
+    /// `fn rhs`.
+    pub rhs: TokenStream,
+    /// The length of the `Prepared` array.
+    pub hoisted: usize,
+}
+
+/// The factorization of M, where it runs and what it costs per call.
+struct Factors {
+    /// Statements in `prepare` (a constant M), else empty.
+    prepare: TokenStream,
+    /// Statements in `rhs`: the factorization, or the pivot checks of the
+    /// prepared factors.
+    rhs: TokenStream,
+    /// Operations per rhs call.
+    ops: usize,
+    /// The names `rhs` reads from `Prepared`.
+    names: Vec<TokenStream>,
+    /// The expressions `prepare` returns.
+    values: Vec<TokenStream>,
+}
+
+impl Emitter<'_> {
+    /// `prepare`, `rhs` and the `ModelInfo` (which counts the rhs's
+    /// operations).
+    pub(super) fn rhs(&self, common: &super::functions::Common) -> RhsParts {
+        let p = p();
+        let d = self.d;
+        let (l, retained) = (d.l, &d.reduction.retained);
+        let constant_mass = self.constant_mass();
+        let mut tri_roots: Vec<Id> = Vec::new();
+        for i in 0..l {
+            for j in 0..=i {
+                tri_roots.push(d.equations.mass[i * l + j]);
+            }
+        }
+        let mut roots: Vec<Id> = if constant_mass {
+            Vec::new()
+        } else {
+            tri_roots.clone()
+        };
+        roots.extend(&d.equations.forcing);
+        roots.extend(retained.iter().map(|&r| d.map.qdot[r]));
+        let (rhs, rhs_body, elim_ops) = self.staged_rhs(&roots);
+        let tri = if constant_mass { 0 } else { l * (l + 1) / 2 };
+        let factors = self.factors(&tri_roots, &rhs.outputs, &rhs.hoisted, constant_mass);
+        let (solve, solve_ops) = self.ldlt_solve(&rhs.outputs[tri..tri + l]);
+        let info = self.info(rhs.ops, factors.ops + solve_ops + elim_ops);
+        let g = &d.model.g;
+        let state_q = retained.iter().enumerate().map(|(k, &r)| {
+            let (q, k) = (self.coord(r), int(k));
+            quote!(let #q = __state[#k];)
+        });
+        let state_u = d.model.speed_specs.iter().enumerate().map(|(k, spec)| {
+            let (u, k) = (
+                self.ident(g.symbol_name(spec.symbol)),
+                int(retained.len() + k),
+            );
+            quote!(let #u = __state[#k];)
+        });
+        let rates_out = (0..retained.len()).map(|k| {
+            let (value, k) = (&rhs.outputs[tri + l + k], int(k));
+            quote!(__dstate[#k] = #value;)
+        });
+        let accels_out = (0..l).map(|k| {
+            let (y, k) = (format_ident!("__y_{}", k), int(retained.len() + k));
+            quote!(__dstate[#k] = #y;)
+        });
+        let ns = retained.len() + l;
+        let finite = if ns == 0 {
+            quote!(true)
+        } else {
+            let each = (0..ns).map(|k| {
+                let k = int(k);
+                quote!(#p::Scalar::re(__dstate[#k]).is_finite())
+            });
+            quote!(#(#each)&&*)
+        };
+        let h = factors.names.len();
+        let hi = int(h);
+        let (params_t, pos, bind_inputs) =
+            (&common.params_t, &common.positivity, &common.bind_inputs);
+        let prepare_statements = &rhs.prepare;
+        let (factors_prepare, factors_rhs) = (&factors.prepare, &factors.rhs);
+        let (names, values) = (&factors.names, &factors.values);
+        let checks = [
+            self.check("__state", ns),
+            self.check("__inputs", d.model.inputs.len()),
+            self.check("__dstate", ns),
+        ];
+        let diagnose = self.non_finite_diagnosis();
+        let prepare = quote! {
+            fn prepare<__T: #p::Scalar>(&self) -> [__T; #hi] {
+                #params_t #(#prepare_statements)* #factors_prepare
+                [#(#values),*]
+            }
+        };
+        let rhs_fn = quote! {
+            fn rhs<__T: #p::Scalar>(&self, __prepared: &[__T; #hi], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #(#checks)* #pos
+                let __result: #p::Result<(), #p::ModelError> = (|| {
+                    let [#(#names),*] = *__prepared;
+                    #params_t #(#state_q)* #(#state_u)* #bind_inputs #rhs_body #factors_rhs #solve #(#rates_out)* #(#accels_out)*
+                    if !(#finite) { return #p::Err(#p::ModelError::NonFinite { what: "the state derivative" }); }
+                    #p::Ok(())
+                })();
+                match __result {
+                    #p::Ok(()) => #p::Ok(()),
+                    #p::Err(__e) => {
+                        #diagnose
+                        #p::Err(__e)
+                    }
+                }
+            }
+        };
+        RhsParts {
+            info,
+            prepare,
+            rhs: rhs_fn,
+            hoisted: h,
+        }
+    }
+
+    /// M's factorization: in `prepare` when M is constant (its pivots still
+    /// checked per call, against the prepared tolerance), else in `rhs`
+    /// from the program's outputs.
+    fn factors(
+        &self,
+        tri_roots: &[Id],
+        outputs: &[TokenStream],
+        hoisted: &[TokenStream],
+        constant_mass: bool,
+    ) -> Factors {
+        let p = p();
+        let l = self.d.l;
+        let lower = |values: &[TokenStream]| {
+            let mut m = vec![TokenStream::new(); l * l];
+            let mut idx = 0;
+            for i in 0..l {
+                for j in 0..=i {
+                    m[i * l + j] = values[idx].clone();
+                    idx += 1;
+                }
+            }
+            m
+        };
+        if !constant_mass {
+            let (rhs, ops) = self.ldlt_factor(&lower(outputs), true);
+            return Factors {
+                prepare: TokenStream::new(),
+                rhs,
+                ops,
+                names: hoisted.to_vec(),
+                values: hoisted.to_vec(),
+            };
+        }
+        let mc = code(self.d, tri_roots, Target::Generic { hoist: false });
+        let (fac, _) = self.ldlt_factor(&lower(&mc.outputs), false);
+        let factor_names = self.factor_names();
+        let count = int(factor_names.len());
+        let statements = mc.statements();
+        let prepare = quote! {
+            let __factors: [__T; #count] = {
+                #statements
+                #fac
+                let __tolv = <__T as #p::Scalar>::from_f64(__tol);
+                [#(#factor_names),*]
+            };
+        };
+        let rhs = (0..l)
+            .map(|j| self.pivot_check(j, quote!(#p::Scalar::re(__tolv))))
+            .collect();
+        let mut names = hoisted.to_vec();
+        names.extend(factor_names.iter().map(|n| quote!(#n)));
+        let mut values = hoisted.to_vec();
+        values.extend((0..factor_names.len()).map(|i| {
+            let i = int(i);
+            quote!(__factors[#i])
+        }));
+        Factors {
+            prepare,
+            rhs,
+            ops: 0,
+            names,
+            values,
+        }
+    }
+}
