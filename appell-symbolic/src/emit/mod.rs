@@ -3,7 +3,9 @@
 //! Two steps. [`Program::lower`] turns the canonical n-ary graph into binary
 //! instructions (`+ − × ÷`, negation, integer powers by repeated squaring,
 //! function calls), hash-consed again so that e.g. `x²` is computed once for
-//! `x³` and `x⁴`, then runs sharing passes over them. [`Program::to_rust`] then writes one `let` per instruction used
+//! `x³` and `x⁴`, then runs the sharing passes of [`Pass::ALL`] over them
+//! ([`Program::lower_with`] can switch passes off and reports what each
+//! did). [`Program::to_rust`] then writes one `let` per instruction used
 //! more than once (common-subexpression elimination is "a node used twice
 //! becomes a `let`"), inlines the rest, and separates the instructions that
 //! depend on parameters only, so they can be computed once per parameter set.
@@ -27,6 +29,7 @@ mod writer;
 mod tests;
 
 pub use inst::{Inst, OpCount};
+pub use passes::{LowerOptions, Pass, PassReport, ProgramSize};
 pub use writer::{EmitOptions, RustCode};
 
 use inst::{parameter_only_flags, use_counts};
@@ -38,10 +41,13 @@ pub struct Program {
     outputs: Vec<u32>,
     parameter_only: Vec<bool>,
     uses: Vec<u32>,
+    /// What each pass did, in the order they ran.
+    report: Vec<PassReport>,
 }
 
 impl Program {
-    /// Lowers the expressions `roots` of `graph`.
+    /// Lowers the expressions `roots` of `graph`, running every pass of
+    /// [`Pass::ALL`].
     ///
     /// ```
     /// use appell_symbolic::{Graph, Program};
@@ -52,8 +58,29 @@ impl Program {
     /// assert_eq!(p.op_count().total(), 3); // x·y·(z + w)
     /// ```
     pub fn lower(graph: &Graph, roots: &[Id]) -> Program {
+        Program::lower_with(graph, roots, &LowerOptions::default())
+    }
+
+    /// Lowers the expressions `roots` of `graph`, running the passes
+    /// `options` selects, and records what each did
+    /// ([`Program::pass_report`]). With the default options this is
+    /// [`Program::lower`].
+    ///
+    /// ```
+    /// use appell_symbolic::{Graph, LowerOptions, Pass, Program};
+    /// let mut g = Graph::new();
+    /// let a = g.parse("x*y*z").unwrap();
+    /// let b = g.parse("x*z*w").unwrap();
+    /// let all = Program::lower(&g, &[a, b]);
+    /// let without = LowerOptions::default().without(Pass::ShareProducts);
+    /// let fewer = Program::lower_with(&g, &[a, b], &without);
+    /// // Without sharing x·z, each product computes it.
+    /// assert_eq!(all.op_count().mul + 1, fewer.op_count().mul);
+    /// assert!(fewer.pass_report().iter().all(|r| r.pass != Pass::ShareProducts));
+    /// ```
+    pub fn lower_with(graph: &Graph, roots: &[Id], options: &LowerOptions) -> Program {
         let (insts, outputs) = lower::lower(graph, roots);
-        let (insts, outputs) = passes::run(graph, insts, outputs);
+        let (insts, outputs, report) = passes::run(graph, insts, outputs, options);
         let parameter_only = parameter_only_flags(graph, &insts);
         let uses = use_counts(&insts, &outputs);
         Program {
@@ -61,7 +88,25 @@ impl Program {
             outputs,
             parameter_only,
             uses,
+            report,
         }
+    }
+
+    /// What each pass did, in the order they ran: its name and the
+    /// program's size before and after it. The first entry's `before` is the
+    /// lowering's output; each entry's `after` is the next one's `before`.
+    ///
+    /// ```
+    /// use appell_symbolic::{Graph, Pass, Program};
+    /// let mut g = Graph::new();
+    /// let e = g.parse("(x + y)*z - x*z").unwrap();
+    /// let p = Program::lower(&g, &[e]);
+    /// let passes: Vec<Pass> = p.pass_report().iter().map(|r| r.pass).collect();
+    /// assert_eq!(passes, Pass::ALL);
+    /// assert_eq!(p.pass_report().last().unwrap().after.ops, p.op_count());
+    /// ```
+    pub fn pass_report(&self) -> &[PassReport] {
+        &self.report
     }
 
     /// The instructions, in evaluation order.

@@ -221,8 +221,7 @@ fn negated(out: &mut Vec<Inst>, v: u32) -> u32 {
 
 #[cfg(test)]
 mod tests {
-    use super::super::prune::prune;
-    use super::share_equal_values;
+    use crate::emit::passes::Pass;
     use crate::emit::tests::{program, values};
     use crate::emit::Inst;
     use crate::graph::{Func, Graph, SymbolKind};
@@ -253,8 +252,7 @@ mod tests {
             Mul(11, 13),
         ];
         let outputs = vec![7, 9, 14];
-        let (after, outs) = share_equal_values(&g, insts, outputs);
-        let (after, outs) = prune(after, outs);
+        let (after, outs) = Pass::ShareEqualValues.run(&g, insts, outputs);
         let program = program(after, outs);
         let got = program.eval(&values(&g)).unwrap();
         assert_eq!(got, vec![-2.1, -1.3, 1.3 * 1.3]);
@@ -288,8 +286,7 @@ mod tests {
             Mul(9, 9),
         ];
         let outputs = vec![4, 7, 8, 10, 5];
-        let (after, outs) = share_equal_values(&g, insts, outputs);
-        let (after, outs) = prune(after, outs);
+        let (after, outs) = Pass::ShareEqualValues.run(&g, insts, outputs);
         assert_eq!(outs[1], outs[0], "{after:?}");
         assert_eq!(after[outs[2] as usize], Neg(outs[0]), "{after:?}");
         assert_ne!(outs[3], outs[4], "{after:?}");
@@ -327,8 +324,7 @@ mod tests {
             Sub(13, 2),
         ];
         let outputs = vec![6, 7, 11, 12, 14];
-        let (after, outs) = share_equal_values(&g, insts, outputs);
-        let (after, outs) = prune(after, outs);
+        let (after, outs) = Pass::ShareEqualValues.run(&g, insts, outputs);
         assert_ne!(outs[1], outs[0], "{after:?}");
         assert_eq!(after[outs[1] as usize], Mul(0, 0), "{after:?}");
         assert_ne!(outs[3], outs[2], "{after:?}");
