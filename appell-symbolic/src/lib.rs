@@ -45,7 +45,9 @@ mod rule_tests;
 pub use deps::SymbolSet;
 pub use diff::RateRules;
 pub use display::DisplayExpr;
-pub use emit::{EmitOptions, Inst, OpCount, Program, RustCode};
+pub use emit::{
+    EmitOptions, Inst, LowerOptions, OpCount, Pass, PassReport, Program, ProgramSize, RustCode,
+};
 pub use error::{Result, SymbolicError};
 pub use eval::{Tape, Value};
 pub use graph::{Coordinate, Func, Graph, Id, Limits, Node, Stats, Symbol, SymbolInfo, SymbolKind};

@@ -1,0 +1,742 @@
+//! Writing a [`Program`] as Rust: [`EmitOptions`] (the choices) and
+//! [`RustCode`] (the text: hoisted statements, per-call statements by
+//! stage, and one expression per output).
+
+use std::collections::{BTreeMap, BTreeSet};
+use std::fmt::Write;
+
+use crate::graph::{Graph, Symbol};
+use crate::number::Number;
+
+use super::inst::{Inst, OpCount};
+use super::Program;
+
+/// Deepest nesting of operations written inline in one expression.
+const MAX_INLINE_DEPTH: usize = 16;
+
+/// Choices for [`Program::to_rust`].
+#[derive(Clone, Debug)]
+pub struct EmitOptions {
+    /// The scalar type in the emitted code (a generic parameter name or a
+    /// concrete type).
+    pub scalar: String,
+    /// The expression that turns an `f64` literal into the scalar;
+    /// `{ty}` is replaced by [`EmitOptions::scalar`] and `{lit}` by the literal.
+    pub constant: String,
+    /// Share subexpressions used more than once through `let` bindings. Off,
+    /// every use is written out (readable for very small problems only).
+    pub cse: bool,
+    /// Move parameter-only subexpressions into [`RustCode::prepare`].
+    pub hoist_parameters: bool,
+    /// How each symbol is read (default: its name, as a local binding).
+    pub symbol_text: BTreeMap<Symbol, String>,
+    /// The stage at which each symbol becomes available (default 0). A
+    /// statement belongs to the latest stage of the symbols it reads, and
+    /// [`RustCode::stages`] lists the statements stage by stage, so a caller
+    /// can compute some values between stages (e.g. a numeric solve whose
+    /// results are the symbols of the next stage) within one program that
+    /// shares every common subexpression.
+    pub symbol_stage: BTreeMap<Symbol, usize>,
+    /// Write a product that feeds a sum or a difference, and is not shared,
+    /// as `x.fused_mul_add(y, z)` (a method the scalar trait must provide,
+    /// equal to `x * y + z`): one instruction where the target fuses them.
+    /// A difference is written with the sign moved onto a factor or the
+    /// addend, which IEEE arithmetic gives exactly, so an unfused
+    /// `fused_mul_add` gives the same values as the plain text.
+    pub fused: bool,
+}
+
+impl Default for EmitOptions {
+    fn default() -> Self {
+        EmitOptions {
+            scalar: "T".to_string(),
+            constant: "<{ty} as ::appell_runtime::Scalar>::from_f64({lit})".to_string(),
+            cse: true,
+            hoist_parameters: true,
+            symbol_text: BTreeMap::new(),
+            symbol_stage: BTreeMap::new(),
+            fused: false,
+        }
+    }
+}
+
+/// Emitted Rust code: statements and the expression of each output.
+///
+/// The statements use method-call syntax (`x.sin()`, `x.powi(20)`) on the
+/// scalar, so the runtime's scalar trait must be in scope where they are
+/// placed.
+///
+/// ```
+/// use appell_symbolic::{EmitOptions, Graph, Program};
+/// let mut g = Graph::new();
+/// let m = g.parameter("m").unwrap();
+/// let l = g.parameter("l").unwrap();
+/// let e = g.parse("m*l^2*sin(q)*cos(q) + m*l^2*q").unwrap();
+/// let program = Program::lower(&g, &[e]);
+/// let code = program.to_rust(&g, &EmitOptions::default());
+/// assert_eq!(code.hoisted, vec!["p0".to_string()]);      // m*l^2, once per parameter set
+/// assert!(code.prepare.iter().any(|s| s.starts_with("let p0 = ")));
+/// assert_eq!(code.outputs[0], "q.sin() * p0 * q.cos() + q * p0");
+/// # let _ = (m, l);
+/// ```
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct RustCode {
+    /// Statements that compute the hoisted parameter-only values (they read
+    /// parameters only).
+    pub prepare: Vec<String>,
+    /// Names bound by `prepare` that the body reads.
+    pub hoisted: Vec<String>,
+    /// Statements of the per-call body.
+    pub body: Vec<String>,
+    /// The same statements split by stage ([`EmitOptions::symbol_stage`]):
+    /// `stages[s]` reads symbols of stages up to `s` only; constants are in
+    /// stage 0. One entry when no symbol has a later stage.
+    pub stages: Vec<Vec<String>>,
+    /// One expression per root, valid after `body`.
+    pub outputs: Vec<String>,
+    /// Operations per call (body and outputs).
+    pub ops: OpCount,
+    /// Operations once per parameter set (prepare).
+    pub prepare_ops: OpCount,
+}
+
+impl RustCode {
+    /// A complete generic function computing all outputs at once (prepare and
+    /// body together), for tests and small tools:
+    /// `fn name<T: Trait>(symbols…) -> [T; N]`.
+    pub fn function(&self, name: &str, scalar_trait: &str, args: &[String]) -> String {
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "#[allow(clippy::all, unused_variables, unused_parens, non_snake_case)]\n\
+             pub fn {name}<T: {scalar_trait}>({}) -> [T; {}] {{",
+            args.iter()
+                .map(|a| format!("{a}: T"))
+                .collect::<Vec<_>>()
+                .join(", "),
+            self.outputs.len()
+        );
+        let mut seen = BTreeSet::new();
+        for st in self.prepare.iter().chain(&self.body) {
+            // A constant both sections bind is written once.
+            if seen.insert(st.as_str()) {
+                let _ = writeln!(s, "    {st}");
+            }
+        }
+        let _ = writeln!(s, "    [{}]\n}}", self.outputs.join(", "));
+        s
+    }
+}
+
+impl RustCode {
+    /// Two functions that keep the hoisting visible: `{name}_prepare(params)`
+    /// returns the hoisted values, and `{name}(hoisted, params, state)`
+    /// computes the outputs reading only those, the parameters and the state.
+    /// A body that used a value internal to the preparation would not compile.
+    pub fn split_functions(
+        &self,
+        name: &str,
+        scalar_trait: &str,
+        params: &[String],
+        state: &[String],
+    ) -> String {
+        let h = self.hoisted.len();
+        let typed = |v: &[String]| {
+            v.iter()
+                .map(|a| format!("{a}: T"))
+                .collect::<Vec<_>>()
+                .join(", ")
+        };
+        let mut s = String::new();
+        let _ = writeln!(
+            s,
+            "#[allow(clippy::all, unused_variables, unused_parens, non_snake_case)]\n\
+             pub fn {name}_prepare<T: {scalar_trait}>({}) -> [T; {h}] {{",
+            typed(params)
+        );
+        for st in &self.prepare {
+            let _ = writeln!(s, "    {st}");
+        }
+        let _ = writeln!(s, "    [{}]\n}}", self.hoisted.join(", "));
+        let mut args = vec![format!("hoisted: &[T; {h}]")];
+        if !params.is_empty() {
+            args.push(typed(params));
+        }
+        if !state.is_empty() {
+            args.push(typed(state));
+        }
+        let _ = writeln!(
+            s,
+            "#[allow(clippy::all, unused_variables, unused_parens, non_snake_case)]\n\
+             pub fn {name}<T: {scalar_trait}>({}) -> [T; {}] {{",
+            args.join(", "),
+            self.outputs.len()
+        );
+        let _ = writeln!(s, "    let [{}] = *hoisted;", self.hoisted.join(", "));
+        for st in &self.body {
+            let _ = writeln!(s, "    {st}");
+        }
+        let _ = writeln!(s, "    [{}]\n}}", self.outputs.join(", "));
+        s
+    }
+}
+
+/// How tightly an expression's text binds, loosest first: an operand of a
+/// tighter operation is parenthesized.
+#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+enum Prec {
+    Sum = 0,
+    Product = 1,
+    Unary = 2,
+    Atom = 3,
+}
+
+/// The statements of a [`RustCode`] as they are written.
+#[derive(Default)]
+struct Sections {
+    /// [`RustCode::prepare`].
+    prepare: Vec<String>,
+    /// [`RustCode::body`].
+    body: Vec<String>,
+    /// [`RustCode::stages`].
+    staged: Vec<Vec<String>>,
+    /// Names bound by `prepare` that the body reads.
+    hoisted: Vec<String>,
+    /// The constants (by instruction) already bound in `prepare`.
+    const_in_prepare: BTreeSet<usize>,
+    /// The constants (by instruction) already bound in the body.
+    const_in_body: BTreeSet<usize>,
+}
+
+/// Writes `p` as Rust ([`Program::to_rust`]).
+pub(super) fn write(p: &Program, g: &Graph, o: &EmitOptions) -> RustCode {
+    Writer::new(p, g, o).write()
+}
+
+/// Writes one [`Program`] as Rust text.
+struct Writer<'a> {
+    p: &'a Program,
+    g: &'a Graph,
+    o: &'a EmitOptions,
+    /// Name of each instruction that is bound (`let`), a symbol or a constant.
+    names: Vec<Option<String>>,
+    used_names: BTreeSet<String>,
+    hoisted: Vec<bool>,
+}
+
+impl<'a> Writer<'a> {
+    fn new(p: &'a Program, g: &'a Graph, o: &'a EmitOptions) -> Writer<'a> {
+        let n = p.insts.len();
+        let mut used_names = BTreeSet::new();
+        for (s, info) in g.symbols() {
+            used_names.insert(o.symbol_text.get(&s).cloned().unwrap_or(info.name.clone()));
+        }
+        Writer {
+            p,
+            g,
+            o,
+            names: vec![None; n],
+            used_names,
+            hoisted: vec![false; n],
+        }
+    }
+
+    fn symbol_text(&self, s: Symbol) -> String {
+        self.o
+            .symbol_text
+            .get(&s)
+            .cloned()
+            .unwrap_or_else(|| self.g.symbol_name(s).to_string())
+    }
+
+    fn fresh(&mut self, wanted: String) -> String {
+        let mut name = wanted.clone();
+        let mut k = 2;
+        while self.used_names.contains(&name) {
+            name = format!("{wanted}_{k}");
+            k += 1;
+        }
+        self.used_names.insert(name.clone());
+        name
+    }
+
+    /// A readable name for a bound instruction when one is obvious.
+    fn suggest(&self, i: usize) -> Option<String> {
+        let leaf = |j: u32| -> Option<String> {
+            match &self.p.insts[j as usize] {
+                Inst::Symbol(s) => Some(self.symbol_text(*s)),
+                _ => self.names[j as usize].clone(),
+            }
+        };
+        let ident = |s: String| {
+            (s.len() <= 24 && s.chars().all(|c| c.is_alphanumeric() || c == '_')).then_some(s)
+        };
+        match self.p.insts[i] {
+            Inst::Call(f, a) => ident(format!("{}_{}", f.name(), leaf(a)?)),
+            Inst::Mul(a, b) if a == b => ident(format!("{}_sq", leaf(a)?)),
+            Inst::Atan2(y, x) => ident(format!("atan2_{}_{}", leaf(y)?, leaf(x)?)),
+            _ => None,
+        }
+    }
+
+    fn constant_name(n: Number) -> String {
+        match n {
+            Number::Rational { num, den: 1 } => format!("k{num}").replace('-', "m"),
+            Number::Rational { num, den } => format!("k{num}_{den}").replace('-', "m"),
+            // Floats get a short name; the literal is in the binding.
+            Number::Float(_) => "kf".to_string(),
+        }
+    }
+
+    fn literal(n: Number) -> String {
+        let x = n.to_f64();
+        format!("{x:?}")
+    }
+
+    /// The whole program as Rust: which instructions are hoisted and which
+    /// bound, then the statements section by section, and the outputs.
+    fn write(mut self) -> RustCode {
+        let boundary = self.mark_hoisted();
+        let bind = self.bindings(&boundary);
+        let stage = self.stages();
+        let stage_count = 1 + stage.iter().copied().max().unwrap_or(0);
+        // Constants: bound once at the top of the section that first needs them.
+        let const_names = self.name_constants();
+        let (body_ops, prepare_ops) = self.count_ops(&bind);
+        let mut s = Sections {
+            staged: vec![Vec::new(); stage_count],
+            ..Sections::default()
+        };
+        self.bind_statements(&bind, &boundary, &stage, &const_names, &mut s);
+        let mut outputs = Vec::new();
+        for k in 0..self.p.outputs.len() {
+            let o = self.p.outputs[k] as usize;
+            self.body_constants(self.constants_of(o, &bind), &const_names, &mut s);
+            outputs.push(self.expr(o).0);
+        }
+        // Constants first in each section (stable order by instruction).
+        let split = |v: Vec<String>| {
+            let (mut c, rest): (Vec<String>, Vec<String>) =
+                v.into_iter().partition(|s| s.starts_with("let k"));
+            c.extend(rest);
+            c
+        };
+        RustCode {
+            prepare: split(s.prepare),
+            hoisted: s.hoisted,
+            body: split(s.body),
+            stages: s.staged.into_iter().map(split).collect(),
+            outputs,
+            ops: body_ops,
+            prepare_ops,
+        }
+    }
+
+    /// Whether instruction `i` is an operation (not a constant or symbol).
+    fn nontrivial(&self, i: usize) -> bool {
+        !matches!(self.p.insts[i], Inst::Const(_) | Inst::Symbol(_))
+    }
+
+    /// Decides what is hoisted (into `self.hoisted`): the parameter-only
+    /// operations, when [`EmitOptions::hoist_parameters`] is on. Returns the
+    /// boundary: the instructions a per-call instruction or an output reads,
+    /// of which the hoisted ones are handed to the body.
+    fn mark_hoisted(&mut self) -> Vec<bool> {
+        let p = self.p;
+        let n = p.insts.len();
+        let mut boundary = vec![false; n];
+        if self.o.hoist_parameters {
+            for i in 0..n {
+                if !p.parameter_only[i] {
+                    for op in p.insts[i].operands() {
+                        boundary[op as usize] = true;
+                    }
+                }
+            }
+            for &o in &p.outputs {
+                boundary[o as usize] = true;
+            }
+            let nontrivial = |i: usize| !matches!(p.insts[i], Inst::Const(_) | Inst::Symbol(_));
+            for (i, h) in self.hoisted.iter_mut().enumerate() {
+                *h = p.parameter_only[i] && nontrivial(i);
+            }
+        }
+        boundary
+    }
+
+    /// Which instructions get a `let`: the shared ones (with CSE), the
+    /// hoisted ones the body reads, and every few levels of a long chain.
+    fn bindings(&self, boundary: &[bool]) -> Vec<bool> {
+        let p = self.p;
+        let n = p.insts.len();
+        let mut bind = vec![false; n];
+        for i in 0..n {
+            if !self.nontrivial(i) {
+                continue;
+            }
+            let shared = p.uses[i] >= 2;
+            bind[i] = (self.o.cse && shared) || (self.hoisted[i] && boundary[i]);
+        }
+        // Long chains (a sum of hundreds of terms) are cut by a `let` every
+        // few levels, so no written expression nests deeper than
+        // MAX_INLINE_DEPTH (the writer recurses on nesting, and deep lines do
+        // not read).
+        let mut depth = vec![0usize; n];
+        for i in 0..n {
+            if !self.nontrivial(i) || bind[i] {
+                continue;
+            }
+            let d = 1 + p.insts[i]
+                .operands()
+                .iter()
+                .map(|&o| depth[o as usize])
+                .max()
+                .unwrap_or(0);
+            if d > MAX_INLINE_DEPTH {
+                bind[i] = true;
+            } else {
+                depth[i] = d;
+            }
+        }
+        bind
+    }
+
+    /// The stage of each instruction: the latest of its symbols'
+    /// ([`EmitOptions::symbol_stage`]).
+    fn stages(&self) -> Vec<usize> {
+        let p = self.p;
+        let n = p.insts.len();
+        let mut stage = vec![0usize; n];
+        for i in 0..n {
+            stage[i] = match p.insts[i] {
+                Inst::Symbol(s) => self.o.symbol_stage.get(&s).copied().unwrap_or(0),
+                ref other => other
+                    .operands()
+                    .iter()
+                    .map(|&o| stage[o as usize])
+                    .max()
+                    .unwrap_or(0),
+            };
+        }
+        stage
+    }
+
+    /// A name for each constant, by instruction.
+    fn name_constants(&mut self) -> BTreeMap<usize, String> {
+        let mut const_names: BTreeMap<usize, String> = BTreeMap::new();
+        for i in 0..self.p.insts.len() {
+            if let Inst::Const(c) = self.p.insts[i] {
+                let name = self.fresh(Self::constant_name(c));
+                const_names.insert(i, name.clone());
+                self.names[i] = Some(name);
+            }
+        }
+        const_names
+    }
+
+    /// The operations of the body and of `prepare`: bound instructions
+    /// once; inlined ones once per inline use when CSE is off (their text
+    /// is repeated).
+    fn count_ops(&self, bind: &[bool]) -> (OpCount, OpCount) {
+        let p = self.p;
+        let mut body_ops = OpCount::default();
+        let mut prepare_ops = OpCount::default();
+        let mult = if self.o.cse {
+            vec![1usize; p.insts.len()]
+        } else {
+            p.tree_multiplicity()
+        };
+        for (i, inst) in p.insts.iter().enumerate() {
+            if self.hoisted[i] {
+                prepare_ops.count(inst, if bind[i] { 1 } else { mult[i] });
+            } else {
+                body_ops.count(inst, if bind[i] { 1 } else { mult[i] });
+            }
+        }
+        (body_ops, prepare_ops)
+    }
+
+    /// One `let` per bound instruction, in order, into `prepare` (hoisted)
+    /// or the body and its stage, each section's constants bound before
+    /// their first use.
+    fn bind_statements(
+        &mut self,
+        bind: &[bool],
+        boundary: &[bool],
+        stage: &[usize],
+        const_names: &BTreeMap<usize, String>,
+        s: &mut Sections,
+    ) {
+        let mut counter_p = 0;
+        let mut counter_t = 0;
+        for i in 0..self.p.insts.len() {
+            if !bind[i] {
+                continue;
+            }
+            let wanted = self.suggest(i).unwrap_or_else(|| {
+                if self.hoisted[i] {
+                    counter_p += 1;
+                    format!("p{}", counter_p - 1)
+                } else {
+                    counter_t += 1;
+                    format!("t{}", counter_t - 1)
+                }
+            });
+            let (text, _) = self.expr_inline(i);
+            let name = self.fresh(wanted);
+            let consts = self.constants_of(i, bind);
+            if self.hoisted[i] {
+                for c in consts {
+                    if s.const_in_prepare.insert(c) {
+                        s.prepare.push(self.const_stmt(c, const_names));
+                    }
+                }
+                s.prepare.push(format!("let {name} = {text};"));
+                if boundary[i] {
+                    s.hoisted.push(name.clone());
+                }
+            } else {
+                self.body_constants(consts, const_names, s);
+                s.staged[stage[i]].push(format!("let {name} = {text};"));
+                s.body.push(format!("let {name} = {text};"));
+            }
+            self.names[i] = Some(name);
+        }
+    }
+
+    /// Binds the constants `consts` in the body (and stage 0) unless bound
+    /// there already.
+    fn body_constants(
+        &self,
+        consts: Vec<usize>,
+        const_names: &BTreeMap<usize, String>,
+        s: &mut Sections,
+    ) {
+        for c in consts {
+            if s.const_in_body.insert(c) {
+                let st = self.const_stmt(c, const_names);
+                s.staged[0].push(st.clone());
+                s.body.push(st);
+            }
+        }
+    }
+    fn const_stmt(&self, i: usize, names: &BTreeMap<usize, String>) -> String {
+        let Inst::Const(c) = self.p.insts[i] else {
+            unreachable!("constant")
+        };
+        let text = self
+            .o
+            .constant
+            .replace("{ty}", &self.o.scalar)
+            .replace("{lit}", &Self::literal(c));
+        format!("let {}: {} = {text};", names[&i], self.o.scalar)
+    }
+
+    /// Constants read by the inline text of instruction `i`.
+    fn constants_of(&self, i: usize, bind: &[bool]) -> Vec<usize> {
+        let mut out = Vec::new();
+        let mut stack = self.p.insts[i].operands();
+        if matches!(self.p.insts[i], Inst::Const(_)) {
+            out.push(i);
+        }
+        while let Some(j) = stack.pop() {
+            let j = j as usize;
+            match self.p.insts[j] {
+                Inst::Const(_) => out.push(j),
+                _ if bind[j] => {}
+                Inst::Symbol(_) => {}
+                _ => stack.extend(self.p.insts[j].operands()),
+            }
+        }
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    /// The text of instruction `i` as used by another (its name when bound).
+    fn expr(&self, i: usize) -> (String, Prec) {
+        if let Some(n) = &self.names[i] {
+            return (n.clone(), Prec::Atom);
+        }
+        if let Inst::Symbol(s) = self.p.insts[i] {
+            return (self.symbol_text(s), Prec::Atom);
+        }
+        self.expr_inline(i)
+    }
+
+    /// The operands of a commutative operation, ordered so that a nested
+    /// operation of the same level stands on the left, where it needs no
+    /// parentheses (`a * b` and `b * a` are the same IEEE value).
+    fn commuted(&self, a: u32, b: u32, level: Prec) -> ((String, Prec), (String, Prec)) {
+        let (l, r) = (self.expr(a as usize), self.expr(b as usize));
+        if r.1 == level && l.1 != level {
+            (r, l)
+        } else {
+            (l, r)
+        }
+    }
+
+    /// The factors of instruction `i` when it is a product written inline
+    /// (not bound), so a sum reading it can fuse it.
+    fn inline_product(&self, i: u32) -> Option<(u32, u32)> {
+        match self.p.insts[i as usize] {
+            Inst::Mul(a, b) if self.names[i as usize].is_none() => Some((a, b)),
+            _ => None,
+        }
+    }
+
+    /// `x.fused_mul_add(y, z)` for a sum or difference with an inline
+    /// product operand: a + x·y, x·y + b, a − x·y as (−x)·y + a, and
+    /// x·y − b as x·y + (−b).
+    fn fused_inline(&self, i: usize) -> Option<String> {
+        let atom = |j: u32| {
+            let (s, p) = self.expr(j as usize);
+            if p < Prec::Atom {
+                format!("({s})")
+            } else {
+                s
+            }
+        };
+        let arg = |j: u32| self.expr(j as usize).0;
+        let fused = |x: String, y: u32, z: String| format!("{x}.fused_mul_add({}, {z})", arg(y));
+        match self.p.insts[i] {
+            Inst::Add(a, b) => {
+                if let Some((x, y)) = self.inline_product(b) {
+                    Some(fused(atom(x), y, arg(a)))
+                } else {
+                    let (x, y) = self.inline_product(a)?;
+                    Some(fused(atom(x), y, arg(b)))
+                }
+            }
+            Inst::Sub(a, b) => {
+                if let Some((x, y)) = self.inline_product(b) {
+                    Some(fused(format!("(-{})", atom(x)), y, arg(a)))
+                } else {
+                    let (x, y) = self.inline_product(a)?;
+                    Some(fused(atom(x), y, format!("-{}", atom(b))))
+                }
+            }
+            _ => None,
+        }
+    }
+
+    /// The text of instruction `i` itself.
+    fn expr_inline(&self, i: usize) -> (String, Prec) {
+        let wrap = |(s, p): (String, Prec), min: Prec| {
+            if p < min {
+                format!("({s})")
+            } else {
+                s
+            }
+        };
+        let right = |(s, p): (String, Prec), level: Prec| {
+            if p <= level {
+                format!("({s})")
+            } else {
+                s
+            }
+        };
+        if self.o.fused {
+            if let Some(text) = self.fused_inline(i) {
+                return (text, Prec::Atom);
+            }
+        }
+        match self.p.insts[i] {
+            Inst::Const(_) | Inst::Symbol(_) => self.expr(i),
+            Inst::Add(a, b) => {
+                let (l, r) = self.commuted(a, b, Prec::Sum);
+                (
+                    format!("{} + {}", wrap(l, Prec::Sum), right(r, Prec::Sum)),
+                    Prec::Sum,
+                )
+            }
+            Inst::Sub(a, b) => (
+                format!(
+                    "{} - {}",
+                    wrap(self.expr(a as usize), Prec::Sum),
+                    right(self.expr(b as usize), Prec::Sum)
+                ),
+                Prec::Sum,
+            ),
+            Inst::Mul(a, b) => {
+                let (l, r) = self.commuted(a, b, Prec::Product);
+                (
+                    format!("{} * {}", wrap(l, Prec::Product), right(r, Prec::Product)),
+                    Prec::Product,
+                )
+            }
+            Inst::Div(a, b) => (
+                format!(
+                    "{} / {}",
+                    wrap(self.expr(a as usize), Prec::Product),
+                    right(self.expr(b as usize), Prec::Product)
+                ),
+                Prec::Product,
+            ),
+            Inst::Neg(a) => (
+                format!("-{}", wrap(self.expr(a as usize), Prec::Atom)),
+                Prec::Unary,
+            ),
+            Inst::Powi(a, e) => (
+                format!("{}.powi({e})", wrap(self.expr(a as usize), Prec::Atom)),
+                Prec::Atom,
+            ),
+            Inst::Call(f, a) => (
+                format!("{}.{}()", wrap(self.expr(a as usize), Prec::Atom), f.name()),
+                Prec::Atom,
+            ),
+            Inst::Atan2(y, x) => (
+                format!(
+                    "{}.atan2({})",
+                    wrap(self.expr(y as usize), Prec::Atom),
+                    self.expr(x as usize).0
+                ),
+                Prec::Atom,
+            ),
+        }
+    }
+}
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::graph::SymbolKind;
+
+    #[test]
+    fn statements_are_split_by_the_latest_stage_they_read() {
+        let mut g = Graph::new();
+        let _q = g.coordinate("q").unwrap();
+        let x = g.declare("x", SymbolKind::Auxiliary).unwrap();
+        let w = g.declare("w", SymbolKind::Auxiliary).unwrap();
+        // sin(q)·cos(q) is shared by every stage; x·sin(q)·cos(q) by the
+        // last two; w reads both.
+        let a = g.parse("sin(q)*cos(q) + q").unwrap();
+        let b = g.parse("sin(q)*cos(q)*x + x^2").unwrap();
+        let c = g
+            .parse("(sin(q)*cos(q)*x + x^2)*w + w^2 + sin(q)*cos(q)")
+            .unwrap();
+        let p = Program::lower(&g, &[a, b, c]);
+        let mut o = EmitOptions::default();
+        o.symbol_stage.insert(x, 1);
+        o.symbol_stage.insert(w, 2);
+        let code = p.to_rust(&g, &o);
+        assert_eq!(code.stages.len(), 3);
+        let mut all: Vec<String> = code.stages.concat();
+        let mut body = code.body.clone();
+        all.sort();
+        body.sort();
+        assert_eq!(all, body, "the stages hold exactly the body's statements");
+        let mentions = |v: &[String], name: &str| {
+            v.iter().any(|s| {
+                s.split(|c: char| !c.is_alphanumeric() && c != '_')
+                    .any(|t| t == name)
+            })
+        };
+        assert!(!mentions(&code.stages[0], "x") && !mentions(&code.stages[0], "w"));
+        assert!(!mentions(&code.stages[1], "w"));
+        assert!(mentions(&code.stages[0], "q"));
+        // Without stages, one stage holds everything.
+        let plain = p.to_rust(&g, &EmitOptions::default());
+        assert_eq!(plain.stages.len(), 1);
+        assert_eq!(plain.stages[0], plain.body);
+    }
+}
