@@ -24,7 +24,7 @@ pub fn emit(
     let p = p();
     let base = &full.model.name;
     let scene_type = |name: &syn::Ident| format_ident!("{}{}", base, camel(&name.to_string()));
-    let scene_infos = scenes.iter().map(|(n, _)| format_ident!("__INFO_{}", n));
+    let scene_infos = scenes.iter().map(|(n, _)| info_static(n));
     let count = int(scenes.len());
     let mut body = quote! {
         static __SCENES: [&#p::ModelInfo; #count] = [#(&#scene_infos),*];
@@ -49,7 +49,7 @@ pub fn emit(
                 d,
                 type_name: ty,
                 this: quote!(self.0),
-                info_ident: format_ident!("__INFO_{}", name),
+                info_ident: info_static(name),
                 scene_infos: quote!(&[]),
                 scene_rhs: TokenStream::new(),
             }
@@ -64,6 +64,13 @@ pub fn emit(
             #body
         };
     }
+}
+
+/// The `ModelInfo` static of scene `name`. Named at the call site: a span
+/// in the user's attribute would make the compiler's lints on generated
+/// items (an upper-case static name) point at the user's code.
+fn info_static(name: &syn::Ident) -> syn::Ident {
+    format_ident!("__INFO_{}", name, span = proc_macro2::Span::call_site())
 }
 
 /// The full model's `scene_rhs` and `visit_scene` (nothing without scenes).
