@@ -31,7 +31,9 @@ mod dop853;
 pub use dop853::*;
 mod dopri5;
 mod explicit;
-pub use dopri5::{Dopri5, EventFn, IntegrateError, ProjectFn, Solution, Stats};
+mod solution;
+pub use dopri5::Dopri5;
+pub use solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 #[cfg(feature = "std")]
 mod implicit;
 #[cfg(feature = "std")]

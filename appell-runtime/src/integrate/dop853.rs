@@ -5,10 +5,10 @@
 #![allow(clippy::excessive_precision)]
 
 use super::check_state_len;
-use super::dopri5::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
 };
+use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use crate::model::{Model, ModelError};
 use crate::scalar::Scalar;
 
