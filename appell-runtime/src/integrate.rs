@@ -24,7 +24,7 @@
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
 //! otherwise, so a blow-up never goes unnoticed as NaN.
 
-use crate::model::{Model, ModelError};
+use crate::model::{check_state_len, Model, ModelError};
 use crate::scalar::Scalar;
 
 mod dop853;
@@ -245,20 +245,6 @@ where
         }
     }
     Ok(out)
-}
-
-/// Checks that the array length `S` is the model's reduced state length.
-fn check_state_len<M: Model>(found: usize) -> Result<(), ModelError> {
-    let expected = M::info().state_len();
-    if found == expected {
-        Ok(())
-    } else {
-        Err(ModelError::Length {
-            argument: "state",
-            expected,
-            found,
-        })
-    }
 }
 
 /// One classical RK4 step of size `h` of the model's reduced equations

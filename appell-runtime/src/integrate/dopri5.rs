@@ -1,12 +1,11 @@
 //! Adaptive Dormand–Prince 5(4) integration with dense output and event
 //! location, on fixed-size arrays and without allocation.
 
-use super::check_state_len;
 use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
 };
 use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
-use crate::model::{Model, ModelError};
+use crate::model::{check_state_len, Model, ModelError};
 use crate::scalar::Scalar;
 
 /// Adaptive Dormand–Prince 5(4) integrator (Hairer, Nørsett & Wanner,
