@@ -24,14 +24,16 @@
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
 //! otherwise, so a blow-up never goes unnoticed as NaN.
 
-use crate::model::{Model, ModelError};
+use crate::model::{check_state_len, Model, ModelError};
 use crate::scalar::Scalar;
 
 mod dop853;
 pub use dop853::*;
 mod dopri5;
 mod explicit;
-pub use dopri5::{Dopri5, EventFn, IntegrateError, ProjectFn, Solution, Stats};
+mod solution;
+pub use dopri5::Dopri5;
+pub use solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 #[cfg(feature = "std")]
 mod implicit;
 #[cfg(feature = "std")]
@@ -243,20 +245,6 @@ where
         }
     }
     Ok(out)
-}
-
-/// Checks that the array length `S` is the model's reduced state length.
-fn check_state_len<M: Model>(found: usize) -> Result<(), ModelError> {
-    let expected = M::info().state_len();
-    if found == expected {
-        Ok(())
-    } else {
-        Err(ModelError::Length {
-            argument: "state",
-            expected,
-            found,
-        })
-    }
 }
 
 /// One classical RK4 step of size `h` of the model's reduced equations

@@ -17,7 +17,8 @@ use crate::scalar::Scalar;
 /// in magnitude is reported as [`ModelError::SingularConstraints`] (the use
 /// this solve has in generated code, where `A` is the dependent block D' and
 /// `B` holds −D'' and −d: a pivot is negligible relative to the whole
-/// constraint matrix, not only to D').
+/// constraint matrix, not only to D'). [`lu_solve_ops`] counts its
+/// arithmetic.
 ///
 /// ```
 /// use appell_runtime::linalg::lu_solve;
@@ -146,6 +147,7 @@ pub fn check_pivot<T: Scalar>(pivot: T, scale: f64, column: usize) -> Result<(),
 /// right sides that depend on an earlier solution. A pivot smaller than
 /// `1e-12 ×` the largest magnitude among `A`'s entries and `rhs_scale` is
 /// reported as [`ModelError::SingularConstraints`], as in [`lu_solve`].
+/// [`lu_factor_ops`] counts its arithmetic.
 ///
 /// ```
 /// use appell_runtime::linalg::{lu_factor, lu_substitute};
@@ -209,7 +211,8 @@ fn swap_rows<T: Copy, const N: usize, const M: usize>(a: &mut [[T; M]; N], i: us
 }
 
 /// Solves `A X = B` in place with the factors and row exchanges of
-/// [`lu_factor`]: on return `b` holds `X`.
+/// [`lu_factor`]: on return `b` holds `X`. [`lu_substitute_ops`] counts its
+/// arithmetic.
 ///
 /// ```
 /// use appell_runtime::linalg::{lu_factor, lu_substitute};
@@ -251,6 +254,67 @@ pub fn lu_substitute<T: Scalar, const N: usize, const M: usize>(
             b[col][j] = s * inv;
         }
     }
+}
+
+/// The arithmetic operations [`lu_factor`] performs on an `n × n` matrix:
+/// additions, subtractions, multiplications and divisions of the scalar,
+/// each counted 1 (pivot search, comparisons, row exchanges and the pivot
+/// tolerance, all on `f64` magnitudes, are not counted). Per column `c`: a
+/// reciprocal of the pivot, then for each of the `n − c − 1` rows below it a
+/// multiplier and a multiply-subtract per entry right of the pivot, so
+/// `Σ_{c<n} 1 + (n − c − 1)(1 + 2(n − c − 1))`. A row whose multiplier is
+/// zero is skipped, so this is the count for a matrix without zero
+/// multipliers and an upper bound otherwise.
+///
+/// ```
+/// use appell_runtime::linalg::lu_factor_ops;
+/// assert_eq!(lu_factor_ops(0), 0);
+/// assert_eq!(lu_factor_ops(1), 1); // the reciprocal of the pivot
+/// assert_eq!(lu_factor_ops(2), 5); // 2 reciprocals, 1 multiplier, 1 multiply-subtract
+/// assert_eq!(lu_factor_ops(3), 16);
+/// // Usable in constants.
+/// const OPS: usize = lu_factor_ops(4);
+/// assert_eq!(OPS, 38);
+/// ```
+pub const fn lu_factor_ops(n: usize) -> usize {
+    if n == 0 {
+        return 0;
+    }
+    // n reciprocals, n(n − 1)/2 multipliers, 2 Σ_{m<n} m² for the updates.
+    n + n * (n - 1) / 2 + n * (n - 1) * (2 * n - 1) / 3
+}
+
+/// The arithmetic operations [`lu_substitute`] performs with the factors of
+/// an `n × n` matrix on a right side of `columns` columns, counted as for
+/// [`lu_factor_ops`]: per right-hand column, a multiply-subtract for each
+/// entry of L below the diagonal (forward), then a multiply-subtract for
+/// each entry of U above the diagonal and a multiplication by the stored
+/// reciprocal per row (backward), so
+/// `columns · (n(n − 1) + n²) = columns · (2n² − n)`. Rows of L with a zero
+/// multiplier are skipped, as in [`lu_factor_ops`].
+///
+/// ```
+/// use appell_runtime::linalg::lu_substitute_ops;
+/// assert_eq!(lu_substitute_ops(1, 1), 1); // one multiplication by 1/a
+/// assert_eq!(lu_substitute_ops(3, 2), 2 * (2 * 9 - 3));
+/// assert_eq!(lu_substitute_ops(4, 0), 0);
+/// ```
+pub const fn lu_substitute_ops(n: usize, columns: usize) -> usize {
+    columns * (2 * n * n - n)
+}
+
+/// The arithmetic operations [`lu_solve`] performs on an `n × n` system with
+/// `columns` right-hand columns: [`lu_factor_ops`]`(n)` plus
+/// [`lu_substitute_ops`]`(n, columns)` (the right side's scale is computed
+/// on `f64` magnitudes and not counted).
+///
+/// ```
+/// use appell_runtime::linalg::{lu_factor_ops, lu_solve_ops, lu_substitute_ops};
+/// assert_eq!(lu_solve_ops(3, 2), lu_factor_ops(3) + lu_substitute_ops(3, 2));
+/// assert_eq!(lu_solve_ops(2, 1), 5 + 6);
+/// ```
+pub const fn lu_solve_ops(n: usize, columns: usize) -> usize {
+    lu_factor_ops(n) + lu_substitute_ops(n, columns)
 }
 
 /// Solves `M x = f` for a symmetric positive definite `M` by an LDLᵀ
@@ -316,6 +380,195 @@ pub fn ldlt_solve<T: Scalar, const N: usize>(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An `f64` that counts the arithmetic done on it: additions,
+    /// subtractions, multiplications and divisions (assigning forms
+    /// included) in `ARITHMETIC`, anything else (negation, elementary
+    /// functions) in `OTHER`, per thread.
+    #[derive(Clone, Copy, Debug)]
+    struct Counted(f64);
+
+    std::thread_local! {
+        static ARITHMETIC: core::cell::Cell<usize> = const { core::cell::Cell::new(0) };
+        static OTHER: core::cell::Cell<usize> = const { core::cell::Cell::new(0) };
+    }
+
+    fn tick(counter: &'static std::thread::LocalKey<core::cell::Cell<usize>>) {
+        counter.with(|c| c.set(c.get() + 1));
+    }
+
+    /// The counts since the last call (arithmetic, other), resetting them.
+    fn take_counts() -> (usize, usize) {
+        (
+            ARITHMETIC.with(|c| c.replace(0)),
+            OTHER.with(|c| c.replace(0)),
+        )
+    }
+
+    macro_rules! counted_op {
+        ($op:ident, $f:ident, $op_assign:ident, $f_assign:ident, $sym:tt) => {
+            impl core::ops::$op for Counted {
+                type Output = Counted;
+                fn $f(self, rhs: Counted) -> Counted {
+                    tick(&ARITHMETIC);
+                    Counted(self.0 $sym rhs.0)
+                }
+            }
+            impl core::ops::$op_assign for Counted {
+                fn $f_assign(&mut self, rhs: Counted) {
+                    *self = core::ops::$op::$f(*self, rhs);
+                }
+            }
+        };
+    }
+    counted_op!(Add, add, AddAssign, add_assign, +);
+    counted_op!(Sub, sub, SubAssign, sub_assign, -);
+    counted_op!(Mul, mul, MulAssign, mul_assign, *);
+    counted_op!(Div, div, DivAssign, div_assign, /);
+
+    impl core::ops::Neg for Counted {
+        type Output = Counted;
+        fn neg(self) -> Counted {
+            tick(&OTHER);
+            Counted(-self.0)
+        }
+    }
+
+    impl Scalar for Counted {
+        fn from_f64(x: f64) -> Self {
+            Counted(x)
+        }
+        fn re(self) -> f64 {
+            self.0
+        }
+        fn sin(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.sin())
+        }
+        fn cos(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.cos())
+        }
+        fn tan(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.tan())
+        }
+        fn exp(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.exp())
+        }
+        fn ln(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.ln())
+        }
+        fn abs(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.abs())
+        }
+        fn sqrt(self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.sqrt())
+        }
+        fn powi(self, n: i32) -> Self {
+            tick(&OTHER);
+            Counted(self.0.powi(n))
+        }
+        fn atan2(self, x: Self) -> Self {
+            tick(&OTHER);
+            Counted(self.0.atan2(x.0))
+        }
+    }
+
+    /// Counts the operations of `lu_factor`, `lu_substitute` and `lu_solve`
+    /// on an `N × N` system with `M` right-hand columns whose entries are
+    /// pseudo-random and non-zero (so no multiplier is zero and no row is
+    /// skipped), and compares them with the formulas.
+    fn check_lu_op_counts<const N: usize, const M: usize>(seed: &mut u64) {
+        let mut next = || {
+            *seed ^= *seed << 13;
+            *seed ^= *seed >> 7;
+            *seed ^= *seed << 17;
+            // In ±[0.5, 1.5): never zero.
+            let u = (*seed >> 11) as f64 / (1u64 << 53) as f64;
+            if u < 0.5 {
+                -(1.0 + u)
+            } else {
+                u
+            }
+        };
+        let mut a = [[Counted(0.0); N]; N];
+        for x in a.as_flattened_mut() {
+            *x = Counted(next());
+        }
+        let mut b = [[Counted(0.0); M]; N];
+        for x in b.as_flattened_mut() {
+            *x = Counted(next());
+        }
+        take_counts();
+
+        let mut factors = a;
+        let swaps = lu_factor(&mut factors, max_abs(&b)).unwrap();
+        let factor = take_counts();
+        for row in 1..N {
+            for col in 0..row {
+                assert_ne!(factors[row][col].0, 0.0, "a zero multiplier skips a row");
+            }
+        }
+        let mut x = b;
+        lu_substitute(&factors, &swaps, &mut x);
+        let substitute = take_counts();
+        let (mut a2, mut x2) = (a, b);
+        lu_solve(&mut a2, &mut x2).unwrap();
+        let solve = take_counts();
+
+        assert_eq!(factor, (lu_factor_ops(N), 0), "lu_factor, n = {N}");
+        assert_eq!(
+            substitute,
+            (lu_substitute_ops(N, M), 0),
+            "lu_substitute, n = {N}, {M} columns"
+        );
+        assert_eq!(
+            solve,
+            (lu_solve_ops(N, M), 0),
+            "lu_solve, n = {N}, {M} columns"
+        );
+        // The counted solve is a solve.
+        for i in 0..N {
+            for j in 0..M {
+                let r: f64 = (0..N).map(|k| a[i][k].0 * x[k][j].0).sum::<f64>() - b[i][j].0;
+                assert!(r.abs() < 1e-9, "residual {r}");
+            }
+        }
+    }
+
+    #[test]
+    fn lu_op_counts_are_the_operations_performed() {
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        macro_rules! sizes {
+            ($($n:literal)*) => {$(
+                check_lu_op_counts::<$n, 1>(&mut seed);
+                check_lu_op_counts::<$n, 2>(&mut seed);
+                check_lu_op_counts::<$n, 3>(&mut seed);
+                check_lu_op_counts::<$n, 5>(&mut seed);
+            )*};
+        }
+        sizes!(1 2 3 4 5 6);
+        assert_eq!((lu_factor_ops(0), lu_substitute_ops(0, 3)), (0, 0));
+        assert_eq!(lu_substitute_ops(4, 0), 0);
+
+        // Zero multipliers skip rows: the formulas are then upper bounds.
+        let mut a = [[Counted(0.0); 4]; 4];
+        for i in 0..4 {
+            a[i][i] = Counted(2.0);
+        }
+        take_counts();
+        let swaps = lu_factor(&mut a, 1.0).unwrap();
+        let (factor, _) = take_counts();
+        let mut b = [[Counted(1.0); 2]; 4];
+        lu_substitute(&a, &swaps, &mut b);
+        let (substitute, _) = take_counts();
+        assert!(factor < lu_factor_ops(4) && substitute < lu_substitute_ops(4, 2));
+    }
 
     #[test]
     fn scales_read_every_entry_and_report_non_finite_ones() {

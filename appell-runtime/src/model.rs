@@ -253,6 +253,21 @@ pub fn check_len<T>(argument: &'static str, s: &[T], expected: usize) -> Result<
     }
 }
 
+/// Checks that an array length `found` (the `S` of a `[T; S]` state) is the
+/// model's reduced state length ([`ModelInfo::state_len`]).
+pub(crate) fn check_state_len<M: Model>(found: usize) -> Result<(), ModelError> {
+    let expected = M::info().state_len();
+    if found == expected {
+        Ok(())
+    } else {
+        Err(ModelError::Length {
+            argument: "state",
+            expected,
+            found,
+        })
+    }
+}
+
 /// A constrained multibody model whose equations of motion were derived at
 /// compile time. Implemented by `#[derive(Appell)]`.
 ///

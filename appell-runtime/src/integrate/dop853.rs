@@ -4,12 +4,11 @@
 // The coefficients are kept with the digits they are published with.
 #![allow(clippy::excessive_precision)]
 
-use super::check_state_len;
-use super::dopri5::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
 };
-use crate::model::{Model, ModelError};
+use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
+use crate::model::{check_state_len, Model, ModelError};
 use crate::scalar::Scalar;
 
 /// Adaptive Dormand–Prince 8(5,3) integrator (Hairer, Nørsett & Wanner,

@@ -7,7 +7,7 @@
 //! and FSAL handling) and its continuous extension. Everything is generic
 //! and monomorphised per method, without allocation.
 
-use super::dopri5::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
+use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use crate::model::ModelError;
 use crate::scalar::Scalar;
 

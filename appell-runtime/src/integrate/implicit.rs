@@ -1,7 +1,7 @@
 //! Adaptive implicit integration for stiff models: TR-BDF2 (std only).
 
 use super::explicit::illinois;
-use super::IntegrateError;
+use super::solution::IntegrateError;
 use crate::model::{check_len, Model, ModelError};
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;

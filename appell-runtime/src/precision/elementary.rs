@@ -1,8 +1,10 @@
-//! The elementary functions of [`DoubleDouble`]: each starts from the `f64`
+//! The elementary functions of [`DoubleDouble`], and its [`Scalar`]
+//! implementation, which is made of them: each starts from the `f64`
 //! function (or a reduction to a small argument) and adds the missing 53
 //! bits by one Newton step or a Taylor series evaluated in double-double.
 
 use super::{fp, two_prod, DoubleDouble};
+use crate::Scalar;
 
 /// `x` as a double-double.
 #[inline]
@@ -30,7 +32,7 @@ fn sub_multiple(a: DoubleDouble, k: f64, c: DoubleDouble, c_lo2: f64) -> DoubleD
 /// Square root: the f64 root `s`, corrected by one Newton step
 /// `s + (a − s²) / (2 s)` whose remainder `a − s²` is formed in
 /// double-double.
-pub(super) fn sqrt(a: DoubleDouble) -> DoubleDouble {
+fn sqrt(a: DoubleDouble) -> DoubleDouble {
     if a.hi <= 0.0 {
         // √0 = 0 (keeping the sign of zero), √(negative) = NaN.
         return if a.hi == 0.0 {
@@ -51,7 +53,7 @@ pub(super) fn sqrt(a: DoubleDouble) -> DoubleDouble {
 /// eˣ: x = k ln 2 + r with |r| ≤ ln 2 / 2; r scaled by 2⁻⁸; e^(r/256) − 1 by
 /// its Taylor series; eight squarings in the form (1 + e)² − 1 = 2e + e²,
 /// which keeps the relative error of e from growing; then · 2ᵏ.
-pub(super) fn exp(a: DoubleDouble) -> DoubleDouble {
+fn exp(a: DoubleDouble) -> DoubleDouble {
     if a.hi.is_nan() {
         return a;
     }
@@ -87,7 +89,7 @@ pub(super) fn exp(a: DoubleDouble) -> DoubleDouble {
 /// ln x: near 1 (|x − 1| < 1/4), 2 atanh((x − 1)/(x + 1)) by its series,
 /// which keeps the relative accuracy of a small result; elsewhere one Newton
 /// step on eʸ = x from the f64 logarithm, y + x e⁻ʸ − 1.
-pub(super) fn ln(a: DoubleDouble) -> DoubleDouble {
+fn ln(a: DoubleDouble) -> DoubleDouble {
     if a.hi.is_nan() {
         return a;
     }
@@ -124,7 +126,7 @@ pub(super) fn ln(a: DoubleDouble) -> DoubleDouble {
 /// (sin x, cos x): x = k π/2 + r with |r| ≤ π/4 (π/2 to three words, see
 /// [`sub_multiple`]), both Taylor series of r, then the
 /// quadrant k mod 4.
-pub(super) fn sin_cos(a: DoubleDouble) -> (DoubleDouble, DoubleDouble) {
+fn sin_cos(a: DoubleDouble) -> (DoubleDouble, DoubleDouble) {
     if !a.hi.is_finite() {
         let nan = DoubleDouble::special(f64::NAN);
         return (nan, nan);
@@ -178,7 +180,7 @@ fn sin_cos_small(r: DoubleDouble) -> (DoubleDouble, DoubleDouble) {
 /// atan2(y, x): θ₀ from the f64 `atan2`, then one Newton step on
 /// y cos θ − x sin θ = 0, θ₁ = θ₀ + (y cos θ₀ − x sin θ₀)/(x cos θ₀ + y sin θ₀),
 /// which is θ₀ + tan(θ − θ₀): the error falls from 1e-16 to 1e-48.
-pub(super) fn atan2(y: DoubleDouble, x: DoubleDouble) -> DoubleDouble {
+fn atan2(y: DoubleDouble, x: DoubleDouble) -> DoubleDouble {
     let theta0 = fp::atan2(y.hi, x.hi);
     if !theta0.is_finite() || (y.hi == 0.0 && x.hi == 0.0) || !y.is_finite() || !x.is_finite() {
         return DoubleDouble::special(theta0);
@@ -190,7 +192,7 @@ pub(super) fn atan2(y: DoubleDouble, x: DoubleDouble) -> DoubleDouble {
 }
 
 /// xⁿ by binary powering; x⁻ⁿ = 1/xⁿ.
-pub(super) fn powi(a: DoubleDouble, n: i32) -> DoubleDouble {
+fn powi(a: DoubleDouble, n: i32) -> DoubleDouble {
     let mut m = n.unsigned_abs();
     let mut base = a;
     let mut result = dd(1.0);
@@ -207,5 +209,50 @@ pub(super) fn powi(a: DoubleDouble, n: i32) -> DoubleDouble {
         dd(1.0) / result
     } else {
         result
+    }
+}
+
+// The bare calls are to this module's functions above, not to the methods.
+impl Scalar for DoubleDouble {
+    #[inline]
+    fn from_f64(x: f64) -> Self {
+        DoubleDouble::from(x)
+    }
+    #[inline]
+    fn re(self) -> f64 {
+        self.to_f64()
+    }
+    fn sin(self) -> Self {
+        sin_cos(self).0
+    }
+    fn cos(self) -> Self {
+        sin_cos(self).1
+    }
+    fn tan(self) -> Self {
+        let (s, c) = sin_cos(self);
+        s / c
+    }
+    fn exp(self) -> Self {
+        exp(self)
+    }
+    fn ln(self) -> Self {
+        ln(self)
+    }
+    #[inline]
+    fn abs(self) -> Self {
+        if self.hi < 0.0 {
+            -self
+        } else {
+            self
+        }
+    }
+    fn sqrt(self) -> Self {
+        sqrt(self)
+    }
+    fn powi(self, n: i32) -> Self {
+        powi(self, n)
+    }
+    fn atan2(self, x: Self) -> Self {
+        atan2(self, x)
     }
 }
