@@ -22,22 +22,7 @@ use crate::algebra::{cross, dot, expanded, Vec3};
 use crate::ctxt::Ctxt;
 use crate::model::Model;
 
-/// Where a velocity constraint row comes from.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum RowSource {
-    /// The time derivative of the i-th `holonomic(...)`.
-    Holonomic(usize),
-    /// The i-th `nonholonomic(...)`.
-    Nonholonomic(usize),
-    /// A component of the i-th `rolls(...)`: `direction` indexes N.x, N.y,
-    /// N.z, or the `along` list.
-    Rolling {
-        /// Index into `Model::rolling`.
-        contact: usize,
-        /// The component.
-        direction: usize,
-    },
-}
+pub use appell_runtime::RowSource;
 
 /// The material velocity at a rolling contact, as written (the twin's).
 #[derive(Clone, Copy)]
@@ -137,7 +122,7 @@ fn holonomic_rows(cx: &Ctxt, model: &mut Model, calculus: &Calculus) -> (Vec<Id>
                 holonomic: true,
                 as_written,
                 direction: None,
-                source: RowSource::Holonomic(index),
+                source: RowSource::Holonomic { index },
             }),
             (Err(e), _) | (_, Err(e)) => cx.error_spanned_by(&c.at, e),
         }
@@ -159,7 +144,7 @@ fn nonholonomic_rows(model: &Model, calculus: &Calculus) -> Vec<Row> {
             holonomic: false,
             as_written,
             direction: None,
-            source: RowSource::Nonholonomic(index),
+            source: RowSource::Nonholonomic { index },
         });
     }
     rows
@@ -443,7 +428,7 @@ mod tests {
     fn a_holonomic_constraint_enters_through_its_time_derivative() {
         // x² + y² − l² = 0 → 2x ẋ + 2y ẏ = 0.
         let (mut m, rows) = rows_of(testing::CARTESIAN);
-        assert_eq!(rows.sources, vec![RowSource::Holonomic(0)]);
+        assert_eq!(rows.sources, vec![RowSource::Holonomic { index: 0 }]);
         assert_eq!(rows.d.len(), 2);
         assert_agrees(&mut m.g, rows.d[0], "2*x");
         assert_agrees(&mut m.g, rows.d[1], "2*y");
@@ -456,7 +441,7 @@ mod tests {
     fn a_knife_edge_is_one_nonholonomic_row() {
         // ẏ cos θ − ẋ sin θ = 0: D = [−sin θ, cos θ, 0], d = 0.
         let (mut m, rows) = rows_of(testing::SLEIGH);
-        assert_eq!(rows.sources, vec![RowSource::Nonholonomic(0)]);
+        assert_eq!(rows.sources, vec![RowSource::Nonholonomic { index: 0 }]);
         assert_agrees(&mut m.g, rows.d[0], "-sin(theta)");
         assert_agrees(&mut m.g, rows.d[1], "cos(theta)");
         assert!(m.g.is_zero(rows.d[2]));

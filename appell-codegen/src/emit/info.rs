@@ -27,12 +27,12 @@ impl Emitter<'_> {
             quote!(#p::BodyInfo { name: #name, rigid: #rigid })
         });
         let row_sources = d.constraints.sources.iter().map(|r| match *r {
-            RowSource::Holonomic(i) => {
-                let i = int(i);
+            RowSource::Holonomic { index } => {
+                let i = int(index);
                 quote!(#p::RowSource::Holonomic { index: #i })
             }
-            RowSource::Nonholonomic(i) => {
-                let i = int(i);
+            RowSource::Nonholonomic { index } => {
+                let i = int(index);
                 quote!(#p::RowSource::Nonholonomic { index: #i })
             }
             RowSource::Rolling { contact, direction } => {

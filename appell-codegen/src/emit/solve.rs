@@ -14,6 +14,7 @@
 
 use std::collections::HashSet;
 
+use appell_runtime::linalg::{lu_factor_ops, lu_substitute_ops};
 use appell_symbolic::Id;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
@@ -21,20 +22,6 @@ use quote::{format_ident, quote};
 use super::code::{code, code_with, options, Code, Target};
 use super::{int, p, Emitter};
 use crate::derivation::{singleton_rows, Elimination, NumericElimination, SingletonOrder};
-
-/// Operations of `lu_factor` on an n×n block: a reciprocal per column,
-/// kept, then a multiplier and a multiply-subtract per entry below and
-/// right of the pivot.
-fn factor_ops(n: usize) -> usize {
-    (0..n)
-        .map(|c| 1 + (n - c - 1) * (1 + 2 * (n - c - 1)))
-        .sum()
-}
-
-/// Operations of `lu_substitute` for `k` right-hand columns.
-fn substitute_ops(n: usize, k: usize) -> usize {
-    k * (2 * n * n - n)
-}
 
 /// The m×w matrix of `outputs[offset..]`, row-major, as nested arrays.
 fn matrix(outputs: &[TokenStream], offset: usize, m: usize, w: usize) -> TokenStream {
@@ -297,10 +284,10 @@ impl Solver<'_> {
                     Err(e) => return Err(e)
                 };
             });
-            ops += factor_ops(b);
+            ops += lu_factor_ops(b);
         }
         out.extend(quote!(#p::lu_substitute(&__sb, &__swaps, &mut #block_rhs);));
-        ops += substitute_ops(b, w);
+        ops += lu_substitute_ops(b, w);
         for (q, &c) in cols_left.iter().enumerate() {
             for k in 0..w {
                 let (unknown, qi, ki) = (name(c, k), int(q), int(k));
