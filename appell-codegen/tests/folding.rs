@@ -22,12 +22,12 @@ fn equations_with(
     let input: syn::DeriveInput = syn::parse_str(src).expect("valid Rust");
     let cx = Ctxt::new();
     let ast = parse::parse(&cx, &input);
-    let m = model::build(&cx, &ast).expect("model");
+    let kinematics = model::build(&cx, &ast).expect("model");
     let options = Options {
         fold_always,
         rotor_form,
     };
-    let d = derive_with(&cx, m, &options).expect("derivation");
+    let d = derive_with(&cx, kinematics, &options).expect("derivation");
     cx.check().expect("no errors");
     let mut roots = d.equations.mass.clone();
     roots.extend(&d.equations.forcing);

@@ -271,9 +271,8 @@ mod tests {
             #[appell(nonholonomic(dt(y) == dt(x)), nonholonomic(dt(y) == 2 * dt(x)))]
             struct Bad { m: f64 }
         "#;
-        let mut model = testing::model(src);
+        let (mut model, calculus) = testing::model_and_calculus(src);
         let cx = Ctxt::new();
-        let calculus = super::super::Calculus::take_from(&mut model);
         let rows = super::super::rows::constraint_rows(&cx, &mut model, &calculus)
             .unwrap()
             .unwrap();

@@ -62,7 +62,7 @@ pub use speeds::SpeedDefinitions;
 pub use structure::{singleton_rows, SingletonOrder};
 
 use crate::ctxt::Ctxt;
-use crate::model::Model;
+use crate::model::{Kinematics, Model, Twin};
 
 /// Choices the derivation makes by operation count, forced for tests that
 /// compare the forms.
@@ -83,7 +83,7 @@ pub struct Calculus {
     /// q → q̇ → q̈, t → 1.
     pub rules: RateRules,
     /// The twin, when the model has one.
-    pub twin: Option<Box<Model>>,
+    pub twin: Option<Twin>,
     /// The twin's rate rules (direction cosines turning with their frames).
     pub twin_rules: Option<RateRules>,
     /// Direction-cosine symbols → their values.
@@ -91,9 +91,8 @@ pub struct Calculus {
 }
 
 impl Calculus {
-    /// Takes the twin out of `model`.
-    pub fn take_from(model: &mut Model) -> Calculus {
-        let twin = model.twin.take();
+    /// The derivatives, with `twin` where the model has one.
+    pub fn new(twin: Option<Twin>) -> Calculus {
         let twin_rules = twin.as_ref().map(|t| t.rate_rules());
         let uncut = twin
             .as_ref()
@@ -155,13 +154,14 @@ pub struct Unreduced {
 }
 
 /// Runs the derivation; errors go to `cx`.
-pub fn derive(cx: &Ctxt, model: Model) -> Option<Derivation> {
-    derive_with(cx, model, &Options::default())
+pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derivation> {
+    derive_with(cx, kinematics, &Options::default())
 }
 
 /// [`derive`] with the cost-driven choices forced by `options`.
-pub fn derive_with(cx: &Ctxt, mut model: Model, options: &Options) -> Option<Derivation> {
-    match stages(cx, &mut model, options) {
+pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derivation> {
+    let Kinematics { mut model, twin } = kinematics;
+    match stages(cx, &mut model, Calculus::new(twin), options) {
         Ok(Some(d)) => Some(d.finish(model)),
         Ok(None) => None,
         Err(e) => {
@@ -216,9 +216,9 @@ impl Stages {
 fn stages(
     cx: &Ctxt,
     model: &mut Model,
+    mut calculus: Calculus,
     options: &Options,
 ) -> Result<Option<Stages>, SymbolicError> {
-    let mut calculus = Calculus::take_from(model);
     let Some(constraints) = rows::constraint_rows(cx, model, &calculus)? else {
         return Ok(None);
     };

@@ -267,7 +267,7 @@ mod tests {
 
     fn derived(src: &str) -> Derivation {
         let cx = Ctxt::new();
-        let d = derive(&cx, testing::model(src));
+        let d = derive(&cx, testing::kinematics(src));
         cx.check().expect("no errors");
         d.expect("a derivation")
     }

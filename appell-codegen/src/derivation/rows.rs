@@ -414,8 +414,7 @@ mod tests {
     use super::*;
 
     fn rows_of(src: &str) -> (Model, ConstraintRows) {
-        let mut model = testing::model(src);
-        let calculus = Calculus::take_from(&mut model);
+        let (mut model, calculus) = testing::model_and_calculus(src);
         let cx = Ctxt::new();
         let rows = constraint_rows(&cx, &mut model, &calculus)
             .expect("rows")
@@ -479,7 +478,7 @@ mod tests {
 
     #[test]
     fn a_row_with_no_rate_is_reported() {
-        let mut model = testing::model(
+        let (mut model, calculus) = testing::model_and_calculus(
             r#"
             #[appell(coordinates(x, y), speeds(x))]
             #[appell(point(P = O + x * N.x + y * N.y), particle(P, mass = m))]
@@ -487,7 +486,6 @@ mod tests {
             struct Bad { m: f64 }
             "#,
         );
-        let calculus = Calculus::take_from(&mut model);
         let cx = Ctxt::new();
         let rows = constraint_rows(&cx, &mut model, &calculus).expect("no engine error");
         assert!(rows.is_none());

@@ -122,7 +122,7 @@ mod tests {
             )
             .replace("j: f64 }", "j: f64, g: f64 }");
         let cx = Ctxt::new();
-        let full = derive(&cx, testing::model(&src)).expect("derivation");
+        let full = derive(&cx, testing::kinematics(&src)).expect("derivation");
         let scene = derive_scene(&cx, &full, &full.model.scenes[0]).expect("scene");
         cx.check().expect("no errors");
         let mut g = scene.model.g.clone();

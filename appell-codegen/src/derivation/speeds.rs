@@ -191,8 +191,7 @@ mod tests {
     use super::*;
 
     fn definitions(src: &str) -> (Model, Option<SpeedDefinitions>, Result<(), String>) {
-        let mut model = testing::model(src);
-        let calculus = Calculus::take_from(&mut model);
+        let (mut model, calculus) = testing::model_and_calculus(src);
         let cx = Ctxt::new();
         let rows = constraint_rows(&cx, &mut model, &calculus)
             .expect("rows")

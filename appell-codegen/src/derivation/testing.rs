@@ -21,7 +21,7 @@ use super::speed_map::{Rates, SpeedMap};
 use super::speeds::SpeedDefinitions;
 use super::{elimination, numeric, partials, remainders, rows, speed_map, speeds, Calculus};
 use crate::ctxt::Ctxt;
-use crate::model::Model;
+use crate::model::{Kinematics, Model};
 
 /// A particle of mass m on a massless rod of length l, angle q from the
 /// downward vertical, under gravity g.
@@ -53,14 +53,25 @@ pub const SLEIGH: &str = r#"
     struct Sleigh { m: f64, b: f64, i0: f64 }
 "#;
 
-/// The model of `src`, which must be free of errors.
-pub fn model(src: &str) -> Model {
+/// The kinematics of `src`, which must be free of errors.
+pub fn kinematics(src: &str) -> Kinematics {
     let input: syn::DeriveInput = syn::parse_str(src).expect("valid Rust");
     let cx = Ctxt::new();
     let ast = crate::parse::parse(&cx, &input);
-    let model = crate::model::build(&cx, &ast);
+    let built = crate::model::build(&cx, &ast);
     cx.check().expect("a model without errors");
-    model.expect("a model")
+    built.expect("a model")
+}
+
+/// The model of `src` alone (its twin dropped).
+pub fn model(src: &str) -> Model {
+    kinematics(src).model
+}
+
+/// The model of `src` and the derivatives with its twin.
+pub fn model_and_calculus(src: &str) -> (Model, Calculus) {
+    let Kinematics { model, twin } = kinematics(src);
+    (model, Calculus::new(twin))
 }
 
 /// A symbol of the model's graph by name.
@@ -130,9 +141,8 @@ pub fn solve(
     SpeedDefinitions,
     SolvedRates,
 ) {
-    let mut model = model(src);
+    let (mut model, calculus) = model_and_calculus(src);
     let cx = Ctxt::new();
-    let calculus = Calculus::take_from(&mut model);
     let rows = rows::constraint_rows(&cx, &mut model, &calculus)
         .expect("rows")
         .expect("no errors");

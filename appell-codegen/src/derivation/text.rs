@@ -125,7 +125,7 @@ mod tests {
     #[test]
     fn the_text_names_the_dependent_speeds_and_the_reduced_state() {
         let cx = Ctxt::new();
-        let d = derive(&cx, testing::model(testing::DISC_ON_A_LINE)).expect("derivation");
+        let d = derive(&cx, testing::kinematics(testing::DISC_ON_A_LINE)).expect("derivation");
         cx.check().expect("no errors");
         assert!(
             d.text

@@ -1,0 +1,208 @@
+//! Points, bodies, constraints, loads and rolling contacts.
+
+use appell_symbolic::Id;
+
+use super::builder::{hint, Builder};
+use super::expr::Val;
+use super::{Body, Constraint, Load, Point, Rolling, Vec3};
+use crate::ast::*;
+
+/// The loads of a model: its forces and torques with their effects.
+pub(super) struct Loads {
+    /// Effect names in order of first use.
+    pub effects: Vec<String>,
+    /// Forces, each body's weight first when there is `gravity(...)`.
+    pub forces: Vec<Load>,
+    /// Torques.
+    pub torques: Vec<Load>,
+    /// The `gravity(...)` acceleration.
+    pub gravity: Option<Vec3>,
+}
+
+impl Builder<'_> {
+    pub(super) fn add_point(&mut self, p: &PointDef) {
+        self.context = format!("point `{}`", p.name);
+        match self.eval(&p.location) {
+            Some(Val::Point(pos)) => self.points.push(Point {
+                name: p.name.to_string(),
+                pos,
+            }),
+            Some(_) => self.cx.error_at(
+                p.location.span(),
+                "a point is located from another point: `P = O + vector` or `P = Q + vector`",
+            ),
+            None => {}
+        }
+    }
+
+    pub(super) fn add_body(&mut self, d: &BodyDef) -> Option<Body> {
+        let center = self.point_named(&d.center);
+        let frame = match &d.frame {
+            Some(f) => Some(self.frame_named(f)?),
+            None => None,
+        };
+        let mass = self.scalar(&d.mass);
+        if let Some(m) = mass {
+            if self.g.is_zero(m) {
+                self.cx
+                    .error_at(d.mass.span(), format!("`{}` has zero mass", d.name));
+            }
+        }
+        let zero = self.g.int(0).ok()?;
+        let mut inertia = [[zero; 3]; 3];
+        match &d.inertia {
+            Some(Inertia::Principal(m)) => {
+                for (i, e) in m.iter().enumerate() {
+                    inertia[i][i] = self.scalar(e)?;
+                }
+            }
+            Some(Inertia::Matrix(m)) => {
+                let v: Vec<Id> = m.iter().map(|e| self.scalar(e)).collect::<Option<_>>()?;
+                inertia = [[v[0], v[3], v[5]], [v[3], v[1], v[4]], [v[5], v[4], v[2]]];
+            }
+            None => {}
+        }
+        Some(Body {
+            name: d.name.to_string(),
+            center: center?,
+            frame,
+            mass: mass?,
+            inertia,
+        })
+    }
+
+    pub(super) fn constraint(&mut self, c: &ConstraintDef) -> Option<Constraint> {
+        self.context = "a constraint".to_string();
+        let l = self.scalar(&c.lhs)?;
+        let r = self.scalar(&c.rhs)?;
+        match self.g.sub(l, r) {
+            Ok(residual) => Some(Constraint {
+                residual,
+                at: c.at.clone(),
+            }),
+            Err(e) => {
+                self.cx.error_spanned_by(&c.at, e);
+                None
+            }
+        }
+    }
+
+    /// Each body's weight (effect `gravity`), then the forces and torques.
+    pub(super) fn loads(&mut self, ast: &ModelAst, bodies: &[Body]) -> Option<Loads> {
+        let zero = self.g.int(0).ok()?;
+        let mut effects = Vec::new();
+        let mut forces = Vec::new();
+        let mut torques = Vec::new();
+        let mut gravity = None;
+        if let Some(gvec) = &ast.gravity {
+            if let Some(v) = self.vector(gvec) {
+                gravity = Some(v);
+                for (index, body) in bodies.iter().enumerate() {
+                    let f = self.scale3(v, body.mass);
+                    if let Some(f) = f {
+                        forces.push(Load {
+                            point: body.center,
+                            frame: 0,
+                            vector: f,
+                            effect: "gravity".into(),
+                            weight_of: Some(index),
+                        });
+                    }
+                }
+                effects.push("gravity".to_string());
+            }
+        }
+        for l in &ast.forces {
+            let Some(p) = self.point_named(&l.target) else {
+                continue;
+            };
+            let Some(v) = self.vector(&l.vector) else {
+                continue;
+            };
+            let effect = l.effect.to_string();
+            if !effects.contains(&effect) {
+                effects.push(effect.clone());
+            }
+            forces.push(Load {
+                point: p,
+                frame: 0,
+                vector: v,
+                effect,
+                weight_of: None,
+            });
+        }
+        for l in &ast.torques {
+            let Some(fi) = self.frame_named(&l.target) else {
+                continue;
+            };
+            let Some(v) = self.vector(&l.vector) else {
+                continue;
+            };
+            let effect = l.effect.to_string();
+            if !effects.contains(&effect) {
+                effects.push(effect.clone());
+            }
+            torques.push(Load {
+                point: [zero; 3],
+                frame: fi,
+                vector: v,
+                effect,
+                weight_of: None,
+            });
+        }
+        Some(Loads {
+            effects,
+            forces,
+            torques,
+            gravity,
+        })
+    }
+
+    /// The `rolls(...)` contacts: a rigid body, a contact point, and
+    /// optionally the directions constrained.
+    pub(super) fn rolling_contacts(&mut self, ast: &ModelAst, bodies: &[Body]) -> Vec<Rolling> {
+        let mut rolling = Vec::new();
+        for r in &ast.rolls {
+            let name = r.body.to_string();
+            let Some(bi) = bodies.iter().position(|x| x.name == name) else {
+                let h = hint(&name, bodies.iter().map(|x| x.name.clone()));
+                self.cx
+                    .error_spanned_by(&r.body, format!("unknown body `{name}`{h}"));
+                continue;
+            };
+            if bodies[bi].frame.is_none() {
+                self.cx.error_spanned_by(
+                    &r.body,
+                    format!("`{name}` is a particle; only a rigid body rolls"),
+                );
+                continue;
+            }
+            let Some(contact) = self.point_named(&r.contact) else {
+                continue;
+            };
+            let along = match &r.along {
+                Some(list) => {
+                    let dirs: Vec<Vec3> = list.iter().filter_map(|e| self.vector(e)).collect();
+                    if dirs.len() != list.len() {
+                        continue;
+                    }
+                    if dirs.is_empty() {
+                        self.cx
+                            .error_spanned_by(&r.at, "`along` needs at least one direction");
+                        continue;
+                    }
+                    Some(dirs)
+                }
+                None => None,
+            };
+            rolling.push(Rolling {
+                body: bi,
+                contact,
+                along,
+                point: r.contact.to_string(),
+                at: r.at.clone(),
+            });
+        }
+        rolling
+    }
+}

@@ -1,0 +1,344 @@
+//! The builder: declares the symbols, then resolves frames, points,
+//! bodies, constraints, loads, rolling contacts, speeds and scenes in that
+//! order, each step reading the names the earlier ones declared.
+
+use syn::Ident;
+
+use appell_symbolic::{Coordinate, Graph, Id, RateRules, Symbol, SymbolKind, SymbolicError};
+
+use super::{Cut, Frame, Mat3, Model, Param, Point, SpeedSpec, Vec3};
+use crate::ast::*;
+use crate::ctxt::{did_you_mean, Ctxt};
+
+/// Resolves one model: the names declared so far and the graph they live in.
+pub(super) struct Builder<'a> {
+    pub(super) cx: &'a Ctxt,
+    pub(super) g: Graph,
+    pub(super) params: Vec<Param>,
+    pub(super) coords: Vec<(Ident, Coordinate)>,
+    pub(super) inputs: Vec<(Ident, Symbol)>,
+    pub(super) time: Symbol,
+    pub(super) frames: Vec<Frame>,
+    pub(super) points: Vec<Point>,
+    /// Frames and points whose definition failed: references to them are
+    /// not reported again.
+    pub(super) poisoned: Vec<String>,
+    /// The definition being evaluated (for `norms`).
+    pub(super) context: String,
+    pub(super) norms: Vec<(Id, String)>,
+    /// When building the twin: the model's frame matrices, whose entries
+    /// become symbols.
+    pub(super) cut_from: Option<Vec<Mat3>>,
+    pub(super) cuts: Vec<Cut>,
+    pub(super) rules: RateRules,
+}
+
+pub(super) fn engine_error(cx: &Ctxt, span: proc_macro2::Span, e: SymbolicError) {
+    cx.error_at(span, e);
+}
+
+/// One build of the model from `ast` in `g`; with `cut_from` (the model's
+/// frame matrices), the twin's build, whose direction cosines become
+/// symbols. Returns the model and the direction-cosine symbols made.
+pub(super) fn build_in(
+    cx: &Ctxt,
+    ast: &ModelAst,
+    mut g: Graph,
+    cut_from: Option<Vec<Mat3>>,
+) -> Option<(Model, Vec<Cut>)> {
+    let time = g.time().expect("fresh graph");
+    let mut b = Builder {
+        cx,
+        g,
+        params: Vec::new(),
+        coords: Vec::new(),
+        inputs: Vec::new(),
+        time,
+        frames: Vec::new(),
+        points: Vec::new(),
+        poisoned: Vec::new(),
+        context: String::new(),
+        norms: Vec::new(),
+        cut_from,
+        cuts: Vec::new(),
+        rules: RateRules::coordinates(),
+    };
+    b.declare_symbols(ast);
+    b.frames_and_points(ast)?;
+    let bodies: Vec<super::Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
+    let holonomic = ast
+        .holonomic
+        .iter()
+        .filter_map(|c| b.constraint(c))
+        .collect();
+    let nonholonomic = ast
+        .nonholonomic
+        .iter()
+        .filter_map(|c| b.constraint(c))
+        .collect();
+    let loads = b.loads(ast, &bodies)?;
+    let rolling = b.rolling_contacts(ast, &bodies);
+    let (speed_specs, speeds_at) = b.speeds(ast);
+    let speeds: Vec<usize> = speed_specs.iter().filter_map(|s| s.coordinate).collect();
+    let scenes = b.scenes(ast, &loads.effects);
+    if bodies.is_empty() && !cx.has_errors() {
+        cx.error_at(
+            ast.name.span(),
+            "the model has no `body(...)` or `particle(...)`: there is nothing to move",
+        );
+    }
+    if cx.has_errors() {
+        return None;
+    }
+    let model = Model {
+        g: b.g,
+        name: ast.name.clone(),
+        params: b.params,
+        coords: b.coords,
+        speeds,
+        speed_specs,
+        speeds_at,
+        inputs: b.inputs,
+        time: b.time,
+        frames: b.frames,
+        points: b.points,
+        bodies,
+        holonomic,
+        nonholonomic,
+        rolling,
+        forces: loads.forces,
+        torques: loads.torques,
+        effects: loads.effects,
+        scenes,
+        quadrature: Vec::new(),
+        outputs: Vec::new(),
+        info_name: ast.name.to_string(),
+        gravity: loads.gravity,
+        norms: b.norms,
+    };
+    Some((model, b.cuts))
+}
+
+/// Names every model has: the inertial frame, its origin, time.
+const RESERVED: &[&str] = &["N", "O", "t"];
+
+impl Builder<'_> {
+    /// The inertial frame N and its origin O, then the model's frames and
+    /// points in order; a definition that fails poisons its name, so that
+    /// later references to it are not reported again.
+    pub(super) fn frames_and_points(&mut self, ast: &ModelAst) -> Option<()> {
+        let zero = self.g.int(0).ok()?;
+        let one = self.g.int(1).ok()?;
+        self.frames.push(Frame {
+            name: "N".into(),
+            rot: [[one, zero, zero], [zero, one, zero], [zero, zero, one]],
+            omega: [zero; 3],
+        });
+        self.points.push(Point {
+            name: "O".into(),
+            pos: [zero; 3],
+        });
+        for f in &ast.frames {
+            let before = self.frames.len();
+            self.add_frame(f);
+            if self.frames.len() == before {
+                self.poisoned.push(f.name.to_string());
+            }
+        }
+        for p in &ast.points {
+            let before = self.points.len();
+            self.add_point(p);
+            if self.points.len() == before {
+                self.poisoned.push(p.name.to_string());
+            }
+        }
+        Some(())
+    }
+
+    pub(super) fn declare_symbols(&mut self, ast: &ModelAst) {
+        let mut seen: Vec<(String, &'static str)> = Vec::new();
+        let mut check = |cx: &Ctxt, ident: &Ident, what: &'static str| -> bool {
+            let name = ident.to_string();
+            if RESERVED.contains(&name.as_str()) {
+                cx.error_spanned_by(
+                    ident,
+                    format!(
+                        "`{name}` is reserved (N is the Newtonian frame, O its origin, t time)"
+                    ),
+                );
+                return false;
+            }
+            if name.ends_with("_dot") || name.ends_with("_ddot") {
+                cx.error_spanned_by(
+                    ident,
+                    format!("`{name}`: names ending in `_dot` or `_ddot` are reserved for rates"),
+                );
+                return false;
+            }
+            if let Some((_, other)) = seen.iter().find(|(n, _)| *n == name) {
+                if *other == what {
+                    cx.error_spanned_by(ident, format!("duplicate {what} `{name}`"));
+                } else {
+                    cx.error_spanned_by(ident, format!("`{name}` is already a {other}"));
+                }
+                return false;
+            }
+            seen.push((name, what));
+            true
+        };
+        for (f, _) in &ast.fields {
+            if check(self.cx, f, "parameter") {
+                let s = self.g.parameter(&f.to_string()).expect("fresh name");
+                let positive = ast.positive.iter().any(|p| p == f);
+                self.params.push(Param {
+                    ident: f.clone(),
+                    symbol: s,
+                    positive,
+                });
+            }
+        }
+        for p in &ast.positive {
+            if !ast.fields.iter().any(|(f, _)| f == p) {
+                let hint = hint(
+                    &p.to_string(),
+                    ast.fields.iter().map(|(f, _)| f.to_string()),
+                );
+                self.cx.error_spanned_by(
+                    p,
+                    format!("`positive` names a parameter, and `{p}` is not one{hint}"),
+                );
+            }
+        }
+        if ast.coordinates.is_empty() {
+            self.cx
+                .error_at(ast.name.span(), "the model declares no `coordinates(...)`");
+        }
+        for c in &ast.coordinates {
+            if check(self.cx, c, "coordinate") {
+                let coord = self.g.coordinate(&c.to_string()).expect("fresh name");
+                self.coords.push((c.clone(), coord));
+            }
+        }
+        for i in &ast.inputs {
+            if check(self.cx, i, "input") {
+                let s = self.g.input(&i.to_string()).expect("fresh name");
+                self.inputs.push((i.clone(), s));
+            }
+        }
+        for f in &ast.frames {
+            if check(self.cx, &f.name, "frame") {}
+        }
+        for p in &ast.points {
+            if check(self.cx, &p.name, "point") {}
+        }
+    }
+
+    pub(super) fn speeds(&mut self, ast: &ModelAst) -> (Vec<SpeedSpec>, proc_macro2::TokenStream) {
+        let Some((list, at)) = &ast.speeds else {
+            self.cx.error_at(ast.name.span(), "the model declares no `speeds(...)`: name the coordinates whose rates are independent");
+            let name = &ast.name;
+            return (Vec::new(), quote::quote!(#name));
+        };
+        let mut out: Vec<SpeedSpec> = Vec::new();
+        for s in list {
+            let name = s.name.to_string();
+            if out.iter().any(|o| o.name == name) {
+                self.cx
+                    .error_spanned_by(&s.name, format!("duplicate speed `{name}`"));
+                continue;
+            }
+            match &s.definition {
+                None => match self.coords.iter().position(|(c, _)| *c == s.name) {
+                    Some(i) => {
+                        let c = self.coords[i].1;
+                        out.push(SpeedSpec {
+                            name,
+                            symbol: c.rate,
+                            accel: c.accel,
+                            coordinate: Some(i),
+                            definition: None,
+                        });
+                    }
+                    None => {
+                        let h = hint(&name, self.coords.iter().map(|(c, _)| c.to_string()));
+                        self.cx.error_spanned_by(
+                            &s.name,
+                            format!("`{name}` is not a coordinate; a speed is a coordinate's name, or `name = expression` for a quasi-velocity{h}"),
+                        );
+                    }
+                },
+                Some(def) => {
+                    if self.all_names().contains(&name) {
+                        self.cx.error_spanned_by(&s.name, format!("the quasi-velocity `{name}` needs a new name; `{name}` is already used"));
+                        continue;
+                    }
+                    let Some(e) = self.scalar(def) else { continue };
+                    let (Ok(symbol), Ok(accel)) = (
+                        self.g.declare(&name, SymbolKind::Auxiliary),
+                        self.g
+                            .declare(&format!("{name}_dot"), SymbolKind::Auxiliary),
+                    ) else {
+                        self.cx.error_spanned_by(
+                            &s.name,
+                            format!("the quasi-velocity `{name}` clashes with another name"),
+                        );
+                        continue;
+                    };
+                    out.push(SpeedSpec {
+                        name,
+                        symbol,
+                        accel,
+                        coordinate: None,
+                        definition: Some(e),
+                    });
+                }
+            }
+        }
+        (out, at.clone())
+    }
+
+    pub(super) fn all_names(&self) -> Vec<String> {
+        let mut v: Vec<String> = self.params.iter().map(|p| p.ident.to_string()).collect();
+        v.extend(self.coords.iter().map(|(c, _)| c.to_string()));
+        v.extend(self.inputs.iter().map(|(c, _)| c.to_string()));
+        v.extend(self.points.iter().map(|p| p.name.clone()));
+        v.push("t".into());
+        v
+    }
+
+    pub(super) fn frame_named(&self, ident: &Ident) -> Option<usize> {
+        let name = ident.to_string();
+        if let Some(i) = self.frames.iter().position(|f| f.name == name) {
+            return Some(i);
+        }
+        if self.poisoned.contains(&name) {
+            return None;
+        }
+        let h = hint(&name, self.frames.iter().map(|f| f.name.clone()));
+        self.cx
+            .error_spanned_by(ident, format!("unknown frame `{name}`{h}"));
+        None
+    }
+
+    pub(super) fn point_named(&self, ident: &Ident) -> Option<Vec3> {
+        let name = ident.to_string();
+        if let Some(p) = self.points.iter().find(|p| p.name == name) {
+            return Some(p.pos);
+        }
+        if self.poisoned.contains(&name) {
+            return None;
+        }
+        let h = hint(&name, self.points.iter().map(|p| p.name.clone()));
+        self.cx
+            .error_spanned_by(ident, format!("unknown point `{name}`{h}"));
+        None
+    }
+}
+
+/// "; did you mean `x`?" when `name` is close to a candidate.
+pub(super) fn hint(name: &str, candidates: impl IntoIterator<Item = String>) -> String {
+    let c: Vec<String> = candidates.into_iter().collect();
+    did_you_mean(name, c.iter().map(|s| s.as_str()))
+        .map(|s| format!("; did you mean `{s}`?"))
+        .unwrap_or_default()
+}

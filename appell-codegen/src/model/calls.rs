@@ -1,0 +1,345 @@
+//! Function calls in expressions: `dt`, the elementary functions, `atan2`,
+//! `powi`, `dot`, `cross`, `norm`, `unit`, `omega` and `velocity`. Norms
+//! of vectors made of frame axes are taken by Lagrange's identity and the
+//! vector triple product, which keep their square roots short.
+
+use proc_macro2::Span;
+use syn::Ident;
+
+use appell_symbolic::{Graph, Id, Number, SymbolicError};
+
+use super::builder::{hint, Builder};
+use super::expr::Val;
+use super::Vec3;
+use crate::algebra::{cross, dot};
+use crate::ast::*;
+use crate::ctxt::Ctxt;
+
+impl Builder<'_> {
+    /// |v|² of a vector expression by the identities of its construction,
+    /// so that `norm` and `unit` of vectors made of frame axes stay small
+    /// (differentiated twice, they reach the accelerations): |e|² = 1 for a
+    /// frame's axis and for `unit(v)`, |k v|² = k²|v|²,
+    /// |a ± b|² = |a|² ± 2 a·b + |b|², and Lagrange's identity |a × b|² = |a|²|b|² − (a·b)². `None`
+    /// where no identity applies (the caller takes v·v).
+    pub(super) fn norm_sq(&mut self, e: &Expr) -> Result<Option<Id>, SymbolicError> {
+        Ok(match e {
+            Expr::Axis(..) => Some(self.g.int(1)?),
+            Expr::Neg(a, _) => self.norm_sq(a)?,
+            Expr::Call(f, args, _) if f == "unit" && args.len() == 1 => Some(self.g.int(1)?),
+            Expr::Call(f, args, _) if f == "cross" && args.len() == 2 => {
+                let (Some(na), Some(nb)) = (
+                    self.norm_sq_or_dot(&args[0])?,
+                    self.norm_sq_or_dot(&args[1])?,
+                ) else {
+                    return Ok(None);
+                };
+                let Some(ab) = self.dot_exprs(&args[0], &args[1])? else {
+                    return Ok(None);
+                };
+                let g = &mut self.g;
+                let nn = g.mul(na, nb)?;
+                let ab2 = g.mul(ab, ab)?;
+                Some(g.sub(nn, ab2)?)
+            }
+            Expr::Binary(op @ (BinOp::Add | BinOp::Sub), a, b, _) => {
+                let (Some(na), Some(nb)) = (self.norm_sq_or_dot(a)?, self.norm_sq_or_dot(b)?)
+                else {
+                    return Ok(None);
+                };
+                let Some(ab) = self.dot_exprs(a, b)? else {
+                    return Ok(None);
+                };
+                let g = &mut self.g;
+                let two_ab = g.scale(ab, Number::int(2))?;
+                let cross_term = if *op == BinOp::Add {
+                    two_ab
+                } else {
+                    g.neg(two_ab)?
+                };
+                Some(g.sum(&[na, nb, cross_term])?)
+            }
+            Expr::Binary(op @ (BinOp::Mul | BinOp::Div), a, b, _) => {
+                let (k, v) = match (self.eval(a), self.eval(b)) {
+                    (Some(Val::Scalar(_)), Some(Val::Vector(_))) if *op == BinOp::Mul => (a, b),
+                    (Some(Val::Vector(_)), Some(Val::Scalar(_))) => (b, a),
+                    _ => return Ok(None),
+                };
+                let (Some(Val::Scalar(k)), Some(nv)) = (self.eval(k), self.norm_sq_or_dot(v)?)
+                else {
+                    return Ok(None);
+                };
+                let g = &mut self.g;
+                let k2 = g.mul(k, k)?;
+                Some(if *op == BinOp::Mul {
+                    g.mul(k2, nv)?
+                } else {
+                    g.div(nv, k2)?
+                })
+            }
+            _ => None,
+        })
+    }
+
+    /// A double cross product by the vector triple product identity,
+    /// (x × y) × c = y (x·c) − x (y·c) and a × (x × y) = x (a·y) − y (a·x),
+    /// with the dot products by [`Self::dot_exprs`] (so (e × f) × e = f − (e·f) e
+    /// for a unit e). `None` when neither argument is a cross product.
+    pub(super) fn double_cross(
+        &mut self,
+        a: &Expr,
+        b: &Expr,
+    ) -> Result<Option<Vec3>, SymbolicError> {
+        let as_cross = |e: &Expr| match e {
+            Expr::Call(f, args, _) if f == "cross" && args.len() == 2 => {
+                Some((args[0].clone(), args[1].clone()))
+            }
+            _ => None,
+        };
+        // (p, q, r): the result is p (q·r)... written as y (x·c) − x (y·c).
+        let (x, y, c, sign) = if let Some((x, y)) = as_cross(a) {
+            (x, y, b.clone(), false)
+        } else if let Some((x, y)) = as_cross(b) {
+            // a × (x × y) = −(x × y) × a
+            (x, y, a.clone(), true)
+        } else {
+            return Ok(None);
+        };
+        let (Some(xc), Some(yc)) = (self.dot_exprs(&x, &c)?, self.dot_exprs(&y, &c)?) else {
+            return Ok(None);
+        };
+        let (Some(Val::Vector(vx)), Some(Val::Vector(vy))) = (self.eval(&x), self.eval(&y)) else {
+            return Ok(None);
+        };
+        let g = &mut self.g;
+        let mut out = [vx[0]; 3];
+        for i in 0..3 {
+            let p = g.mul(vy[i], xc)?;
+            let q = g.mul(vx[i], yc)?;
+            out[i] = if sign { g.sub(q, p)? } else { g.sub(p, q)? };
+        }
+        Ok(Some(out))
+    }
+
+    /// [`Self::norm_sq`], or v·v by components.
+    pub(super) fn norm_sq_or_dot(&mut self, e: &Expr) -> Result<Option<Id>, SymbolicError> {
+        if let Some(n) = self.norm_sq(e)? {
+            return Ok(Some(n));
+        }
+        let Some(Val::Vector(v)) = self.eval(e) else {
+            return Ok(None);
+        };
+        Ok(Some(dot(&mut self.g, v, v)?))
+    }
+
+    /// a·b of two vector expressions; a triple product with a repeated
+    /// vector, (x × y)·x or (x × y)·y, is zero.
+    pub(super) fn dot_exprs(&mut self, a: &Expr, b: &Expr) -> Result<Option<Id>, SymbolicError> {
+        let (Some(Val::Vector(va)), Some(Val::Vector(vb))) = (self.eval(a), self.eval(b)) else {
+            return Ok(None);
+        };
+        if va == vb {
+            return self.norm_sq_or_dot(a);
+        }
+        for (c, other) in [(a, vb), (b, va)] {
+            if let Expr::Call(f, args, _) = c {
+                if f == "cross" && args.len() == 2 {
+                    for x in args {
+                        if let Some(Val::Vector(vx)) = self.eval(x) {
+                            if vx == other {
+                                return Ok(Some(self.g.int(0)?));
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        Ok(Some(dot(&mut self.g, va, vb)?))
+    }
+
+    pub(super) fn call(
+        &mut self,
+        f: &Ident,
+        args: &[Expr],
+        span: Span,
+    ) -> Result<Option<Val>, SymbolicError> {
+        let name = f.to_string();
+        let arity = |n: usize| -> bool { args.len() == n };
+        let wrong = |cx: &Ctxt, n: usize| {
+            cx.error_spanned_by(
+                f,
+                format!("`{name}` takes {n} argument(s), found {}", args.len()),
+            );
+        };
+        let unary = |g: &mut Graph, x: Id| -> Result<Id, SymbolicError> {
+            match name.as_str() {
+                "sin" => g.sin(x),
+                "cos" => g.cos(x),
+                "tan" => g.tan(x),
+                "exp" => g.exp(x),
+                "ln" => g.ln(x),
+                "sqrt" => g.sqrt(x),
+                _ => g.abs(x),
+            }
+        };
+        match name.as_str() {
+            "dt" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                if let Expr::Name(i) = &args[0] {
+                    if let Some((_, c)) = self.coords.iter().find(|(c, _)| c == i) {
+                        return Ok(Some(Val::Scalar(self.g.sym(c.rate)?)));
+                    }
+                }
+                let Some(x) = self.scalar(&args[0]) else {
+                    return Ok(None);
+                };
+                let d = self.g.time_derivative(x, &self.rules)?;
+                Ok(Some(Val::Scalar(d)))
+            }
+            "sin" | "cos" | "tan" | "exp" | "ln" | "sqrt" | "abs" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                let Some(x) = self.scalar(&args[0]) else {
+                    return Ok(None);
+                };
+                Ok(Some(Val::Scalar(unary(&mut self.g, x)?)))
+            }
+            "atan2" => {
+                if !arity(2) {
+                    wrong(self.cx, 2);
+                    return Ok(None);
+                }
+                let (Some(y), Some(x)) = (self.scalar(&args[0]), self.scalar(&args[1])) else {
+                    return Ok(None);
+                };
+                Ok(Some(Val::Scalar(self.g.atan2(y, x)?)))
+            }
+            "powi" => {
+                if !arity(2) {
+                    wrong(self.cx, 2);
+                    return Ok(None);
+                }
+                let Some(x) = self.scalar(&args[0]) else {
+                    return Ok(None);
+                };
+                let n = match &args[1] {
+                    Expr::Int(n, _) => *n,
+                    Expr::Neg(inner, _) => match **inner {
+                        Expr::Int(n, _) => -n,
+                        _ => {
+                            self.cx.error_at(
+                                args[1].span(),
+                                "the exponent of `powi` is an integer literal",
+                            );
+                            return Ok(None);
+                        }
+                    },
+                    other => {
+                        self.cx
+                            .error_at(other.span(), "the exponent of `powi` is an integer literal");
+                        return Ok(None);
+                    }
+                };
+                Ok(Some(Val::Scalar(self.g.powi(x, n)?)))
+            }
+            "omega" | "velocity" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                let Expr::Name(target) = &args[0] else {
+                    let what = if name == "omega" {
+                        "a frame"
+                    } else {
+                        "a point"
+                    };
+                    self.cx
+                        .error_at(args[0].span(), format!("`{name}` takes the name of {what}"));
+                    return Ok(None);
+                };
+                if name == "omega" {
+                    let Some(fi) = self.frame_named(target) else {
+                        return Ok(None);
+                    };
+                    Ok(Some(Val::Vector(self.frames[fi].omega)))
+                } else {
+                    let Some(p) = self.point_named(target) else {
+                        return Ok(None);
+                    };
+                    let v = [
+                        self.g.time_derivative(p[0], &self.rules)?,
+                        self.g.time_derivative(p[1], &self.rules)?,
+                        self.g.time_derivative(p[2], &self.rules)?,
+                    ];
+                    Ok(Some(Val::Vector(v)))
+                }
+            }
+            "dot" | "cross" => {
+                if !arity(2) {
+                    wrong(self.cx, 2);
+                    return Ok(None);
+                }
+                let (Some(a), Some(b)) = (self.vector(&args[0]), self.vector(&args[1])) else {
+                    return Ok(None);
+                };
+                if name == "dot" {
+                    Ok(Some(Val::Scalar(dot(&mut self.g, a, b)?)))
+                } else if let Some(v) = self.double_cross(&args[0], &args[1])? {
+                    Ok(Some(Val::Vector(v)))
+                } else {
+                    Ok(Some(Val::Vector(cross(&mut self.g, a, b)?)))
+                }
+            }
+            "norm" | "unit" => {
+                if !arity(1) {
+                    wrong(self.cx, 1);
+                    return Ok(None);
+                }
+                let Some(v) = self.vector(&args[0]) else {
+                    return Ok(None);
+                };
+                let n2 = match self.norm_sq(&args[0])? {
+                    Some(n2) => n2,
+                    None => dot(&mut self.g, v, v)?,
+                };
+                if self.g.is_zero(n2) {
+                    self.cx.error_at(
+                        span,
+                        format!("`{name}` of a vector that is identically zero"),
+                    );
+                    return Ok(None);
+                }
+                self.norms.push((
+                    n2,
+                    format!("the argument of `{name}(...)` in {}", self.context),
+                ));
+                let n = self.g.sqrt(n2)?;
+                if name == "norm" {
+                    Ok(Some(Val::Scalar(n)))
+                } else {
+                    let inv = self.g.recip(n)?;
+                    Ok(Some(Val::Vector([
+                        self.g.mul(v[0], inv)?,
+                        self.g.mul(v[1], inv)?,
+                        self.g.mul(v[2], inv)?,
+                    ])))
+                }
+            }
+            _ => {
+                const FUNCS: &[&str] = &[
+                    "dt", "sin", "cos", "tan", "exp", "ln", "sqrt", "abs", "atan2", "powi", "dot",
+                    "cross", "norm", "unit", "omega", "velocity",
+                ];
+                let h = hint(&name, FUNCS.iter().map(|s| s.to_string()));
+                self.cx
+                    .error_spanned_by(f, format!("unknown function `{name}`{h}"));
+                Ok(None)
+            }
+        }
+    }
+}

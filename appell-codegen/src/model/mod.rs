@@ -1,0 +1,316 @@
+//! Resolve names and build the kinematics in the symbolic engine.
+//!
+//! Frames carry their rotation matrix (columns are the frame's unit vectors
+//! in N components) and angular velocity in N; points carry their position
+//! in N. Everything is an expression in the coordinates, parameters, inputs
+//! and time of one [`Graph`]. [`build`] makes the [`Model`] and its
+//! [`Twin`] from the syntax ([`crate::ast::ModelAst`]):
+//!
+//! | module | what it resolves |
+//! | --- | --- |
+//! | [`builder`] | symbols, speeds, the order of the steps, names |
+//! | [`frames`] | frames: rotations about parent or fixed axes, the twin's direction-cosine symbols |
+//! | [`bodies`] | points, bodies, constraints, loads, rolling contacts |
+//! | [`scenes`] | scenes: their effects and outputs |
+//! | [`expr`] | expressions: names, arithmetic on scalars, vectors and points |
+//! | [`calls`] | function calls: `dt`, `dot`, `cross`, `norm`, `unit`, `omega`, `velocity`, ... |
+
+mod bodies;
+mod builder;
+mod calls;
+mod expr;
+mod frames;
+mod scenes;
+
+use syn::Ident;
+
+use appell_symbolic::{Coordinate, Graph, Id, RateRules, Symbol, SymbolKind};
+
+use crate::ast::ModelAst;
+use crate::ctxt::Ctxt;
+
+pub use crate::algebra::{Mat3, Vec3};
+
+/// A parameter (struct field).
+#[derive(Clone)]
+pub struct Param {
+    /// The field.
+    pub ident: Ident,
+    /// Its symbol.
+    pub symbol: Symbol,
+    /// Declared positive.
+    pub positive: bool,
+}
+
+/// A frame: rotation (columns = unit vectors in N) and angular velocity in N.
+#[derive(Clone)]
+pub struct Frame {
+    /// Its name.
+    pub name: String,
+    /// Rotation matrix.
+    pub rot: Mat3,
+    /// Angular velocity, as an expression in the coordinate rates.
+    pub omega: Vec3,
+}
+
+/// A named point and its position in N.
+#[derive(Clone)]
+pub struct Point {
+    /// Its name.
+    pub name: String,
+    /// Position.
+    pub pos: Vec3,
+}
+
+/// A body or particle.
+#[derive(Clone)]
+pub struct Body {
+    /// Its name.
+    pub name: String,
+    /// Mass-centre position.
+    pub center: Vec3,
+    /// Index of its frame (None for a particle).
+    pub frame: Option<usize>,
+    /// Mass.
+    pub mass: Id,
+    /// Central inertia in the body frame (zero for a particle).
+    pub inertia: Mat3,
+}
+
+/// A force at a point or a torque on a frame.
+#[derive(Clone)]
+pub struct Load {
+    /// Application point's position (forces).
+    pub point: Vec3,
+    /// The frame (torques).
+    pub frame: usize,
+    /// The vector in N.
+    pub vector: Vec3,
+    /// Effect name.
+    pub effect: String,
+    /// For a body's weight (`gravity(...)`): the body's index.
+    pub weight_of: Option<usize>,
+}
+
+/// `rolls(...)`: the material point of a body at a contact point has zero
+/// velocity.
+#[derive(Clone)]
+pub struct Rolling {
+    /// Index of the body in [`Model::bodies`].
+    pub body: usize,
+    /// Position of the contact point.
+    pub contact: Vec3,
+    /// Directions constrained (None: N.x, N.y, N.z, zero rows dropped).
+    pub along: Option<Vec<Vec3>>,
+    /// The contact point's name.
+    pub point: String,
+    /// The item's tokens, for errors.
+    pub at: proc_macro2::TokenStream,
+}
+
+/// `scene(name, effects(...), outputs(...))`: a specialised rhs with the
+/// chosen effects' loads only, and the requested outputs.
+#[derive(Clone)]
+pub struct Scene {
+    /// The scene's name.
+    pub name: Ident,
+    /// The effects it keeps.
+    pub effects: Vec<String>,
+    /// Coordinates integrated by quadrature beside the reduced state
+    /// (`outputs(quadrature(x1, y1))`).
+    pub quadrature: Vec<usize>,
+    /// The outputs asked for, by kind (`quadrature`, `energies`,
+    /// `contact_forces`), in declaration order.
+    pub outputs: Vec<String>,
+}
+
+/// One privileged speed ẏ_k.
+#[derive(Clone)]
+pub struct SpeedSpec {
+    /// Its name (the coordinate's for a coordinate rate).
+    pub name: String,
+    /// The symbol standing for ẏ_k.
+    pub symbol: Symbol,
+    /// The symbol standing for ÿ_k.
+    pub accel: Symbol,
+    /// The coordinate whose rate it is (Method II).
+    pub coordinate: Option<usize>,
+    /// Its definition, linear in the rates (Method III).
+    pub definition: Option<Id>,
+}
+
+/// A constraint residual with its source span.
+#[derive(Clone)]
+pub struct Constraint {
+    /// `lhs - rhs`.
+    pub residual: Id,
+    /// Its tokens, for errors.
+    pub at: proc_macro2::TokenStream,
+}
+
+/// The resolved model.
+#[derive(Clone)]
+pub struct Model {
+    /// The expression graph everything lives in.
+    pub g: Graph,
+    /// The struct's name.
+    pub name: Ident,
+    /// Parameters in field order.
+    pub params: Vec<Param>,
+    /// Coordinates in declaration order.
+    pub coords: Vec<(Ident, Coordinate)>,
+    /// Indices (into `coords`) of the coordinates whose rates are privileged
+    /// speeds (Method II).
+    pub speeds: Vec<usize>,
+    /// All privileged speeds, in order.
+    pub speed_specs: Vec<SpeedSpec>,
+    /// The tokens of `speeds(...)`, for errors.
+    pub speeds_at: proc_macro2::TokenStream,
+    /// Inputs.
+    pub inputs: Vec<(Ident, Symbol)>,
+    /// Time.
+    pub time: Symbol,
+    /// Frames; index 0 is N.
+    pub frames: Vec<Frame>,
+    /// Points; index 0 is O.
+    pub points: Vec<Point>,
+    /// Bodies and particles.
+    pub bodies: Vec<Body>,
+    /// Holonomic constraints f(q, t) = 0.
+    pub holonomic: Vec<Constraint>,
+    /// Nonholonomic constraints, linear in the rates.
+    pub nonholonomic: Vec<Constraint>,
+    /// Rolling contacts.
+    pub rolling: Vec<Rolling>,
+    /// Forces.
+    pub forces: Vec<Load>,
+    /// Torques.
+    pub torques: Vec<Load>,
+    /// Effect names in order of first use.
+    pub effects: Vec<String>,
+    /// Declared scenes.
+    pub scenes: Vec<Scene>,
+    /// Coordinates forced into the reduced state (a scene's quadrature
+    /// outputs); empty for the full model.
+    pub quadrature: Vec<usize>,
+    /// A scene's outputs (see [`Scene::outputs`]); empty for the full model.
+    pub outputs: Vec<String>,
+    /// The name the generated `ModelInfo` carries.
+    pub info_name: String,
+    /// The `gravity(...)` acceleration (N components), if declared.
+    pub gravity: Option<Vec3>,
+    /// The squared length of every `norm(...)` and `unit(...)` argument, with
+    /// where it occurs, so that the generated code can name a zero-length
+    /// one at run time.
+    pub norms: Vec<(Id, String)>,
+}
+
+/// A direction cosine standing as a symbol in the twin model: its rate is a
+/// component of ω × column, so a derivative through nested rotations stays
+/// a few cross products instead of the product rule over every factor of
+/// every direction cosine. [`Twin::uncut_substitution`] puts the values
+/// (the model's own direction cosines) back.
+#[derive(Clone, Copy)]
+pub struct Cut {
+    /// The symbol.
+    pub symbol: Symbol,
+    /// Its value: the model's entry of the frame's matrix.
+    pub value: Id,
+    /// Its rate, linear in the coordinate rates.
+    pub rate: Id,
+}
+
+/// The kinematics built again in the model's graph with each frame's
+/// direction cosines standing as symbols (see [`Cut`]): the derivation
+/// differentiates through it where it wants a constraint row or a velocity
+/// as written, not multiplied out. Its entries match the model's one for
+/// one (the same frames, bodies, constraints and contacts, in order).
+pub struct Twin {
+    /// The frames, their matrices made of direction-cosine symbols.
+    pub frames: Vec<Frame>,
+    /// The bodies.
+    pub bodies: Vec<Body>,
+    /// The holonomic constraints.
+    pub holonomic: Vec<Constraint>,
+    /// The nonholonomic constraints.
+    pub nonholonomic: Vec<Constraint>,
+    /// The rolling contacts.
+    pub rolling: Vec<Rolling>,
+    /// The direction-cosine symbols.
+    pub cuts: Vec<Cut>,
+}
+
+impl Twin {
+    /// Rate rules for the coordinates and the direction-cosine symbols.
+    pub fn rate_rules(&self) -> RateRules {
+        let mut r = RateRules::coordinates();
+        for c in &self.cuts {
+            r = r.with(c.symbol, c.rate);
+        }
+        r
+    }
+
+    /// The substitution of every direction-cosine symbol by its value.
+    pub fn uncut_substitution(&self) -> appell_symbolic::Substitution {
+        let mut s = appell_symbolic::Substitution::new();
+        for c in &self.cuts {
+            s.insert(c.symbol, c.value);
+        }
+        s
+    }
+}
+
+/// What [`build`] makes: the resolved model and its twin, sharing one graph
+/// (the model's).
+pub struct Kinematics {
+    /// The model.
+    pub model: Model,
+    /// The twin; `None` if it could not be built (it is then not needed:
+    /// the derivation differentiates the model's own expressions).
+    pub twin: Option<Twin>,
+}
+
+/// Resolves names and builds the kinematics; `None` when errors were
+/// recorded.
+pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Kinematics> {
+    let (mut model, _) = builder::build_in(cx, ast, Graph::new(), None)?;
+    // The twin, built again in the same graph with direction cosines as
+    // symbols; the first build found every error there is.
+    let scratch = Ctxt::new();
+    let frames: Vec<Mat3> = model.frames.iter().map(|f| f.rot).collect();
+    let built = builder::build_in(&scratch, ast, model.g.clone(), Some(frames));
+    let twin = match (scratch.check(), built) {
+        (Ok(()), Some((mut t, cuts))) => {
+            model.g = std::mem::replace(&mut t.g, Graph::new());
+            Some(Twin {
+                frames: t.frames,
+                bodies: t.bodies,
+                holonomic: t.holonomic,
+                nonholonomic: t.nonholonomic,
+                rolling: t.rolling,
+                cuts,
+            })
+        }
+        _ => None,
+    };
+    Some(Kinematics { model, twin })
+}
+
+/// The model of one scene: loads of the scene's effects only, its
+/// quadrature coordinates kept in the state.
+pub fn scene_model(full: &Model, scene: &Scene) -> Model {
+    let mut m = full.clone();
+    m.forces.retain(|f| scene.effects.contains(&f.effect));
+    m.torques.retain(|t| scene.effects.contains(&t.effect));
+    m.effects.retain(|e| scene.effects.contains(e));
+    m.quadrature = scene.quadrature.clone();
+    m.outputs = scene.outputs.clone();
+    m.info_name = format!("{}::{}", full.name, scene.name);
+    m.scenes = Vec::new();
+    m
+}
+
+/// Whether a symbol is of a kind that may appear in a parameter-only value.
+pub fn is_parameter(g: &Graph, s: Symbol) -> bool {
+    g.symbol_kind(s) == SymbolKind::Parameter
+}
