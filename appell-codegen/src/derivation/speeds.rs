@@ -187,7 +187,6 @@ fn check_holonomic_involve_dependent(cx: &Ctxt, model: &Model, dependent: &[usiz
 mod tests {
     use super::super::rows::constraint_rows;
     use super::super::testing::{self, assert_agrees};
-    use super::super::Calculus;
     use super::*;
 
     fn definitions(src: &str) -> (Model, Option<SpeedDefinitions>, Result<(), String>) {

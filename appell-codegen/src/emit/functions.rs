@@ -77,6 +77,7 @@ impl Emitter<'_> {
         let parameters = self.parameter_access();
         let equations = self.equations_functions(&common);
         let kinematics = self.kinematics_functions(&common);
+        let loads = self.load_functions(&common);
         quote! {
             static #info_ident: #p::ModelInfo = #info;
             #[automatically_derived]
@@ -91,6 +92,7 @@ impl Emitter<'_> {
                 #rhs_fn
                 #equations
                 #kinematics
+                #loads
             }
         }
     }
@@ -229,8 +231,8 @@ impl Emitter<'_> {
         }
     }
 
-    /// The kinematic description: mass properties, body poses, constraint
-    /// rows, load geometry, contact geometry and load values.
+    /// The bodies' description: mass properties, body poses and the
+    /// constraint rows.
     fn kinematics_functions(&self, c: &Common) -> TokenStream {
         let p = p();
         let d = self.d;
@@ -241,19 +243,12 @@ impl Emitter<'_> {
             params_t,
             params_f,
             bind_q,
-            bind_qdot,
-            bind_inputs,
             ..
         } = c;
         let generic = Target::Generic { hoist: false };
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let chk_q = chk("__q", n);
-        let (nb, nf, nt, nc) = (
-            model.bodies.len(),
-            model.forces.len(),
-            model.torques.len(),
-            model.rolling.len(),
-        );
+        let nb = model.bodies.len();
         let mut mp_roots = Vec::new();
         for b in &model.bodies {
             mp_roots.push(b.mass);
@@ -268,13 +263,7 @@ impl Emitter<'_> {
             let k = int(k);
             quote!(__masses[#k] = #mass; __inertias[#k] = [#(#inertia),*];)
         });
-        let zero = g
-            .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ZERO))
-            .expect("zero exists");
-        let one = g
-            .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ONE))
-            .expect("one exists");
-        let identity = [[one, zero, zero], [zero, one, zero], [zero, zero, one]];
+        let (_, identity) = unit_entries(g);
         let mut pose_roots = Vec::new();
         for b in &model.bodies {
             pose_roots.extend(b.center);
@@ -297,6 +286,46 @@ impl Emitter<'_> {
             outputs_into(&rows, "__d", 0..m * n),
             outputs_into(&rows, "__d0", m * n..m * n + m),
         );
+        let checks_mp = [chk("__masses", nb), chk("__inertias", nb)];
+        let checks_poses = [chk("__positions", nb), chk("__rotations", nb)];
+        let checks_rows = [chk("__d", m * n), chk("__d0", m)];
+        let (mp_body, poses_body, rows_body) =
+            (mp.statements(), poses.statements(), rows.statements());
+        quote! {
+            fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
+                #(#checks_mp)* #params_f #mp_body #(#mp_out)*
+                #p::Ok(())
+            }
+            fn body_poses<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __positions: &mut [[__T; 3]], __rotations: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_poses)* #params_t #bind_q #poses_body #(#poses_out)*
+                #p::Ok(())
+            }
+            fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_rows)* #params_t #bind_q #rows_body #rows_d #rows_d0
+                #p::Ok(())
+            }
+        }
+    }
+
+    /// Where the loads act and what they are, and the rolling contacts'
+    /// geometry: load geometry, contact geometry and load values.
+    fn load_functions(&self, c: &Common) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let model = &d.model;
+        let (n, m) = (d.n, d.m);
+        let Common {
+            params_t,
+            bind_q,
+            bind_qdot,
+            bind_inputs,
+            ..
+        } = c;
+        let generic = Target::Generic { hoist: false };
+        let chk = |arg: &str, len: usize| self.check(arg, len);
+        let chk_q = chk("__q", n);
+        let (nf, nt, nc) = (model.forces.len(), model.torques.len(), model.rolling.len());
+        let (zero, identity) = unit_entries(&model.g);
         let mut geo_roots = Vec::new();
         for f in &model.forces {
             geo_roots.extend(f.point);
@@ -342,9 +371,6 @@ impl Emitter<'_> {
             groups_into(&contacts, "__points", 0, nc, 3),
             groups_into(&contacts, "__directions", nc * 3, m, 3),
         );
-        let checks_mp = [chk("__masses", nb), chk("__inertias", nb)];
-        let checks_poses = [chk("__positions", nb), chk("__rotations", nb)];
-        let checks_rows = [chk("__d", m * n), chk("__d0", m)];
         let checks_geo = [chk("__points", nf), chk("__frames", nt)];
         let checks_contacts = [chk("__points", nc), chk("__directions", m)];
         let checks_loads = [
@@ -353,23 +379,9 @@ impl Emitter<'_> {
             chk("__forces", nf),
             chk("__torques", nt),
         ];
-        let (mp_body, poses_body, rows_body) =
-            (mp.statements(), poses.statements(), rows.statements());
         let (geo_body, contacts_body, loads_body) =
             (geo.statements(), contacts.statements(), loads.statements());
         quote! {
-            fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
-                #(#checks_mp)* #params_f #mp_body #(#mp_out)*
-                #p::Ok(())
-            }
-            fn body_poses<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __positions: &mut [[__T; 3]], __rotations: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_poses)* #params_t #bind_q #poses_body #(#poses_out)*
-                #p::Ok(())
-            }
-            fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_rows)* #params_t #bind_q #rows_body #rows_d #rows_d0
-                #p::Ok(())
-            }
             fn load_geometry<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __frames: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> {
                 #chk_q #(#checks_geo)* #params_t #bind_q #geo_body #geo_points #geo_frames
                 #p::Ok(())
@@ -469,4 +481,18 @@ impl Emitter<'_> {
         });
         quote!({ #params_t #(#binds)* #statements #(#tests)* })
     }
+}
+
+/// The graph's zero and the identity matrix made of its zero and one.
+fn unit_entries(g: &appell_symbolic::Graph) -> (Id, [[Id; 3]; 3]) {
+    let zero = g
+        .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ZERO))
+        .expect("zero exists");
+    let one = g
+        .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ONE))
+        .expect("one exists");
+    (
+        zero,
+        [[one, zero, zero], [zero, one, zero], [zero, zero, one]],
+    )
 }

@@ -13,7 +13,6 @@ use super::expr::Val;
 use super::Vec3;
 use crate::algebra::{cross, dot};
 use crate::ast::*;
-use crate::ctxt::Ctxt;
 
 impl Builder<'_> {
     /// |v|² of a vector expression by the identities of its construction,
@@ -157,6 +156,7 @@ impl Builder<'_> {
         Ok(Some(dot(&mut self.g, va, vb)?))
     }
 
+    /// A call `f(args)`: a function of this list, with its arity checked.
     pub(super) fn call(
         &mut self,
         f: &Ident,
@@ -164,182 +164,192 @@ impl Builder<'_> {
         span: Span,
     ) -> Result<Option<Val>, SymbolicError> {
         let name = f.to_string();
-        let arity = |n: usize| -> bool { args.len() == n };
-        let wrong = |cx: &Ctxt, n: usize| {
-            cx.error_spanned_by(
+        let Some(&(_, arity)) = FUNCTIONS.iter().find(|(n, _)| *n == name) else {
+            let h = hint(&name, FUNCTIONS.iter().map(|(n, _)| n.to_string()));
+            self.cx
+                .error_spanned_by(f, format!("unknown function `{name}`{h}"));
+            return Ok(None);
+        };
+        if args.len() != arity {
+            self.cx.error_spanned_by(
                 f,
-                format!("`{name}` takes {n} argument(s), found {}", args.len()),
+                format!("`{name}` takes {arity} argument(s), found {}", args.len()),
             );
-        };
-        let unary = |g: &mut Graph, x: Id| -> Result<Id, SymbolicError> {
-            match name.as_str() {
-                "sin" => g.sin(x),
-                "cos" => g.cos(x),
-                "tan" => g.tan(x),
-                "exp" => g.exp(x),
-                "ln" => g.ln(x),
-                "sqrt" => g.sqrt(x),
-                _ => g.abs(x),
-            }
-        };
+            return Ok(None);
+        }
         match name.as_str() {
-            "dt" => {
-                if !arity(1) {
-                    wrong(self.cx, 1);
-                    return Ok(None);
-                }
-                if let Expr::Name(i) = &args[0] {
-                    if let Some((_, c)) = self.coords.iter().find(|(c, _)| c == i) {
-                        return Ok(Some(Val::Scalar(self.g.sym(c.rate)?)));
-                    }
-                }
-                let Some(x) = self.scalar(&args[0]) else {
-                    return Ok(None);
-                };
-                let d = self.g.time_derivative(x, &self.rules)?;
-                Ok(Some(Val::Scalar(d)))
-            }
-            "sin" | "cos" | "tan" | "exp" | "ln" | "sqrt" | "abs" => {
-                if !arity(1) {
-                    wrong(self.cx, 1);
-                    return Ok(None);
-                }
-                let Some(x) = self.scalar(&args[0]) else {
-                    return Ok(None);
-                };
-                Ok(Some(Val::Scalar(unary(&mut self.g, x)?)))
-            }
+            "dt" => self.call_dt(&args[0]),
             "atan2" => {
-                if !arity(2) {
-                    wrong(self.cx, 2);
-                    return Ok(None);
-                }
                 let (Some(y), Some(x)) = (self.scalar(&args[0]), self.scalar(&args[1])) else {
                     return Ok(None);
                 };
                 Ok(Some(Val::Scalar(self.g.atan2(y, x)?)))
             }
-            "powi" => {
-                if !arity(2) {
-                    wrong(self.cx, 2);
-                    return Ok(None);
-                }
+            "powi" => self.call_powi(args),
+            "omega" | "velocity" => self.call_motion(&name, &args[0]),
+            "dot" | "cross" => self.call_product(&name, args),
+            "norm" | "unit" => self.call_norm(&name, &args[0], span),
+            _ => {
                 let Some(x) = self.scalar(&args[0]) else {
                     return Ok(None);
                 };
-                let n = match &args[1] {
-                    Expr::Int(n, _) => *n,
-                    Expr::Neg(inner, _) => match **inner {
-                        Expr::Int(n, _) => -n,
-                        _ => {
-                            self.cx.error_at(
-                                args[1].span(),
-                                "the exponent of `powi` is an integer literal",
-                            );
-                            return Ok(None);
-                        }
-                    },
-                    other => {
-                        self.cx
-                            .error_at(other.span(), "the exponent of `powi` is an integer literal");
-                        return Ok(None);
-                    }
-                };
-                Ok(Some(Val::Scalar(self.g.powi(x, n)?)))
+                Ok(Some(Val::Scalar(unary(&mut self.g, &name, x)?)))
             }
-            "omega" | "velocity" => {
-                if !arity(1) {
-                    wrong(self.cx, 1);
-                    return Ok(None);
-                }
-                let Expr::Name(target) = &args[0] else {
-                    let what = if name == "omega" {
-                        "a frame"
-                    } else {
-                        "a point"
-                    };
-                    self.cx
-                        .error_at(args[0].span(), format!("`{name}` takes the name of {what}"));
-                    return Ok(None);
-                };
-                if name == "omega" {
-                    let Some(fi) = self.frame_named(target) else {
-                        return Ok(None);
-                    };
-                    Ok(Some(Val::Vector(self.frames[fi].omega)))
-                } else {
-                    let Some(p) = self.point_named(target) else {
-                        return Ok(None);
-                    };
-                    let v = [
-                        self.g.time_derivative(p[0], &self.rules)?,
-                        self.g.time_derivative(p[1], &self.rules)?,
-                        self.g.time_derivative(p[2], &self.rules)?,
-                    ];
-                    Ok(Some(Val::Vector(v)))
-                }
+        }
+    }
+
+    /// `dt(q)` is q's rate symbol; `dt(e)` the time derivative of e.
+    fn call_dt(&mut self, arg: &Expr) -> Result<Option<Val>, SymbolicError> {
+        if let Expr::Name(i) = arg {
+            if let Some((_, c)) = self.coords.iter().find(|(c, _)| c == i) {
+                return Ok(Some(Val::Scalar(self.g.sym(c.rate)?)));
             }
-            "dot" | "cross" => {
-                if !arity(2) {
-                    wrong(self.cx, 2);
-                    return Ok(None);
-                }
-                let (Some(a), Some(b)) = (self.vector(&args[0]), self.vector(&args[1])) else {
-                    return Ok(None);
-                };
-                if name == "dot" {
-                    Ok(Some(Val::Scalar(dot(&mut self.g, a, b)?)))
-                } else if let Some(v) = self.double_cross(&args[0], &args[1])? {
-                    Ok(Some(Val::Vector(v)))
-                } else {
-                    Ok(Some(Val::Vector(cross(&mut self.g, a, b)?)))
-                }
-            }
-            "norm" | "unit" => {
-                if !arity(1) {
-                    wrong(self.cx, 1);
-                    return Ok(None);
-                }
-                let Some(v) = self.vector(&args[0]) else {
-                    return Ok(None);
-                };
-                let n2 = match self.norm_sq(&args[0])? {
-                    Some(n2) => n2,
-                    None => dot(&mut self.g, v, v)?,
-                };
-                if self.g.is_zero(n2) {
+        }
+        let Some(x) = self.scalar(arg) else {
+            return Ok(None);
+        };
+        let d = self.g.time_derivative(x, &self.rules)?;
+        Ok(Some(Val::Scalar(d)))
+    }
+
+    /// `powi(x, n)` with n an integer literal.
+    fn call_powi(&mut self, args: &[Expr]) -> Result<Option<Val>, SymbolicError> {
+        let Some(x) = self.scalar(&args[0]) else {
+            return Ok(None);
+        };
+        let n = match &args[1] {
+            Expr::Int(n, _) => *n,
+            Expr::Neg(inner, _) => match **inner {
+                Expr::Int(n, _) => -n,
+                _ => {
                     self.cx.error_at(
-                        span,
-                        format!("`{name}` of a vector that is identically zero"),
+                        args[1].span(),
+                        "the exponent of `powi` is an integer literal",
                     );
                     return Ok(None);
                 }
-                self.norms.push((
-                    n2,
-                    format!("the argument of `{name}(...)` in {}", self.context),
-                ));
-                let n = self.g.sqrt(n2)?;
-                if name == "norm" {
-                    Ok(Some(Val::Scalar(n)))
-                } else {
-                    let inv = self.g.recip(n)?;
-                    Ok(Some(Val::Vector([
-                        self.g.mul(v[0], inv)?,
-                        self.g.mul(v[1], inv)?,
-                        self.g.mul(v[2], inv)?,
-                    ])))
-                }
-            }
-            _ => {
-                const FUNCS: &[&str] = &[
-                    "dt", "sin", "cos", "tan", "exp", "ln", "sqrt", "abs", "atan2", "powi", "dot",
-                    "cross", "norm", "unit", "omega", "velocity",
-                ];
-                let h = hint(&name, FUNCS.iter().map(|s| s.to_string()));
+            },
+            other => {
                 self.cx
-                    .error_spanned_by(f, format!("unknown function `{name}`{h}"));
-                Ok(None)
+                    .error_at(other.span(), "the exponent of `powi` is an integer literal");
+                return Ok(None);
             }
+        };
+        Ok(Some(Val::Scalar(self.g.powi(x, n)?)))
+    }
+
+    /// `omega(F)`, a frame's angular velocity, or `velocity(P)`, a point's.
+    fn call_motion(&mut self, name: &str, arg: &Expr) -> Result<Option<Val>, SymbolicError> {
+        let Expr::Name(target) = arg else {
+            let what = if name == "omega" {
+                "a frame"
+            } else {
+                "a point"
+            };
+            self.cx
+                .error_at(arg.span(), format!("`{name}` takes the name of {what}"));
+            return Ok(None);
+        };
+        if name == "omega" {
+            let Some(fi) = self.frame_named(target) else {
+                return Ok(None);
+            };
+            return Ok(Some(Val::Vector(self.frames[fi].omega)));
         }
+        let Some(p) = self.point_named(target) else {
+            return Ok(None);
+        };
+        let v = [
+            self.g.time_derivative(p[0], &self.rules)?,
+            self.g.time_derivative(p[1], &self.rules)?,
+            self.g.time_derivative(p[2], &self.rules)?,
+        ];
+        Ok(Some(Val::Vector(v)))
+    }
+
+    /// `dot(a, b)` or `cross(a, b)`; a cross product of a cross product
+    /// by the triple product rule.
+    fn call_product(&mut self, name: &str, args: &[Expr]) -> Result<Option<Val>, SymbolicError> {
+        let (Some(a), Some(b)) = (self.vector(&args[0]), self.vector(&args[1])) else {
+            return Ok(None);
+        };
+        if name == "dot" {
+            Ok(Some(Val::Scalar(dot(&mut self.g, a, b)?)))
+        } else if let Some(v) = self.double_cross(&args[0], &args[1])? {
+            Ok(Some(Val::Vector(v)))
+        } else {
+            Ok(Some(Val::Vector(cross(&mut self.g, a, b)?)))
+        }
+    }
+
+    /// `norm(v)` or `unit(v)`; the squared length is recorded so that the
+    /// generated code can name a zero-length argument at run time.
+    fn call_norm(
+        &mut self,
+        name: &str,
+        arg: &Expr,
+        span: Span,
+    ) -> Result<Option<Val>, SymbolicError> {
+        let Some(v) = self.vector(arg) else {
+            return Ok(None);
+        };
+        let n2 = match self.norm_sq(arg)? {
+            Some(n2) => n2,
+            None => dot(&mut self.g, v, v)?,
+        };
+        if self.g.is_zero(n2) {
+            self.cx.error_at(
+                span,
+                format!("`{name}` of a vector that is identically zero"),
+            );
+            return Ok(None);
+        }
+        self.norms.push((
+            n2,
+            format!("the argument of `{name}(...)` in {}", self.context),
+        ));
+        let n = self.g.sqrt(n2)?;
+        if name == "norm" {
+            return Ok(Some(Val::Scalar(n)));
+        }
+        let inv = self.g.recip(n)?;
+        Ok(Some(Val::Vector([
+            self.g.mul(v[0], inv)?,
+            self.g.mul(v[1], inv)?,
+            self.g.mul(v[2], inv)?,
+        ])))
+    }
+}
+
+/// The functions expressions may call, with their arity.
+const FUNCTIONS: &[(&str, usize)] = &[
+    ("dt", 1),
+    ("sin", 1),
+    ("cos", 1),
+    ("tan", 1),
+    ("exp", 1),
+    ("ln", 1),
+    ("sqrt", 1),
+    ("abs", 1),
+    ("atan2", 2),
+    ("powi", 2),
+    ("dot", 2),
+    ("cross", 2),
+    ("norm", 1),
+    ("unit", 1),
+    ("omega", 1),
+    ("velocity", 1),
+];
+
+/// An elementary function of one argument.
+fn unary(g: &mut Graph, name: &str, x: Id) -> Result<Id, SymbolicError> {
+    match name {
+        "sin" => g.sin(x),
+        "cos" => g.cos(x),
+        "tan" => g.tan(x),
+        "exp" => g.exp(x),
+        "ln" => g.ln(x),
+        "sqrt" => g.sqrt(x),
+        _ => g.abs(x),
     }
 }
