@@ -5,7 +5,7 @@
 //! anywhere in B, b, β̄, γ̄ or F" (the cyclic-coordinate test of Sec. III C)
 //! are a few word operations.
 
-use crate::graph::Symbol;
+use crate::handles::Symbol;
 
 /// A set of symbols.
 ///

@@ -11,29 +11,8 @@ use std::hash::{BuildHasherDefault, Hasher};
 
 use crate::deps::SymbolSet;
 use crate::error::{Result, SymbolicError};
+pub use crate::handles::{Id, Symbol};
 use crate::number::Number;
-
-/// The handle of a node in a [`Graph`]. Equal ids mean equal expressions.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Id(pub u32);
-
-impl Id {
-    /// The position of the node in the arena.
-    pub fn index(self) -> usize {
-        self.0 as usize
-    }
-}
-
-/// The handle of a symbol declared in a [`Graph`].
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
-pub struct Symbol(pub(crate) u32);
-
-impl Symbol {
-    /// The position of the symbol in the graph's symbol table.
-    pub fn index(self) -> usize {
-        self.0 as usize
-    }
-}
 
 /// What a symbol stands for. The kind decides how the total time derivative
 /// treats it and which symbols may be hoisted out of a hot loop.

@@ -31,6 +31,7 @@ pub mod emit;
 pub mod error;
 pub mod eval;
 pub mod graph;
+mod handles;
 pub mod linear;
 pub mod number;
 mod parse;

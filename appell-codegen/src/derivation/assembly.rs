@@ -8,13 +8,51 @@
 
 use appell_symbolic::{Graph, Id, Symbol, SymbolicError};
 
-use super::folding::{Composite, Rotor};
 use super::partials::{raw_parts, through_c, PartialVelocities};
 use super::remainders::Remainders;
 use super::speed_map::{Rates, SpeedMap};
 use super::Calculus;
 use crate::algebra::{cross, dot, mat_vec, Mat3, Vec3};
 use crate::model::Body;
+
+/// An axisymmetric body turning about its symmetry axis, which is fixed in
+/// another body's frame (a wheel on its axle; see [`super::folding::rotors`]).
+#[derive(Clone, Copy)]
+pub struct Rotor {
+    /// The body whose frame carries the axis.
+    pub carrier: usize,
+    /// The axis: 0, 1 or 2 of the carrier's (and the rotor's) frame.
+    pub axis: usize,
+    /// The coordinate whose rate is the spin rate.
+    pub coordinate: usize,
+    /// The moment of inertia about the axis.
+    pub axial: Id,
+    /// Its terms written with its axial partial angular velocities whole
+    /// (λ o_k o_j), or split against the carrier's (see [`super::folding::rotors`]).
+    pub whole: bool,
+}
+
+/// A body's part in a composite (see [`super::folding::composite_bodies`]).
+pub enum Composite {
+    /// Its translational terms are its own.
+    Alone,
+    /// It carries the group's translational terms: the total mass, the
+    /// composite mass centre (N components) and the members' parallel-axis
+    /// inertia about it (in its frame).
+    Leader {
+        /// The total mass.
+        mass: Id,
+        /// The composite mass centre, N components.
+        center: Vec3,
+        /// The composite mass centre less the leader's, in its frame.
+        shift: Vec3,
+        /// The members' parallel-axis inertia about the composite centre.
+        extra_inertia: Mat3,
+    },
+    /// Its translational terms are carried by its group's leader (the
+    /// index).
+    Member(usize),
+}
 
 /// M's entries and f's terms per speed.
 #[derive(Clone)]

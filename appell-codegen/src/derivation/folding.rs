@@ -18,7 +18,7 @@
 
 use appell_symbolic::{Assumptions, Graph, Id, Sign, SymbolicError};
 
-use super::assembly::{Assembled, Assembler};
+use super::assembly::{Assembled, Assembler, Composite, Rotor};
 use super::Options;
 use crate::algebra::{dot, expanded, expanded3, mat_t_vec, Mat3, Vec3};
 use crate::model::{Body, Frame};
@@ -131,23 +131,6 @@ fn composite_lines(bodies: &[Body], chosen: &[Composite]) -> Vec<String> {
     lines
 }
 
-/// An axisymmetric body turning about its symmetry axis, which is fixed in
-/// another body's frame (a wheel on its axle; see [`rotors`]).
-#[derive(Clone, Copy)]
-pub struct Rotor {
-    /// The body whose frame carries the axis.
-    pub carrier: usize,
-    /// The axis: 0, 1 or 2 of the carrier's (and the rotor's) frame.
-    pub axis: usize,
-    /// The coordinate whose rate is the spin rate.
-    pub coordinate: usize,
-    /// The moment of inertia about the axis.
-    pub axial: Id,
-    /// Its terms written with its axial partial angular velocities whole
-    /// (λ o_k o_j), or split against the carrier's (see [`rotors`]).
-    pub whole: bool,
-}
-
 /// Finds rotors: a rigid body whose frame is a carrier body's frame turned
 /// about one of its axes by a coordinate, with an inertia symmetric about
 /// that axis. Its inertia is then the same matrix in the carrier's frame,
@@ -228,28 +211,6 @@ pub fn rotors(
         }
     }
     Ok(out)
-}
-
-/// A body's part in a composite (see [`composite_bodies`]).
-pub enum Composite {
-    /// Its translational terms are its own.
-    Alone,
-    /// It carries the group's translational terms: the total mass, the
-    /// composite mass centre (N components) and the members' parallel-axis
-    /// inertia about it (in its frame).
-    Leader {
-        /// The total mass.
-        mass: Id,
-        /// The composite mass centre, N components.
-        center: Vec3,
-        /// The composite mass centre less the leader's, in its frame.
-        shift: Vec3,
-        /// The members' parallel-axis inertia about the composite centre.
-        extra_inertia: Mat3,
-    },
-    /// Its translational terms are carried by its group's leader (the
-    /// index).
-    Member(usize),
 }
 
 /// Groups bodies whose mass centres are fixed in a rigid body's frame (a

@@ -10,7 +10,7 @@
 use appell_symbolic::{Graph, Id, RateRules, Symbol, SymbolicError};
 
 use super::assembly::Assembled;
-use super::folding::Composite;
+use super::assembly::Composite;
 use super::partials::{raw_parts, through_c, PartialVelocities};
 use super::speed_map::SpeedMap;
 use crate::algebra::{dot, expanded, expanded3, mat_t_vec, Vec3};
