@@ -9,7 +9,9 @@
 
 use std::str::FromStr;
 
-use appell_symbolic::{EmitOptions, Id, OpCount, Program, RustCode};
+use appell_symbolic::{
+    ConstantForm, EmitOptions, Id, OpCount, Program, RustCode, RustPath, ScalarType,
+};
 use proc_macro2::TokenStream;
 
 use crate::derivation::Derivation;
@@ -55,8 +57,10 @@ impl Code {
 pub fn options(target: Target) -> EmitOptions {
     match target {
         Target::Generic { hoist } => EmitOptions {
-            scalar: "__T".into(),
-            constant: "<__T as ::appell::__private::Scalar>::from_f64({lit})".into(),
+            scalar: ScalarType::named("__T"),
+            constant: ConstantForm::FromF64 {
+                scalar_trait: RustPath::absolute(&["appell", "__private", "Scalar"]),
+            },
             cse: true,
             hoist_parameters: hoist,
             symbol_text: Default::default(),
@@ -64,8 +68,8 @@ pub fn options(target: Target) -> EmitOptions {
             fused: true,
         },
         Target::F64 => EmitOptions {
-            scalar: "f64".into(),
-            constant: "{lit}_f64".into(),
+            scalar: ScalarType::named("f64"),
+            constant: ConstantForm::F64Literal,
             cse: true,
             hoist_parameters: false,
             symbol_text: Default::default(),
