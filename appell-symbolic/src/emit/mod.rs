@@ -30,6 +30,8 @@ mod writer;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod token_tests;
 
 pub use inst::{Inst, OpCount};
 pub use passes::{LowerOptions, Pass, PassReport, ProgramSize};
