@@ -137,14 +137,14 @@ pub struct RustCode {
 /// use appell_symbolic::{EmitOptions, Graph, Program};
 /// let mut g = Graph::new();
 /// let m = g.parameter("m").unwrap();
-/// let e = g.parse("m*sin(q)*cos(q) + m*q/2").unwrap();
+/// let l = g.parameter("l").unwrap();
+/// let e = g.parse("m*l^2*sin(q)*cos(q) + m*l^2*q").unwrap();
 /// let program = Program::lower(&g, &[e]);
 /// let tokens = program.to_tokens(&g, &EmitOptions::default());
-/// let text = program.to_rust(&g, &EmitOptions::default());
-/// assert_eq!(tokens.prepare.len(), text.prepare.len());
-/// assert_eq!(tokens.hoisted[0].to_string(), text.hoisted[0]);
+/// assert_eq!(tokens.prepare[0].to_string(), "let p0 = l * l * m ;");
+/// assert_eq!(tokens.hoisted[0], "p0");
 /// assert_eq!(tokens.outputs[0].to_string(), "q . sin () * p0 * q . cos () + q * p0");
-/// # let _ = m;
+/// # let _ = (m, l);
 /// ```
 #[derive(Clone, Debug)]
 pub struct RustTokens {
