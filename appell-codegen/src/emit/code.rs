@@ -7,10 +7,8 @@
 //! expression per output. This module asks the engine for them with the
 //! options the generated code needs and hands them on as tokens.
 
-use std::str::FromStr;
-
 use appell_symbolic::{
-    ConstantForm, EmitOptions, Id, OpCount, Program, RustCode, RustPath, ScalarType,
+    ConstantForm, EmitOptions, Id, OpCount, Program, RustPath, RustTokens, ScalarType,
 };
 use proc_macro2::TokenStream;
 
@@ -87,22 +85,16 @@ pub fn code(d: &Derivation, roots: &[Id], target: Target) -> Code {
 /// The program computing `roots`, written with `options`.
 pub fn code_with(d: &Derivation, roots: &[Id], options: &EmitOptions) -> Code {
     let g = &d.model.g;
-    from_text(&Program::lower(g, roots).to_rust(g, options))
+    from_tokens(Program::lower(g, roots).to_tokens(g, options))
 }
 
-fn from_text(c: &RustCode) -> Code {
-    let all = |v: &[String]| v.iter().map(|s| tokens(s)).collect::<Vec<_>>();
+fn from_tokens(c: RustTokens) -> Code {
     Code {
-        prepare: all(&c.prepare),
-        hoisted: all(&c.hoisted),
-        body: all(&c.body),
-        stages: c.stages.iter().map(|s| all(s)).collect(),
-        outputs: all(&c.outputs),
+        prepare: c.prepare,
+        hoisted: c.hoisted.iter().map(|h| quote::quote!(#h)).collect(),
+        body: c.body,
+        stages: c.stages,
+        outputs: c.outputs,
         ops: c.ops,
     }
-}
-
-/// One statement or expression of the engine's writer as tokens.
-fn tokens(text: &str) -> TokenStream {
-    TokenStream::from_str(text).expect("the engine writes valid Rust")
 }
