@@ -47,7 +47,8 @@ pub use deps::SymbolSet;
 pub use diff::RateRules;
 pub use display::DisplayExpr;
 pub use emit::{
-    EmitOptions, Inst, LowerOptions, OpCount, Pass, PassReport, Program, ProgramSize, RustCode,
+    ConstantForm, EmitOptions, Inst, LowerOptions, OpCount, Pass, PassReport, Program, ProgramSize,
+    RustCode, RustPath, RustTokens, ScalarType,
 };
 pub use error::{Result, SymbolicError};
 pub use eval::{Tape, Value};

@@ -7,9 +7,9 @@
 //! expression per output. This module asks the engine for them with the
 //! options the generated code needs and hands them on as tokens.
 
-use std::str::FromStr;
-
-use appell_symbolic::{EmitOptions, Id, OpCount, Program, RustCode};
+use appell_symbolic::{
+    ConstantForm, EmitOptions, Id, OpCount, Program, RustPath, RustTokens, ScalarType,
+};
 use proc_macro2::TokenStream;
 
 use crate::derivation::Derivation;
@@ -55,8 +55,10 @@ impl Code {
 pub fn options(target: Target) -> EmitOptions {
     match target {
         Target::Generic { hoist } => EmitOptions {
-            scalar: "__T".into(),
-            constant: "<__T as ::appell::__private::Scalar>::from_f64({lit})".into(),
+            scalar: ScalarType::named("__T"),
+            constant: ConstantForm::FromF64 {
+                scalar_trait: RustPath::absolute(&["appell", "__private", "Scalar"]),
+            },
             cse: true,
             hoist_parameters: hoist,
             symbol_text: Default::default(),
@@ -64,8 +66,8 @@ pub fn options(target: Target) -> EmitOptions {
             fused: true,
         },
         Target::F64 => EmitOptions {
-            scalar: "f64".into(),
-            constant: "{lit}_f64".into(),
+            scalar: ScalarType::named("f64"),
+            constant: ConstantForm::F64Literal,
             cse: true,
             hoist_parameters: false,
             symbol_text: Default::default(),
@@ -83,22 +85,16 @@ pub fn code(d: &Derivation, roots: &[Id], target: Target) -> Code {
 /// The program computing `roots`, written with `options`.
 pub fn code_with(d: &Derivation, roots: &[Id], options: &EmitOptions) -> Code {
     let g = &d.model.g;
-    from_text(&Program::lower(g, roots).to_rust(g, options))
+    from_tokens(Program::lower(g, roots).to_tokens(g, options))
 }
 
-fn from_text(c: &RustCode) -> Code {
-    let all = |v: &[String]| v.iter().map(|s| tokens(s)).collect::<Vec<_>>();
+fn from_tokens(c: RustTokens) -> Code {
     Code {
-        prepare: all(&c.prepare),
-        hoisted: all(&c.hoisted),
-        body: all(&c.body),
-        stages: c.stages.iter().map(|s| all(s)).collect(),
-        outputs: all(&c.outputs),
+        prepare: c.prepare,
+        hoisted: c.hoisted.iter().map(|h| quote::quote!(#h)).collect(),
+        body: c.body,
+        stages: c.stages,
+        outputs: c.outputs,
         ops: c.ops,
     }
-}
-
-/// One statement or expression of the engine's writer as tokens.
-fn tokens(text: &str) -> TokenStream {
-    TokenStream::from_str(text).expect("the engine writes valid Rust")
 }

@@ -15,7 +15,9 @@
 //!
 //! The parts: `inst` (the instructions and operation counts), `lower`
 //! (graph to instructions), `passes` (one file per pass), `writer`
-//! (instructions to Rust text).
+//! (instructions to Rust: what is bound, named, hoisted, staged and
+//! parenthesized) and `syntax` (the fragments the writer builds, rendered
+//! as text or as tokens).
 
 use crate::error::Result;
 use crate::graph::{Graph, Id, Symbol};
@@ -23,14 +25,18 @@ use crate::graph::{Graph, Id, Symbol};
 mod inst;
 mod lower;
 mod passes;
+mod syntax;
 mod writer;
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod token_tests;
 
 pub use inst::{Inst, OpCount};
 pub use passes::{LowerOptions, Pass, PassReport, ProgramSize};
-pub use writer::{EmitOptions, RustCode};
+pub use syntax::{ConstantForm, RustPath, ScalarType};
+pub use writer::{EmitOptions, RustCode, RustTokens};
 
 use inst::{parameter_only_flags, use_counts};
 
@@ -172,9 +178,38 @@ impl Program {
         Some(self.outputs.iter().map(|&o| v[o as usize]).collect())
     }
 
-    /// Writes the program as Rust statements.
+    /// Writes the program as Rust statements (text).
     pub fn to_rust(&self, graph: &Graph, options: &EmitOptions) -> RustCode {
-        writer::write(self, graph, options)
+        writer::write(self, graph, options).text()
+    }
+
+    /// Writes the program as Rust tokens: the statements and expressions of
+    /// [`Program::to_rust`], built as `proc_macro2` tokens without parsing
+    /// (see [`RustTokens`] for how float literals are spelled).
+    ///
+    /// ```
+    /// use appell_symbolic::{ConstantForm, EmitOptions, Graph, Program, ScalarType};
+    /// let mut g = Graph::new();
+    /// let e = g.parse("x/2 - y").unwrap();
+    /// let program = Program::lower(&g, &[e]);
+    /// let options = EmitOptions {
+    ///     scalar: ScalarType::named("f64"),
+    ///     constant: ConstantForm::F64Literal,
+    ///     ..EmitOptions::default()
+    /// };
+    /// let tokens = program.to_tokens(&g, &options);
+    /// let text = program.to_rust(&g, &options);
+    /// assert_eq!(text.body, ["let k1_2: f64 = 0.5_f64;"]);
+    /// assert_eq!(tokens.body[0].to_string(), "let k1_2 : f64 = 0.5f64 ;");
+    /// assert_eq!(tokens.outputs[0].to_string(), "x * k1_2 - y");
+    /// ```
+    ///
+    /// # Panics
+    ///
+    /// If a symbol is read by a name that is not a Rust identifier (see
+    /// [`EmitOptions::symbol_text`]).
+    pub fn to_tokens(&self, graph: &Graph, options: &EmitOptions) -> RustTokens {
+        writer::write(self, graph, options).tokens()
     }
 }
 

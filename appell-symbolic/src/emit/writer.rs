@@ -1,14 +1,22 @@
-//! Writing a [`Program`] as Rust: [`EmitOptions`] (the choices) and
+//! Writing a [`Program`] as Rust: [`EmitOptions`] (the choices),
 //! [`RustCode`] (the text: hoisted statements, per-call statements by
-//! stage, and one expression per output).
+//! stage, and one expression per output) and [`RustTokens`] (the same as
+//! tokens).
+//!
+//! The writer decides the code once, as fragments ([`Frag`], [`Let`]);
+//! [`RustCode`] and [`RustTokens`] are two renderings of the same
+//! [`Written`] program.
 
 use std::collections::{BTreeMap, BTreeSet};
 use std::fmt::Write;
+
+use proc_macro2::{Ident, TokenStream};
 
 use crate::graph::{Graph, Symbol};
 use crate::number::Number;
 
 use super::inst::{Inst, OpCount};
+use super::syntax::{self, BinOp, ConstantForm, Frag, Let, Prec, RustPath, ScalarType};
 use super::Program;
 
 /// Deepest nesting of operations written inline in one expression.
@@ -17,18 +25,18 @@ const MAX_INLINE_DEPTH: usize = 16;
 /// Choices for [`Program::to_rust`].
 #[derive(Clone, Debug)]
 pub struct EmitOptions {
-    /// The scalar type in the emitted code (a generic parameter name or a
-    /// concrete type).
-    pub scalar: String,
-    /// The expression that turns an `f64` literal into the scalar;
-    /// `{ty}` is replaced by [`EmitOptions::scalar`] and `{lit}` by the literal.
-    pub constant: String,
+    /// The scalar type in the emitted code (a generic parameter or a
+    /// concrete type); constants are bound with it as type annotation.
+    pub scalar: ScalarType,
+    /// How an `f64` constant becomes a [`EmitOptions::scalar`].
+    pub constant: ConstantForm,
     /// Share subexpressions used more than once through `let` bindings. Off,
     /// every use is written out (readable for very small problems only).
     pub cse: bool,
     /// Move parameter-only subexpressions into [`RustCode::prepare`].
     pub hoist_parameters: bool,
     /// How each symbol is read (default: its name, as a local binding).
+    /// [`Program::to_tokens`] needs every symbol read by an identifier.
     pub symbol_text: BTreeMap<Symbol, String>,
     /// The stage at which each symbol becomes available (default 0). A
     /// statement belongs to the latest stage of the symbols it reads, and
@@ -46,11 +54,28 @@ pub struct EmitOptions {
     pub fused: bool,
 }
 
+/// The defaults: generic code over a scalar `T` implementing
+/// `::appell_runtime::Scalar`, constants through its `from_f64`, shared
+/// subexpressions bound once, parameter-only work hoisted, every symbol in
+/// stage 0 and read by its name, no fused products.
+///
+/// ```
+/// use appell_symbolic::{ConstantForm, EmitOptions, RustPath, ScalarType};
+/// let o = EmitOptions::default();
+/// assert_eq!(o.scalar, ScalarType::named("T"));
+/// assert_eq!(
+///     o.constant,
+///     ConstantForm::FromF64 { scalar_trait: RustPath::absolute(&["appell_runtime", "Scalar"]) }
+/// );
+/// assert!(o.cse && o.hoist_parameters && !o.fused);
+/// ```
 impl Default for EmitOptions {
     fn default() -> Self {
         EmitOptions {
-            scalar: "T".to_string(),
-            constant: "<{ty} as ::appell_runtime::Scalar>::from_f64({lit})".to_string(),
+            scalar: ScalarType::named("T"),
+            constant: ConstantForm::FromF64 {
+                scalar_trait: RustPath::absolute(&["appell_runtime", "Scalar"]),
+            },
             cse: true,
             hoist_parameters: true,
             symbol_text: BTreeMap::new(),
@@ -94,6 +119,46 @@ pub struct RustCode {
     pub stages: Vec<Vec<String>>,
     /// One expression per root, valid after `body`.
     pub outputs: Vec<String>,
+    /// Operations per call (body and outputs).
+    pub ops: OpCount,
+    /// Operations once per parameter set (prepare).
+    pub prepare_ops: OpCount,
+}
+
+/// The same program as [`RustCode`], as tokens: every statement and
+/// expression built token by token from the writer's fragments (nothing is
+/// parsed), for code generators that assemble Rust with `quote!`.
+///
+/// The tokens are those of the text form, except float literals: they are
+/// built from their value, so they are spelled without exponent and with the
+/// suffix `f64` rather than `_f64` (same values).
+///
+/// ```
+/// use appell_symbolic::{EmitOptions, Graph, Program};
+/// let mut g = Graph::new();
+/// let m = g.parameter("m").unwrap();
+/// let l = g.parameter("l").unwrap();
+/// let e = g.parse("m*l^2*sin(q)*cos(q) + m*l^2*q").unwrap();
+/// let program = Program::lower(&g, &[e]);
+/// let tokens = program.to_tokens(&g, &EmitOptions::default());
+/// assert_eq!(tokens.prepare[0].to_string(), "let p0 = l * l * m ;");
+/// assert_eq!(tokens.hoisted[0], "p0");
+/// assert_eq!(tokens.outputs[0].to_string(), "q . sin () * p0 * q . cos () + q * p0");
+/// # let _ = (m, l);
+/// ```
+#[derive(Clone, Debug)]
+pub struct RustTokens {
+    /// Statements that compute the hoisted parameter-only values
+    /// ([`RustCode::prepare`]).
+    pub prepare: Vec<TokenStream>,
+    /// Names bound by `prepare` that the body reads.
+    pub hoisted: Vec<Ident>,
+    /// Statements of the per-call body.
+    pub body: Vec<TokenStream>,
+    /// The same statements split by stage ([`RustCode::stages`]).
+    pub stages: Vec<Vec<TokenStream>>,
+    /// One expression per root, valid after `body`.
+    pub outputs: Vec<TokenStream>,
     /// Operations per call (body and outputs).
     pub ops: OpCount,
     /// Operations once per parameter set (prepare).
@@ -181,25 +246,15 @@ impl RustCode {
     }
 }
 
-/// How tightly an expression's text binds, loosest first: an operand of a
-/// tighter operation is parenthesized.
-#[derive(Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
-enum Prec {
-    Sum = 0,
-    Product = 1,
-    Unary = 2,
-    Atom = 3,
-}
-
 /// The statements of a [`RustCode`] as they are written.
 #[derive(Default)]
 struct Sections {
     /// [`RustCode::prepare`].
-    prepare: Vec<String>,
+    prepare: Vec<Let>,
     /// [`RustCode::body`].
-    body: Vec<String>,
+    body: Vec<Let>,
     /// [`RustCode::stages`].
-    staged: Vec<Vec<String>>,
+    staged: Vec<Vec<Let>>,
     /// Names bound by `prepare` that the body reads.
     hoisted: Vec<String>,
     /// The constants (by instruction) already bound in `prepare`.
@@ -208,12 +263,57 @@ struct Sections {
     const_in_body: BTreeSet<usize>,
 }
 
-/// Writes `p` as Rust ([`Program::to_rust`]).
-pub(super) fn write(p: &Program, g: &Graph, o: &EmitOptions) -> RustCode {
+/// A program as the writer decided it, before it is rendered as text
+/// ([`Written::text`]) or tokens ([`Written::tokens`]).
+pub(super) struct Written<'a> {
+    o: &'a EmitOptions,
+    prepare: Vec<Let>,
+    hoisted: Vec<String>,
+    body: Vec<Let>,
+    stages: Vec<Vec<Let>>,
+    outputs: Vec<Frag>,
+    ops: OpCount,
+    prepare_ops: OpCount,
+}
+
+impl Written<'_> {
+    /// The program as text ([`Program::to_rust`]).
+    pub(super) fn text(&self) -> RustCode {
+        let o = self.o;
+        let stmts = |v: &[Let]| v.iter().map(|s| s.text(o)).collect::<Vec<_>>();
+        RustCode {
+            prepare: stmts(&self.prepare),
+            hoisted: self.hoisted.clone(),
+            body: stmts(&self.body),
+            stages: self.stages.iter().map(|s| stmts(s)).collect(),
+            outputs: self.outputs.iter().map(|f| syntax::text(f, o)).collect(),
+            ops: self.ops,
+            prepare_ops: self.prepare_ops,
+        }
+    }
+
+    /// The program as tokens ([`Program::to_tokens`]).
+    pub(super) fn tokens(&self) -> RustTokens {
+        let o = self.o;
+        let stmts = |v: &[Let]| v.iter().map(|s| s.tokens(o)).collect::<Vec<_>>();
+        RustTokens {
+            prepare: stmts(&self.prepare),
+            hoisted: self.hoisted.iter().map(|h| Let::name_token(h)).collect(),
+            body: stmts(&self.body),
+            stages: self.stages.iter().map(|s| stmts(s)).collect(),
+            outputs: self.outputs.iter().map(|f| syntax::tokens(f, o)).collect(),
+            ops: self.ops,
+            prepare_ops: self.prepare_ops,
+        }
+    }
+}
+
+/// Writes `p` as Rust ([`Program::to_rust`], [`Program::to_tokens`]).
+pub(super) fn write<'a>(p: &'a Program, g: &'a Graph, o: &'a EmitOptions) -> Written<'a> {
     Writer::new(p, g, o).write()
 }
 
-/// Writes one [`Program`] as Rust text.
+/// Writes one [`Program`] as Rust fragments.
 struct Writer<'a> {
     p: &'a Program,
     g: &'a Graph,
@@ -288,14 +388,9 @@ impl<'a> Writer<'a> {
         }
     }
 
-    fn literal(n: Number) -> String {
-        let x = n.to_f64();
-        format!("{x:?}")
-    }
-
     /// The whole program as Rust: which instructions are hoisted and which
     /// bound, then the statements section by section, and the outputs.
-    fn write(mut self) -> RustCode {
+    fn write(mut self) -> Written<'a> {
         let boundary = self.mark_hoisted();
         let bind = self.bindings(&boundary);
         let stage = self.stages();
@@ -314,14 +409,16 @@ impl<'a> Writer<'a> {
             self.body_constants(self.constants_of(o, &bind), &const_names, &mut s);
             outputs.push(self.expr(o).0);
         }
-        // Constants first in each section (stable order by instruction).
-        let split = |v: Vec<String>| {
-            let (mut c, rest): (Vec<String>, Vec<String>) =
-                v.into_iter().partition(|s| s.starts_with("let k"));
+        // Constants first in each section (stable order by instruction):
+        // every statement whose name starts with `k`.
+        let split = |v: Vec<Let>| {
+            let (mut c, rest): (Vec<Let>, Vec<Let>) =
+                v.into_iter().partition(|s| s.name.starts_with('k'));
             c.extend(rest);
             c
         };
-        RustCode {
+        Written {
+            o: self.o,
             prepare: split(s.prepare),
             hoisted: s.hoisted,
             body: split(s.body),
@@ -491,14 +588,23 @@ impl<'a> Writer<'a> {
                         s.prepare.push(self.const_stmt(c, const_names));
                     }
                 }
-                s.prepare.push(format!("let {name} = {text};"));
+                s.prepare.push(Let {
+                    name: name.clone(),
+                    typed: false,
+                    value: text,
+                });
                 if boundary[i] {
                     s.hoisted.push(name.clone());
                 }
             } else {
                 self.body_constants(consts, const_names, s);
-                s.staged[stage[i]].push(format!("let {name} = {text};"));
-                s.body.push(format!("let {name} = {text};"));
+                let st = Let {
+                    name: name.clone(),
+                    typed: false,
+                    value: text,
+                };
+                s.staged[stage[i]].push(st.clone());
+                s.body.push(st);
             }
             self.names[i] = Some(name);
         }
@@ -520,16 +626,15 @@ impl<'a> Writer<'a> {
             }
         }
     }
-    fn const_stmt(&self, i: usize, names: &BTreeMap<usize, String>) -> String {
+    fn const_stmt(&self, i: usize, names: &BTreeMap<usize, String>) -> Let {
         let Inst::Const(c) = self.p.insts[i] else {
             unreachable!("constant")
         };
-        let text = self
-            .o
-            .constant
-            .replace("{ty}", &self.o.scalar)
-            .replace("{lit}", &Self::literal(c));
-        format!("let {}: {} = {text};", names[&i], self.o.scalar)
+        Let {
+            name: names[&i].clone(),
+            typed: true,
+            value: Frag::Constant(c.to_f64()),
+        }
     }
 
     /// Constants read by the inline text of instruction `i`.
@@ -553,13 +658,13 @@ impl<'a> Writer<'a> {
         out
     }
 
-    /// The text of instruction `i` as used by another (its name when bound).
-    fn expr(&self, i: usize) -> (String, Prec) {
+    /// Instruction `i` as used by another (its name when bound).
+    fn expr(&self, i: usize) -> (Frag, Prec) {
         if let Some(n) = &self.names[i] {
-            return (n.clone(), Prec::Atom);
+            return (Frag::Name(n.clone()), Prec::Atom);
         }
         if let Inst::Symbol(s) = self.p.insts[i] {
-            return (self.symbol_text(s), Prec::Atom);
+            return (Frag::Name(self.symbol_text(s)), Prec::Atom);
         }
         self.expr_inline(i)
     }
@@ -567,7 +672,7 @@ impl<'a> Writer<'a> {
     /// The operands of a commutative operation, ordered so that a nested
     /// operation of the same level stands on the left, where it needs no
     /// parentheses (`a * b` and `b * a` are the same IEEE value).
-    fn commuted(&self, a: u32, b: u32, level: Prec) -> ((String, Prec), (String, Prec)) {
+    fn commuted(&self, a: u32, b: u32, level: Prec) -> ((Frag, Prec), (Frag, Prec)) {
         let (l, r) = (self.expr(a as usize), self.expr(b as usize));
         if r.1 == level && l.1 != level {
             (r, l)
@@ -588,17 +693,12 @@ impl<'a> Writer<'a> {
     /// `x.fused_mul_add(y, z)` for a sum or difference with an inline
     /// product operand: a + x·y, x·y + b, a − x·y as (−x)·y + a, and
     /// x·y − b as x·y + (−b).
-    fn fused_inline(&self, i: usize) -> Option<String> {
-        let atom = |j: u32| {
-            let (s, p) = self.expr(j as usize);
-            if p < Prec::Atom {
-                format!("({s})")
-            } else {
-                s
-            }
-        };
+    fn fused_inline(&self, i: usize) -> Option<Frag> {
+        let atom = |j: u32| Frag::wrap(self.expr(j as usize), Prec::Atom);
         let arg = |j: u32| self.expr(j as usize).0;
-        let fused = |x: String, y: u32, z: String| format!("{x}.fused_mul_add({}, {z})", arg(y));
+        let fused =
+            |x: Frag, y: u32, z: Frag| Frag::Method(Box::new(x), "fused_mul_add", vec![arg(y), z]);
+        let neg = |x: Frag| Frag::Neg(Box::new(x));
         match self.p.insts[i] {
             Inst::Add(a, b) => {
                 if let Some((x, y)) = self.inline_product(b) {
@@ -610,89 +710,77 @@ impl<'a> Writer<'a> {
             }
             Inst::Sub(a, b) => {
                 if let Some((x, y)) = self.inline_product(b) {
-                    Some(fused(format!("(-{})", atom(x)), y, arg(a)))
+                    Some(fused(Frag::Paren(Box::new(neg(atom(x)))), y, arg(a)))
                 } else {
                     let (x, y) = self.inline_product(a)?;
-                    Some(fused(atom(x), y, format!("-{}", atom(b))))
+                    Some(fused(atom(x), y, neg(atom(b))))
                 }
             }
             _ => None,
         }
     }
 
-    /// The text of instruction `i` itself.
-    fn expr_inline(&self, i: usize) -> (String, Prec) {
-        let wrap = |(s, p): (String, Prec), min: Prec| {
-            if p < min {
-                format!("({s})")
+    /// Instruction `i` itself.
+    fn expr_inline(&self, i: usize) -> (Frag, Prec) {
+        // The right operand of a left-associative operation of `level` is
+        // parenthesized at that level too.
+        let right = |x: (Frag, Prec), level: Prec| {
+            if x.1 <= level {
+                Frag::Paren(Box::new(x.0))
             } else {
-                s
+                x.0
             }
         };
-        let right = |(s, p): (String, Prec), level: Prec| {
-            if p <= level {
-                format!("({s})")
-            } else {
-                s
-            }
+        let binary = |l: (Frag, Prec), op: BinOp, r: (Frag, Prec), level: Prec| {
+            (
+                Frag::Binary(
+                    Box::new(Frag::wrap(l, level)),
+                    op,
+                    Box::new(right(r, level)),
+                ),
+                level,
+            )
+        };
+        let method = |x: usize, name: &'static str, args: Vec<Frag>| {
+            (
+                Frag::Method(Box::new(Frag::wrap(self.expr(x), Prec::Atom)), name, args),
+                Prec::Atom,
+            )
         };
         if self.o.fused {
-            if let Some(text) = self.fused_inline(i) {
-                return (text, Prec::Atom);
+            if let Some(f) = self.fused_inline(i) {
+                return (f, Prec::Atom);
             }
         }
         match self.p.insts[i] {
             Inst::Const(_) | Inst::Symbol(_) => self.expr(i),
             Inst::Add(a, b) => {
                 let (l, r) = self.commuted(a, b, Prec::Sum);
-                (
-                    format!("{} + {}", wrap(l, Prec::Sum), right(r, Prec::Sum)),
-                    Prec::Sum,
-                )
+                binary(l, BinOp::Add, r, Prec::Sum)
             }
-            Inst::Sub(a, b) => (
-                format!(
-                    "{} - {}",
-                    wrap(self.expr(a as usize), Prec::Sum),
-                    right(self.expr(b as usize), Prec::Sum)
-                ),
+            Inst::Sub(a, b) => binary(
+                self.expr(a as usize),
+                BinOp::Sub,
+                self.expr(b as usize),
                 Prec::Sum,
             ),
             Inst::Mul(a, b) => {
                 let (l, r) = self.commuted(a, b, Prec::Product);
-                (
-                    format!("{} * {}", wrap(l, Prec::Product), right(r, Prec::Product)),
-                    Prec::Product,
-                )
+                binary(l, BinOp::Mul, r, Prec::Product)
             }
-            Inst::Div(a, b) => (
-                format!(
-                    "{} / {}",
-                    wrap(self.expr(a as usize), Prec::Product),
-                    right(self.expr(b as usize), Prec::Product)
-                ),
+            Inst::Div(a, b) => binary(
+                self.expr(a as usize),
+                BinOp::Div,
+                self.expr(b as usize),
                 Prec::Product,
             ),
             Inst::Neg(a) => (
-                format!("-{}", wrap(self.expr(a as usize), Prec::Atom)),
+                Frag::Neg(Box::new(Frag::wrap(self.expr(a as usize), Prec::Atom))),
                 Prec::Unary,
             ),
-            Inst::Powi(a, e) => (
-                format!("{}.powi({e})", wrap(self.expr(a as usize), Prec::Atom)),
-                Prec::Atom,
-            ),
-            Inst::Call(f, a) => (
-                format!("{}.{}()", wrap(self.expr(a as usize), Prec::Atom), f.name()),
-                Prec::Atom,
-            ),
-            Inst::Atan2(y, x) => (
-                format!(
-                    "{}.atan2({})",
-                    wrap(self.expr(y as usize), Prec::Atom),
-                    self.expr(x as usize).0
-                ),
-                Prec::Atom,
-            ),
+            Inst::Powi(a, e) => method(a as usize, "powi", vec![Frag::Int(e)]),
+            Inst::Call(f, a) => method(a as usize, f.name(), vec![]),
+            Inst::Atan2(y, x) => method(y as usize, "atan2", vec![self.expr(x as usize).0]),
         }
     }
 }
