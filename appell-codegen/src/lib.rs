@@ -4,10 +4,11 @@
 //! be tested on its own:
 //!
 //! 1. [`parse`]: `#[appell(...)]` attributes → [`ast::ModelAst`] (syntax only);
-//! 2. [`model`]: names resolved, kinematics built in the symbolic engine;
-//! 3. [`derivation`]: D, C_rk, partial velocities, Appell's equations, cyclic
-//!    coordinates (Wang & Pao 2003, Secs. III B-C, IV B);
-//! 4. [`emit`]: the `Model` implementation as tokens.
+//! 2. [`model`]: names resolved, kinematics built in the symbolic engine
+//!    ([`model::Kinematics`]: the model and its twin);
+//! 3. [`derivation`]: Appell's equations, one module per stage of the
+//!    method (Wang & Pao 2003, Secs. III B-C, IV B) → [`derivation::Derivation`];
+//! 4. [`emit`]: the `Model` implementation as tokens, built with `quote!`.
 //!
 //! Errors are collected with spans ([`ctxt::Ctxt`]) and reported together;
 //! on error a stub implementation is emitted beside `compile_error!` so the

@@ -158,7 +158,7 @@ pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derivation> {
     derive_with(cx, kinematics, &Options::default())
 }
 
-/// [`derive`] with the cost-driven choices forced by `options`.
+/// [`derive()`] with the cost-driven choices forced by `options`.
 pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derivation> {
     let Kinematics { mut model, twin } = kinematics;
     match stages(cx, &mut model, Calculus::new(twin), options) {

@@ -1,6 +1,6 @@
 //! The `Model` trait's methods.
 //!
-//! `prepare` and `rhs` carry the reduced equations (see [`Emitter::rhs`]);
+//! `prepare` and `rhs` carry the reduced equations (see the `rhs` module);
 //! the other methods each evaluate one group of the derivation's
 //! expressions at a full state: M and f, C and c, q̇, the constraint
 //! residuals and rows, W and w, the energies and input power, and the

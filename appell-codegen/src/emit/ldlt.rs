@@ -4,7 +4,7 @@
 //! below 1e-13 of M's largest diagonal entry is a `SingularMassMatrix`
 //! error. Each update l_ik (l_jk d_k) reads the undivided product e_jk once.
 //! A pivot's reciprocal is kept where it divides two values or more (see
-//! [`Emitter::pivot_reciprocal`]). With a constant M the factors are
+//! `pivot_reciprocal`). With a constant M the factors are
 //! computed once per parameter set, in `prepare`.
 
 use proc_macro2::TokenStream;

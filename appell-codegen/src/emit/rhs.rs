@@ -5,7 +5,7 @@
 //! `Prepared` array, solves the numeric elimination and M ÿ = f, and writes
 //! the retained coordinates' rates and ÿ. Its work runs in a closure so
 //! that an error path can name a NaN or infinite input (see
-//! [`Emitter::non_finite_diagnosis`]) without slowing the path that
+//! `non_finite_diagnosis`) without slowing the path that
 //! succeeds.
 
 use appell_symbolic::Id;

@@ -8,12 +8,12 @@
 //!
 //! | module | what it resolves |
 //! | --- | --- |
-//! | [`builder`] | symbols, speeds, the order of the steps, names |
-//! | [`frames`] | frames: rotations about parent or fixed axes, the twin's direction-cosine symbols |
-//! | [`bodies`] | points, bodies, constraints, loads, rolling contacts |
-//! | [`scenes`] | scenes: their effects and outputs |
-//! | [`expr`] | expressions: names, arithmetic on scalars, vectors and points |
-//! | [`calls`] | function calls: `dt`, `dot`, `cross`, `norm`, `unit`, `omega`, `velocity`, ... |
+//! | `builder` | symbols, speeds, the order of the steps, names |
+//! | `frames` | frames: rotations about parent or fixed axes, the twin's direction-cosine symbols |
+//! | `bodies` | points, bodies, constraints, loads, rolling contacts |
+//! | `scenes` | scenes: their effects and outputs |
+//! | `expr` | expressions: names, arithmetic on scalars, vectors and points |
+//! | `calls` | function calls: `dt`, `dot`, `cross`, `norm`, `unit`, `omega`, `velocity`, ... |
 
 mod bodies;
 mod builder;
