@@ -254,27 +254,15 @@ fn stages(
         &mut rates,
         &mut calculus,
     )?;
-    let assume = elimination::assumptions(model);
-    let coordinate_rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
-    let folded = {
-        let mut assembler = assembly::Assembler {
-            bodies: &model.bodies,
-            partials: &partials,
-            remainders: &mut remainders,
-            map: &map,
-            rates: &mut rates,
-            calculus: &mut calculus,
-            coordinate_rates,
-        };
-        folding::fold(
-            &mut model.g,
-            (&model.bodies, &model.frames, &model.coords),
-            &mut assembler,
-            &partials.rotations,
-            &assume,
-            options,
-        )?
-    };
+    let folded = assemble_and_fold(
+        model,
+        &partials,
+        &mut remainders,
+        &map,
+        &mut rates,
+        &mut calculus,
+        options,
+    )?;
     let mut equations = loads::equations(
         model,
         folded.assembled,
@@ -321,6 +309,39 @@ fn stages(
         unreduced,
         folded: folded.lines,
     }))
+}
+
+/// Stages 8 and 9: M and f's inertial terms, folded where that is
+/// cheaper.
+#[allow(clippy::too_many_arguments)] // the outputs of stages 4 to 7, each its own type
+fn assemble_and_fold(
+    model: &mut Model,
+    partials: &PartialVelocities,
+    remainders: &mut Remainders,
+    map: &SpeedMap,
+    rates: &mut Rates,
+    calculus: &mut Calculus,
+    options: &Options,
+) -> Result<Folded, SymbolicError> {
+    let assume = elimination::assumptions(model);
+    let coordinate_rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let mut assembler = assembly::Assembler {
+        bodies: &model.bodies,
+        partials,
+        remainders,
+        map,
+        rates,
+        calculus,
+        coordinate_rates,
+    };
+    folding::fold(
+        &mut model.g,
+        (&model.bodies, &model.frames, &model.coords),
+        &mut assembler,
+        &partials.rotations,
+        &assume,
+        options,
+    )
 }
 
 /// D q̇ + d, row by row, with q̇ the coordinate rate symbols.

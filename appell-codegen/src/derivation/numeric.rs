@@ -55,6 +55,22 @@ pub struct NumericElimination {
     pub w: Vec<Symbol>,
 }
 
+impl NumericElimination {
+    /// The expressions the generated code evaluates: S, R and the right
+    /// side for w.
+    pub fn expressions(&self) -> impl Iterator<Item = &Id> {
+        self.dp.iter().chain(&self.rhs).chain(&self.rhs_rate)
+    }
+
+    /// The same, to rewrite in place.
+    pub fn expressions_mut(&mut self) -> impl Iterator<Item = &mut Id> {
+        self.dp
+            .iter_mut()
+            .chain(self.rhs.iter_mut())
+            .chain(self.rhs_rate.iter_mut())
+    }
+}
+
 /// What stage 5 reads besides the Schur complement.
 pub struct NumericInputs<'a> {
     /// Stage 1's rows.

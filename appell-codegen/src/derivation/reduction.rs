@@ -62,7 +62,7 @@ pub fn reduce_state(
         Elimination::Symbolic => Vec::new(),
         Elimination::Numeric(ne) => {
             let mut all = SymbolSet::new();
-            for &e in ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate) {
+            for &e in ne.expressions() {
                 all.union_with(g.dependencies(e));
             }
             ne.x.iter()
@@ -129,7 +129,7 @@ fn fix_independent_coordinates(
     let zero = g.int(0)?;
     let mut core: Vec<Id> = mass.iter().chain(forcing.iter()).copied().collect();
     if let Elimination::Numeric(ne) = &*elimination {
-        core.extend(ne.dp.iter().chain(&ne.rhs).chain(&ne.rhs_rate));
+        core.extend(ne.expressions());
     }
     let mut deps = SymbolSet::new();
     for &e in &core {
@@ -152,12 +152,7 @@ fn fix_independent_coordinates(
         *e = fix.apply(g, *e)?;
     }
     if let Elimination::Numeric(ne) = elimination {
-        for e in ne
-            .dp
-            .iter_mut()
-            .chain(ne.rhs.iter_mut())
-            .chain(ne.rhs_rate.iter_mut())
-        {
+        for e in ne.expressions_mut() {
             *e = fix.apply(g, *e)?;
         }
     }
@@ -247,12 +242,7 @@ pub fn drop_vanishing(
         fix(g, e)?;
     }
     if let Elimination::Numeric(ne) = elimination {
-        for e in ne
-            .dp
-            .iter_mut()
-            .chain(ne.rhs.iter_mut())
-            .chain(ne.rhs_rate.iter_mut())
-        {
+        for e in ne.expressions_mut() {
             fix(g, e)?;
         }
     }

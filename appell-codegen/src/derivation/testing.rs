@@ -203,29 +203,17 @@ impl Run {
     /// Stages 6 to 11, with folding chosen by `options`.
     pub fn later(&mut self, options: &super::Options) -> Later {
         let (partials, mut remainders) = self.remainders();
-        let assume = elimination::assumptions(&self.model);
-        let coordinate_rates = self.model.coords.iter().map(|(_, c)| c.rate).collect();
+        let folded = super::assemble_and_fold(
+            &mut self.model,
+            &partials,
+            &mut remainders,
+            &self.map,
+            &mut self.rates,
+            &mut self.calculus,
+            options,
+        )
+        .expect("folding");
         let model = &mut self.model;
-        let folded = {
-            let mut assembler = super::assembly::Assembler {
-                bodies: &model.bodies,
-                partials: &partials,
-                remainders: &mut remainders,
-                map: &self.map,
-                rates: &mut self.rates,
-                calculus: &mut self.calculus,
-                coordinate_rates,
-            };
-            super::folding::fold(
-                &mut model.g,
-                (&model.bodies, &model.frames, &model.coords),
-                &mut assembler,
-                &partials.rotations,
-                &assume,
-                options,
-            )
-            .expect("folding")
-        };
         let equations = super::loads::equations(
             model,
             folded.assembled,
