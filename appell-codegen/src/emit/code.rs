@@ -44,11 +44,31 @@ pub struct Code {
 }
 
 impl Code {
-    /// `prepare` and `body`, in order.
-    pub fn statements(&self) -> TokenStream {
-        let (prepare, body) = (&self.prepare, &self.body);
-        quote::quote!(#(#prepare)* #(#body)*)
+    /// `prepare` and `body`, in order, moved out (a long body is not
+    /// copied token by token).
+    pub fn take_statements(&mut self) -> TokenStream {
+        let mut out = TokenStream::new();
+        out.extend(std::mem::take(&mut self.prepare));
+        out.extend(std::mem::take(&mut self.body));
+        out
     }
+
+    /// Stage `s`'s statements, moved out.
+    pub fn take_stage(&mut self, s: usize) -> TokenStream {
+        let mut out = TokenStream::new();
+        if let Some(v) = self.stages.get_mut(s) {
+            out.extend(std::mem::take(v));
+        }
+        out
+    }
+}
+
+/// `{ parts }`, the parts moved in: interpolated into `quote!`, a group is
+/// one token, where a long body would be copied token by token.
+pub fn braced(parts: impl IntoIterator<Item = TokenStream>) -> proc_macro2::Group {
+    let mut inner = TokenStream::new();
+    inner.extend(parts);
+    proc_macro2::Group::new(proc_macro2::Delimiter::Brace, inner)
 }
 
 /// The engine's options for `target`.

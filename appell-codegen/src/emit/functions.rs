@@ -12,7 +12,7 @@ use appell_symbolic::{Id, Symbol, SymbolKind};
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use super::code::{code, Code, Target};
+use super::code::{braced, code, Code, Target};
 use super::{int, p, Emitter};
 use crate::derivation::RowSource;
 
@@ -151,55 +151,57 @@ impl Emitter<'_> {
         let generic = Target::Generic { hoist: false };
         let mut mf_roots = d.equations.mass.clone();
         mf_roots.extend(&d.equations.forcing);
-        let mf = code(d, &mf_roots, generic);
+        let mut mf = code(d, &mf_roots, generic);
         let (mf_body, mf_m, mf_f) = (
-            mf.statements(),
+            mf.take_statements(),
             outputs_into(&mf, "__m", 0..l * l),
             outputs_into(&mf, "__f", l * l..l * l + l),
         );
         let mut ct_roots = d.map.c.clone();
         ct_roots.extend(&d.map.c0);
-        let ct = code(d, &ct_roots, generic);
+        let mut ct = code(d, &ct_roots, generic);
         let (ct_body, ct_c, ct_c0) = (
-            ct.statements(),
+            ct.take_statements(),
             outputs_into(&ct, "__c", 0..n * l),
             outputs_into(&ct, "__c0", n * l..n * l + n),
         );
-        let cr = code(d, &d.map.qdot, generic);
-        let (cr_body, cr_out) = (cr.statements(), outputs_into(&cr, "__qdot", 0..n));
+        let mut cr = code(d, &d.map.qdot, generic);
+        let (cr_body, cr_out) = (cr.take_statements(), outputs_into(&cr, "__qdot", 0..n));
         let mut res_roots = d.constraints.holonomic.clone();
         res_roots.extend(&d.velocity_residuals);
-        let res = code(d, &res_roots, generic);
+        let mut res = code(d, &res_roots, generic);
         let (res_body, res_h, res_v) = (
-            res.statements(),
+            res.take_statements(),
             outputs_into(&res, "__holonomic", 0..nh),
             outputs_into(&res, "__velocity", nh..nh + m),
         );
         let mut sd_roots = d.speeds.w.clone();
         sd_roots.extend(&d.speeds.w0);
-        let sd = code(d, &sd_roots, generic);
+        let mut sd = code(d, &sd_roots, generic);
         let (sd_body, sd_w, sd_w0) = (
-            sd.statements(),
+            sd.take_statements(),
             outputs_into(&sd, "__w", 0..l * n),
             outputs_into(&sd, "__w0", l * n..l * n + l),
         );
         let single = |e: Id| {
-            let c = code(d, &[e], generic);
-            (c.statements(), c.outputs[0].clone())
+            let mut c = code(d, &[e], generic);
+            (c.take_statements(), c.outputs[0].clone())
         };
         let (ip_body, ip_out) = single(d.energies.input_power);
         let (pe_body, pe_out) = single(d.energies.potential);
         let (ke_body, ke_out) = single(d.energies.kinetic);
         let checks_mf = [chk("__m", l * l), chk("__f", l)];
+        let mf_fn = braced([
+            quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #elim_full),
+            mf_body,
+            quote!(#mf_m #mf_f #p::Ok(())),
+        ]);
         let checks_ct = [chk("__c", n * l), chk("__c0", n)];
         let chk_qdot = chk("__qdot", n);
         let checks_res = [chk("__holonomic", nh), chk("__velocity", m)];
         let checks_sd = [chk("__w", l * n), chk("__w0", l)];
         quote! {
-            fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #elim_full #mf_body #mf_m #mf_f
-                #p::Ok(())
-            }
+            fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
             fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
                 #chk_q #(#checks_ct)* #pos #params_t #bind_q #elim_pos #ct_body #ct_c #ct_c0
                 #p::Ok(())
@@ -256,13 +258,15 @@ impl Emitter<'_> {
                 mp_roots.extend(row);
             }
         }
-        let mp = code(d, &mp_roots, Target::F64);
-        let mp_out = (0..nb).map(|k| {
-            let mass = &mp.outputs[k * 10];
-            let inertia = &mp.outputs[k * 10 + 1..k * 10 + 10];
-            let k = int(k);
-            quote!(__masses[#k] = #mass; __inertias[#k] = [#(#inertia),*];)
-        });
+        let mut mp = code(d, &mp_roots, Target::F64);
+        let mp_out = (0..nb)
+            .map(|k| {
+                let mass = &mp.outputs[k * 10];
+                let inertia = &mp.outputs[k * 10 + 1..k * 10 + 10];
+                let k = int(k);
+                quote!(__masses[#k] = #mass; __inertias[#k] = [#(#inertia),*];)
+            })
+            .collect::<Vec<_>>();
         let (_, identity) = unit_entries(g);
         let mut pose_roots = Vec::new();
         for b in &model.bodies {
@@ -272,16 +276,18 @@ impl Emitter<'_> {
                 pose_roots.extend(row);
             }
         }
-        let poses = code(d, &pose_roots, generic);
-        let poses_out = (0..nb).map(|k| {
-            let position = &poses.outputs[k * 12..k * 12 + 3];
-            let rotation = &poses.outputs[k * 12 + 3..k * 12 + 12];
-            let k = int(k);
-            quote!(__positions[#k] = [#(#position),*]; __rotations[#k] = [#(#rotation),*];)
-        });
+        let mut poses = code(d, &pose_roots, generic);
+        let poses_out = (0..nb)
+            .map(|k| {
+                let position = &poses.outputs[k * 12..k * 12 + 3];
+                let rotation = &poses.outputs[k * 12 + 3..k * 12 + 12];
+                let k = int(k);
+                quote!(__positions[#k] = [#(#position),*]; __rotations[#k] = [#(#rotation),*];)
+            })
+            .collect::<Vec<_>>();
         let mut rows_roots = d.constraints.d.clone();
         rows_roots.extend(&d.constraints.d0);
-        let rows = code(d, &rows_roots, generic);
+        let mut rows = code(d, &rows_roots, generic);
         let (rows_d, rows_d0) = (
             outputs_into(&rows, "__d", 0..m * n),
             outputs_into(&rows, "__d0", m * n..m * n + m),
@@ -289,8 +295,11 @@ impl Emitter<'_> {
         let checks_mp = [chk("__masses", nb), chk("__inertias", nb)];
         let checks_poses = [chk("__positions", nb), chk("__rotations", nb)];
         let checks_rows = [chk("__d", m * n), chk("__d0", m)];
-        let (mp_body, poses_body, rows_body) =
-            (mp.statements(), poses.statements(), rows.statements());
+        let (mp_body, poses_body, rows_body) = (
+            mp.take_statements(),
+            poses.take_statements(),
+            rows.take_statements(),
+        );
         quote! {
             fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
                 #(#checks_mp)* #params_f #mp_body #(#mp_out)*
@@ -335,7 +344,7 @@ impl Emitter<'_> {
                 geo_roots.extend(row);
             }
         }
-        let geo = code(d, &geo_roots, generic);
+        let mut geo = code(d, &geo_roots, generic);
         let (geo_points, geo_frames) = (
             groups_into(&geo, "__points", 0, nf, 3),
             groups_into(&geo, "__frames", nf * 3, nt, 9),
@@ -347,7 +356,7 @@ impl Emitter<'_> {
         for t in &model.torques {
             load_roots.extend(t.vector);
         }
-        let loads = code(d, &load_roots, generic);
+        let mut loads = code(d, &load_roots, generic);
         let (loads_forces, loads_torques) = (
             groups_into(&loads, "__forces", 0, nf, 3),
             groups_into(&loads, "__torques", nf * 3, nt, 3),
@@ -366,7 +375,7 @@ impl Emitter<'_> {
                 _ => contact_roots.extend([zero; 3]),
             }
         }
-        let contacts = code(d, &contact_roots, generic);
+        let mut contacts = code(d, &contact_roots, generic);
         let (contacts_points, contacts_dirs) = (
             groups_into(&contacts, "__points", 0, nc, 3),
             groups_into(&contacts, "__directions", nc * 3, m, 3),
@@ -379,8 +388,11 @@ impl Emitter<'_> {
             chk("__forces", nf),
             chk("__torques", nt),
         ];
-        let (geo_body, contacts_body, loads_body) =
-            (geo.statements(), contacts.statements(), loads.statements());
+        let (geo_body, contacts_body, loads_body) = (
+            geo.take_statements(),
+            contacts.take_statements(),
+            loads.take_statements(),
+        );
         quote! {
             fn load_geometry<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __points: &mut [[__T; 3]], __frames: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> {
                 #chk_q #(#checks_geo)* #params_t #bind_q #geo_body #geo_points #geo_frames
@@ -468,13 +480,13 @@ impl Emitter<'_> {
             return TokenStream::new();
         }
         let roots: Vec<Id> = checked.iter().map(|(n2, _)| *n2).collect();
-        let c = code(d, &roots, Target::Generic { hoist: false });
+        let mut c = code(d, &roots, Target::Generic { hoist: false });
         let params_t = self.params_as(true);
         let binds = d.reduction.retained.iter().enumerate().map(|(k, &r)| {
             let (q, k) = (self.coord(r), int(k));
             quote!(let #q = __state[#k];)
         });
-        let statements = c.statements();
+        let statements = c.take_statements();
         let tests = checked.iter().enumerate().map(|(k, (_, label))| {
             let (value, what) = (&c.outputs[k], format!("{label} has zero length"));
             quote!(if !(#p::Scalar::re(#value) > 1e-20) { return #p::Err(#p::ModelError::NonFinite { what: #what }); })

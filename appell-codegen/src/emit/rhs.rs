@@ -12,7 +12,7 @@ use appell_symbolic::Id;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use super::code::{code, Target};
+use super::code::{braced, code, Target};
 use super::{int, p, Emitter};
 
 /// The pieces of the reduced equations the implementation is made of.
@@ -117,15 +117,22 @@ impl Emitter<'_> {
                 [#(#values),*]
             }
         };
+        let closure_body = braced([
+            quote! {
+                let [#(#names),*] = *__prepared;
+                #params_t #(#state_q)* #(#state_u)* #bind_inputs
+            },
+            rhs_body,
+            quote! {
+                #factors_rhs #solve #(#rates_out)* #(#accels_out)*
+                if !(#finite) { return #p::Err(#p::ModelError::NonFinite { what: "the state derivative" }); }
+                #p::Ok(())
+            },
+        ]);
         let rhs_fn = quote! {
             fn rhs<__T: #p::Scalar>(&self, __prepared: &[__T; #hi], t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T]) -> #p::Result<(), #p::ModelError> {
                 #(#checks)* #pos
-                let __result: #p::Result<(), #p::ModelError> = (|| {
-                    let [#(#names),*] = *__prepared;
-                    #params_t #(#state_q)* #(#state_u)* #bind_inputs #rhs_body #factors_rhs #solve #(#rates_out)* #(#accels_out)*
-                    if !(#finite) { return #p::Err(#p::ModelError::NonFinite { what: "the state derivative" }); }
-                    #p::Ok(())
-                })();
+                let __result: #p::Result<(), #p::ModelError> = (|| #closure_body)();
                 match __result {
                     #p::Ok(()) => #p::Ok(()),
                     #p::Err(__e) => {
@@ -176,11 +183,11 @@ impl Emitter<'_> {
                 values: hoisted.to_vec(),
             };
         }
-        let mc = code(self.d, tri_roots, Target::Generic { hoist: false });
+        let mut mc = code(self.d, tri_roots, Target::Generic { hoist: false });
         let (fac, _) = self.ldlt_factor(&lower(&mc.outputs), false);
         let factor_names = self.factor_names();
         let count = int(factor_names.len());
-        let statements = mc.statements();
+        let statements = mc.take_statements();
         let prepare = quote! {
             let __factors: [__T; #count] = {
                 #statements

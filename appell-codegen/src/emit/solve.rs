@@ -87,8 +87,8 @@ impl Emitter<'_> {
         let m = ne.k;
         let mut roots: Vec<Id> = ne.dp.clone();
         roots.extend_from_slice(rhs);
-        let c = code(self.d, &roots, Target::Generic { hoist: false });
-        let statements = c.statements();
+        let mut c = code(self.d, &roots, Target::Generic { hoist: false });
+        let statements = c.take_statements();
         let a_rows = matrix(&c.outputs, 0, m, m);
         let b_rows = matrix(&c.outputs, m * m, m, width);
         let (a, b, x) = (
@@ -142,15 +142,11 @@ impl Emitter<'_> {
             order: singleton_rows(m, entry),
             entry: &entry,
         };
-        let stage = |s: usize| -> TokenStream {
-            let v = c.stages.get(s).map_or(&[][..], |v| v.as_slice());
-            quote!(#(#v)*)
-        };
         let p = p();
         let (mi, wi) = (int(m), int(width));
         let s_rows = matrix(&eo, 0, m, m);
         let x_rows = matrix(&eo, m * m, m, width);
-        let mut out = stage(0);
+        let mut out = c.take_stage(0);
         out.extend(quote! {
             let __s: [[__T; #mi]; #mi] = [#s_rows];
             let __x0: [[__T; #wi]; #mi] = [#x_rows];
@@ -170,13 +166,13 @@ impl Emitter<'_> {
         let rhs_zero = |i: usize, k: usize| d.model.g.is_zero(ne.rhs[i * (l + 1) + cols[k]]);
         let (x_solve, x_ops) = solver.solve("__x0", width, &x_name, &rhs_zero, true);
         out.extend(x_solve);
-        out.extend(stage(1));
+        out.extend(c.take_stage(1));
         let w_rows = matrix(&eo, m * m + m * width, m, 1);
         out.extend(quote!(let __x1: [[__T; 1]; #mi] = [#w_rows];));
         let w_name = |j: usize, _k: usize| format_ident!("__w_{}", j);
         let (w_solve, w_ops) = solver.solve("__x1", 1, &w_name, &|_, _| false, false);
         out.extend(w_solve);
-        out.extend(stage(2));
+        out.extend(c.take_stage(2));
         c.body.clear();
         (c, out, solve_ops + x_ops + w_ops)
     }
