@@ -37,18 +37,10 @@ pub fn expand(input: &syn::DeriveInput) -> TokenStream {
     } else {
         model::build(&cx, &ast)
     };
-    // The full derivation, then each scene from it (its effects' loads only:
-    // kinematics, M and the elimination are shared).
-    let derived = model.and_then(|m| derivation::derive(&cx, m));
-    let mut scene_derivations = Vec::new();
-    if let Some(full) = &derived {
-        for sc in &full.model.scenes {
-            if let Some(d) = derivation::derive_scene(&cx, full, sc) {
-                scene_derivations.push((sc.name.clone(), d));
-            }
-        }
-    }
-    let tokens = derived.map(|d| emit::emit(&d, &scene_derivations, &ast.vis));
+    // The full derivation, then each scene's from it (its effects' loads
+    // only: kinematics, M and the elimination are shared).
+    let derived = model.and_then(|k| derivation::derive(&cx, k));
+    let tokens = derived.map(|d| emit::emit(&d, &ast.vis));
     match cx.check() {
         Ok(()) => tokens.expect("no errors means a derivation"),
         Err(err) => {

@@ -27,18 +27,19 @@ fn equations_with(
         fold_always,
         rotor_form,
     };
-    let d = derive_with(&cx, kinematics, &options).expect("derivation");
+    let derived = derive_with(&cx, kinematics, &options).expect("derivation");
+    let (d, g) = (&derived.full, &derived.model.g);
     cx.check().expect("no errors");
     let mut roots = d.equations.mass.clone();
     roots.extend(&d.equations.forcing);
-    let tape = Tape::new(&d.model.g, &roots);
+    let tape = Tape::new(g, &roots);
     let values = (0..5u64)
         .map(|trial| {
-            tape.eval(&|s| Some(pseudo_value(&d.model.g, s, trial)))
+            tape.eval(&|s| Some(pseudo_value(g, s, trial)))
                 .expect("finite")
         })
         .collect();
-    (values, d.text)
+    (values, d.text.clone())
 }
 
 fn assert_same(a: &[Vec<f64>], b: &[Vec<f64>]) {

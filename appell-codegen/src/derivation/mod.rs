@@ -62,7 +62,7 @@ pub use speeds::SpeedDefinitions;
 pub use structure::{singleton_rows, SingletonOrder};
 
 use crate::ctxt::Ctxt;
-use crate::model::{Kinematics, Model, Twin};
+use crate::model::{Kinematics, Model, Scene, Twin};
 
 /// Choices the derivation makes by operation count, forced for tests that
 /// compare the forms.
@@ -106,10 +106,21 @@ impl Calculus {
     }
 }
 
-/// The derived equations and everything the emitter needs.
-pub struct Derivation {
-    /// The model (its graph holds every expression below).
+/// A model's derivations: the full equations and each scene's, their
+/// expressions all in the model's one graph.
+pub struct Derived {
+    /// The model; its graph holds every expression of the derivations.
     pub model: Model,
+    /// The full model's equations.
+    pub full: Derivation,
+    /// Each declared scene with its equations (a scene whose derivation
+    /// failed is reported and left out).
+    pub scenes: Vec<(Scene, Derivation)>,
+}
+
+/// The derived equations of the model or of one scene, and everything the
+/// emitter needs besides the model.
+pub struct Derivation {
     /// Number of coordinates n.
     pub n: usize,
     /// Number of constraint rows m.
@@ -153,25 +164,37 @@ pub struct Unreduced {
     pub elimination: Elimination,
 }
 
-/// Runs the derivation; errors go to `cx`.
-pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derivation> {
+/// Runs the derivation, the full model's and then each scene's; errors go
+/// to `cx`.
+pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
     derive_with(cx, kinematics, &Options::default())
 }
 
 /// [`derive()`] with the cost-driven choices forced by `options`.
-pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derivation> {
+pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derived> {
     let Kinematics { mut model, twin } = kinematics;
-    match stages(cx, &mut model, Calculus::new(twin), options) {
-        Ok(Some(d)) => Some(d.finish(model)),
-        Ok(None) => None,
+    let full = match stages(cx, &mut model, Calculus::new(twin), options) {
+        Ok(Some(d)) => d.finish(&model),
+        Ok(None) => return None,
         Err(e) => {
             cx.error_at(
                 model.name.span(),
                 format!("deriving the equations failed: {e}"),
             );
-            None
+            return None;
+        }
+    };
+    let mut scenes = Vec::new();
+    for scene in model.scenes.clone() {
+        if let Some(d) = derive_scene(cx, &mut model, &full, &scene) {
+            scenes.push((scene, d));
         }
     }
+    Some(Derived {
+        model,
+        full,
+        scenes,
+    })
 }
 
 /// The stage outputs before they are bound to the model.
@@ -189,12 +212,11 @@ struct Stages {
 }
 
 impl Stages {
-    fn finish(self, model: Model) -> Derivation {
+    fn finish(self, model: &Model) -> Derivation {
         let mut d = Derivation {
             n: model.coords.len(),
             m: self.constraints.d0.len(),
             l: model.speed_specs.len(),
-            model,
             constraints: self.constraints,
             velocity_residuals: self.velocity_residuals,
             speeds: self.speeds,
@@ -207,7 +229,7 @@ impl Stages {
             folded: self.folded,
             text: String::new(),
         };
-        d.text = text::equations_text(&d);
+        d.text = text::equations_text(model, &d);
         d
     }
 }
@@ -288,7 +310,7 @@ fn stages(
         &mut model.g,
         reduction::ReductionInputs {
             coords: &model.coords,
-            quadrature: &model.quadrature,
+            quadrature: &[],
             qdot: &map.qdot,
             dependent: &speeds.dependent,
         },

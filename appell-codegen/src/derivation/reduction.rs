@@ -259,7 +259,7 @@ mod tests {
         let cx = Ctxt::new();
         let d = derive(&cx, testing::kinematics(src));
         cx.check().expect("no errors");
-        d.expect("a derivation")
+        d.expect("a derivation").full
     }
 
     #[test]

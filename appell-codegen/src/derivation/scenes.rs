@@ -15,12 +15,17 @@ use super::reduction::{reduce_state, ReductionInputs};
 use super::{text, Derivation};
 use crate::algebra::expanded;
 use crate::ctxt::Ctxt;
-use crate::model::Scene;
+use crate::model::{Model, Scene};
 
 /// Derives `scene` of `full`; errors go to `cx`, spanned by the scene's
 /// name.
-pub fn derive_scene(cx: &Ctxt, full: &Derivation, scene: &Scene) -> Option<Derivation> {
-    match scene_derivation(full, scene) {
+pub fn derive_scene(
+    cx: &Ctxt,
+    model: &mut Model,
+    full: &Derivation,
+    scene: &Scene,
+) -> Option<Derivation> {
+    match scene_derivation(model, full, scene) {
         Ok(d) => Some(d),
         Err(e) => {
             cx.error_spanned_by(
@@ -32,8 +37,11 @@ pub fn derive_scene(cx: &Ctxt, full: &Derivation, scene: &Scene) -> Option<Deriv
     }
 }
 
-fn scene_derivation(full: &Derivation, scene: &Scene) -> Result<Derivation, SymbolicError> {
-    let mut model = crate::model::scene_model(&full.model, scene);
+fn scene_derivation(
+    model: &mut Model,
+    full: &Derivation,
+    scene: &Scene,
+) -> Result<Derivation, SymbolicError> {
     let g = &mut model.g;
     let l = full.l;
     let mut mass = full.unreduced.mass.clone();
@@ -67,7 +75,7 @@ fn scene_derivation(full: &Derivation, scene: &Scene) -> Result<Derivation, Symb
         g,
         ReductionInputs {
             coords: &model.coords,
-            quadrature: &model.quadrature,
+            quadrature: &scene.quadrature,
             qdot: &full.map.qdot,
             dependent: &full.speeds.dependent,
         },
@@ -76,7 +84,6 @@ fn scene_derivation(full: &Derivation, scene: &Scene) -> Result<Derivation, Symb
         &mut elimination,
     )?;
     let mut d = Derivation {
-        model,
         n: full.n,
         m: full.m,
         l,
@@ -102,7 +109,7 @@ fn scene_derivation(full: &Derivation, scene: &Scene) -> Result<Derivation, Symb
         folded: full.folded.clone(),
         text: String::new(),
     };
-    d.text = text::equations_text(&d);
+    d.text = text::equations_text(model, &d);
     Ok(d)
 }
 
@@ -122,10 +129,11 @@ mod tests {
             )
             .replace("j: f64 }", "j: f64, g: f64 }");
         let cx = Ctxt::new();
-        let full = derive(&cx, testing::kinematics(&src)).expect("derivation");
-        let scene = derive_scene(&cx, &full, &full.model.scenes[0]).expect("scene");
+        let derived = derive(&cx, testing::kinematics(&src)).expect("derivation");
         cx.check().expect("no errors");
-        let mut g = scene.model.g.clone();
+        let (full, (scene_of, scene)) = (&derived.full, &derived.scenes[0]);
+        assert_eq!(scene_of.name, "falling");
+        let mut g = derived.model.g.clone();
         assert_agrees(&mut g, full.equations.forcing[0], "-r*f");
         assert_agrees(&mut g, scene.equations.forcing[0], "0");
         assert!(g.is_zero(scene.energies.input_power));

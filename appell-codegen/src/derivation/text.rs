@@ -7,11 +7,12 @@ use std::fmt::Write;
 use appell_symbolic::Id;
 
 use super::{Derivation, Elimination};
+use crate::model::Model;
 
 /// The readable form of the derived equations.
-pub fn equations_text(d: &Derivation) -> String {
-    let g = &d.model.g;
-    let name = |i: usize| d.model.coords[i].0.to_string();
+pub fn equations_text(model: &Model, d: &Derivation) -> String {
+    let g = &model.g;
+    let name = |i: usize| model.coords[i].0.to_string();
     let show = |e: Id| -> String {
         if g.dag_size(&[e]) > 400 {
             format!(
@@ -26,21 +27,20 @@ pub fn equations_text(d: &Derivation) -> String {
     let _ = writeln!(
         s,
         "{}: Appell's equations (Wang & Pao 2003, eq. 56), reduced (eq. 42)",
-        d.model.name
+        model.name
     );
     let _ = writeln!(
         s,
         "coordinates q: {}",
         (0..d.n).map(name).collect::<Vec<_>>().join(", ")
     );
-    let speeds: Vec<String> = d
-        .model
+    let speeds: Vec<String> = model
         .speed_specs
         .iter()
         .map(|sp| g.symbol_name(sp.symbol).to_string())
         .collect();
     let _ = writeln!(s, "privileged speeds: {}", speeds.join(", "));
-    for (k, sp) in d.model.speed_specs.iter().enumerate() {
+    for (k, sp) in model.speed_specs.iter().enumerate() {
         if let Some(def) = sp.definition {
             let _ = writeln!(s, "  {} = {} (quasi-velocity)", speeds[k], show(def));
         }
@@ -89,8 +89,7 @@ pub fn equations_text(d: &Derivation) -> String {
     let mut state: Vec<String> = d.reduction.retained.iter().map(|&i| name(i)).collect();
     state.extend(speeds.iter().cloned());
     let _ = writeln!(s, "reduced state: ({})", state.join(", "));
-    let accels: Vec<String> = d
-        .model
+    let accels: Vec<String> = model
         .speed_specs
         .iter()
         .map(|sp| g.symbol_name(sp.accel).to_string())
@@ -125,7 +124,9 @@ mod tests {
     #[test]
     fn the_text_names_the_dependent_speeds_and_the_reduced_state() {
         let cx = Ctxt::new();
-        let d = derive(&cx, testing::kinematics(testing::DISC_ON_A_LINE)).expect("derivation");
+        let d = derive(&cx, testing::kinematics(testing::DISC_ON_A_LINE))
+            .expect("derivation")
+            .full;
         cx.check().expect("no errors");
         assert!(
             d.text

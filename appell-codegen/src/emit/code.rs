@@ -8,11 +8,9 @@
 //! options the generated code needs and hands them on as tokens.
 
 use appell_symbolic::{
-    ConstantForm, EmitOptions, Id, OpCount, Program, RustPath, RustTokens, ScalarType,
+    ConstantForm, EmitOptions, Graph, Id, OpCount, Program, RustPath, RustTokens, ScalarType,
 };
 use proc_macro2::TokenStream;
-
-use crate::derivation::Derivation;
 
 /// The scalar the program is written for.
 #[derive(Clone, Copy)]
@@ -98,13 +96,12 @@ pub fn options(target: Target) -> EmitOptions {
 }
 
 /// The program computing `roots`, written for `target`.
-pub fn code(d: &Derivation, roots: &[Id], target: Target) -> Code {
-    code_with(d, roots, &options(target))
+pub fn code(g: &Graph, roots: &[Id], target: Target) -> Code {
+    code_with(g, roots, &options(target))
 }
 
 /// The program computing `roots`, written with `options`.
-pub fn code_with(d: &Derivation, roots: &[Id], options: &EmitOptions) -> Code {
-    let g = &d.model.g;
+pub fn code_with(g: &Graph, roots: &[Id], options: &EmitOptions) -> Code {
     from_tokens(Program::lower(g, roots).to_tokens(g, options))
 }
 

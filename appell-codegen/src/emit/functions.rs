@@ -101,7 +101,7 @@ impl Emitter<'_> {
     fn parameter_access(&self) -> TokenStream {
         let p = p();
         let this = &self.this;
-        let params = &self.d.model.params;
+        let params = &self.model.params;
         let check = self.check("__out", params.len());
         let gets = params.iter().enumerate().map(|(k, prm)| {
             let (f, k) = (&prm.ident, int(k));
@@ -144,14 +144,14 @@ impl Emitter<'_> {
             elim_pos,
             ..
         } = c;
-        let ni = d.model.inputs.len();
+        let ni = self.model.inputs.len();
         let nh = d.constraints.holonomic.len();
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let (chk_q, chk_u, chk_inputs) = (chk("__q", n), chk("__u", l), chk("__inputs", ni));
         let generic = Target::Generic { hoist: false };
         let mut mf_roots = d.equations.mass.clone();
         mf_roots.extend(&d.equations.forcing);
-        let mut mf = code(d, &mf_roots, generic);
+        let mut mf = code(&self.model.g, &mf_roots, generic);
         let (mf_body, mf_m, mf_f) = (
             mf.take_statements(),
             outputs_into(&mf, "__m", 0..l * l),
@@ -159,17 +159,17 @@ impl Emitter<'_> {
         );
         let mut ct_roots = d.map.c.clone();
         ct_roots.extend(&d.map.c0);
-        let mut ct = code(d, &ct_roots, generic);
+        let mut ct = code(&self.model.g, &ct_roots, generic);
         let (ct_body, ct_c, ct_c0) = (
             ct.take_statements(),
             outputs_into(&ct, "__c", 0..n * l),
             outputs_into(&ct, "__c0", n * l..n * l + n),
         );
-        let mut cr = code(d, &d.map.qdot, generic);
+        let mut cr = code(&self.model.g, &d.map.qdot, generic);
         let (cr_body, cr_out) = (cr.take_statements(), outputs_into(&cr, "__qdot", 0..n));
         let mut res_roots = d.constraints.holonomic.clone();
         res_roots.extend(&d.velocity_residuals);
-        let mut res = code(d, &res_roots, generic);
+        let mut res = code(&self.model.g, &res_roots, generic);
         let (res_body, res_h, res_v) = (
             res.take_statements(),
             outputs_into(&res, "__holonomic", 0..nh),
@@ -177,14 +177,14 @@ impl Emitter<'_> {
         );
         let mut sd_roots = d.speeds.w.clone();
         sd_roots.extend(&d.speeds.w0);
-        let mut sd = code(d, &sd_roots, generic);
+        let mut sd = code(&self.model.g, &sd_roots, generic);
         let (sd_body, sd_w, sd_w0) = (
             sd.take_statements(),
             outputs_into(&sd, "__w", 0..l * n),
             outputs_into(&sd, "__w0", l * n..l * n + l),
         );
         let single = |e: Id| {
-            let mut c = code(d, &[e], generic);
+            let mut c = code(&self.model.g, &[e], generic);
             (c.take_statements(), c.outputs[0].clone())
         };
         let (ip_body, ip_out) = single(d.energies.input_power);
@@ -238,7 +238,7 @@ impl Emitter<'_> {
     fn kinematics_functions(&self, c: &Common) -> TokenStream {
         let p = p();
         let d = self.d;
-        let model = &d.model;
+        let model = self.model;
         let g = &model.g;
         let (n, m) = (d.n, d.m);
         let Common {
@@ -258,7 +258,7 @@ impl Emitter<'_> {
                 mp_roots.extend(row);
             }
         }
-        let mut mp = code(d, &mp_roots, Target::F64);
+        let mut mp = code(&self.model.g, &mp_roots, Target::F64);
         let mp_out = (0..nb)
             .map(|k| {
                 let mass = &mp.outputs[k * 10];
@@ -276,7 +276,7 @@ impl Emitter<'_> {
                 pose_roots.extend(row);
             }
         }
-        let mut poses = code(d, &pose_roots, generic);
+        let mut poses = code(&self.model.g, &pose_roots, generic);
         let poses_out = (0..nb)
             .map(|k| {
                 let position = &poses.outputs[k * 12..k * 12 + 3];
@@ -287,7 +287,7 @@ impl Emitter<'_> {
             .collect::<Vec<_>>();
         let mut rows_roots = d.constraints.d.clone();
         rows_roots.extend(&d.constraints.d0);
-        let mut rows = code(d, &rows_roots, generic);
+        let mut rows = code(&self.model.g, &rows_roots, generic);
         let (rows_d, rows_d0) = (
             outputs_into(&rows, "__d", 0..m * n),
             outputs_into(&rows, "__d0", m * n..m * n + m),
@@ -321,7 +321,7 @@ impl Emitter<'_> {
     fn load_functions(&self, c: &Common) -> TokenStream {
         let p = p();
         let d = self.d;
-        let model = &d.model;
+        let model = self.model;
         let (n, m) = (d.n, d.m);
         let Common {
             params_t,
@@ -333,30 +333,31 @@ impl Emitter<'_> {
         let generic = Target::Generic { hoist: false };
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let chk_q = chk("__q", n);
-        let (nf, nt, nc) = (model.forces.len(), model.torques.len(), model.rolling.len());
+        let (forces, torques) = (self.forces(), self.torques());
+        let (nf, nt, nc) = (forces.len(), torques.len(), model.rolling.len());
         let (zero, identity) = unit_entries(&model.g);
         let mut geo_roots = Vec::new();
-        for f in &model.forces {
+        for f in &forces {
             geo_roots.extend(f.point);
         }
-        for t in &model.torques {
+        for t in &torques {
             for row in &model.frames[t.frame].rot {
                 geo_roots.extend(row);
             }
         }
-        let mut geo = code(d, &geo_roots, generic);
+        let mut geo = code(&self.model.g, &geo_roots, generic);
         let (geo_points, geo_frames) = (
             groups_into(&geo, "__points", 0, nf, 3),
             groups_into(&geo, "__frames", nf * 3, nt, 9),
         );
         let mut load_roots = Vec::new();
-        for f in &model.forces {
+        for f in &forces {
             load_roots.extend(f.vector);
         }
-        for t in &model.torques {
+        for t in &torques {
             load_roots.extend(t.vector);
         }
-        let mut loads = code(d, &load_roots, generic);
+        let mut loads = code(&self.model.g, &load_roots, generic);
         let (loads_forces, loads_torques) = (
             groups_into(&loads, "__forces", 0, nf, 3),
             groups_into(&loads, "__torques", nf * 3, nt, 3),
@@ -375,7 +376,7 @@ impl Emitter<'_> {
                 _ => contact_roots.extend([zero; 3]),
             }
         }
-        let mut contacts = code(d, &contact_roots, generic);
+        let mut contacts = code(&self.model.g, &contact_roots, generic);
         let (contacts_points, contacts_dirs) = (
             groups_into(&contacts, "__points", 0, nc, 3),
             groups_into(&contacts, "__directions", nc * 3, m, 3),
@@ -415,7 +416,7 @@ impl Emitter<'_> {
     pub(super) fn non_finite_diagnosis(&self) -> TokenStream {
         let p = p();
         let d = self.d;
-        let model = &d.model;
+        let model = self.model;
         let this = &self.this;
         let mut names: Vec<String> = d
             .reduction
@@ -424,7 +425,7 @@ impl Emitter<'_> {
             .map(|&r| self.coord(r).to_string())
             .collect();
         names.extend(model.speed_specs.iter().map(|sp| {
-            let name = d.model.g.symbol_name(sp.symbol).to_string();
+            let name = self.model.g.symbol_name(sp.symbol).to_string();
             match sp.coordinate {
                 Some(_) => name,
                 None => sp.name.clone(),
@@ -454,7 +455,7 @@ impl Emitter<'_> {
     fn zero_length_checks(&self) -> TokenStream {
         let p = p();
         let d = self.d;
-        let model = &d.model;
+        let model = self.model;
         let g = &model.g;
         let retained: Vec<Symbol> = d
             .reduction
@@ -480,7 +481,7 @@ impl Emitter<'_> {
             return TokenStream::new();
         }
         let roots: Vec<Id> = checked.iter().map(|(n2, _)| *n2).collect();
-        let mut c = code(d, &roots, Target::Generic { hoist: false });
+        let mut c = code(&self.model.g, &roots, Target::Generic { hoist: false });
         let params_t = self.params_as(true);
         let binds = d.reduction.retained.iter().enumerate().map(|(k, &r)| {
             let (q, k) = (self.coord(r), int(k));

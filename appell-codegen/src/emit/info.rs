@@ -16,7 +16,7 @@ impl Emitter<'_> {
     pub(super) fn info(&self, rhs_ops: OpCount, extra_ops: usize) -> TokenStream {
         let p = p();
         let d = self.d;
-        let model = &d.model;
+        let model = self.model;
         let names = |idx: &[usize]| {
             let names = idx.iter().map(|&i| self.coord(i).to_string());
             quote!(&[#(#names),*])
@@ -44,7 +44,7 @@ impl Emitter<'_> {
             let (body, point, along) = (int(r.body), &r.point, r.along.is_some());
             quote!(#p::ContactInfo { body: #body, point: #point, along: #along })
         });
-        let name = &model.info_name;
+        let name = self.info_name();
         let params = strings(model.params.iter().map(|p| p.ident.to_string()).collect());
         let all = names(&(0..d.n).collect::<Vec<_>>());
         let speeds = strings(model.speed_specs.iter().map(|sp| sp.name.clone()).collect());
@@ -53,11 +53,11 @@ impl Emitter<'_> {
         let ignorable = names(&d.reduction.ignorable);
         let retained = names(&d.reduction.retained);
         let inputs = strings(model.inputs.iter().map(|(i, _)| i.to_string()).collect());
-        let effects = strings(model.effects.clone());
-        let outputs = strings(model.outputs.clone());
+        let effects = strings(self.effects());
+        let outputs = strings(self.outputs());
         let holonomic = int(d.constraints.holonomic.len());
         let m = int(d.m);
-        let (nf, nt) = (int(model.forces.len()), int(model.torques.len()));
+        let (nf, nt) = (int(self.forces().len()), int(self.torques().len()));
         let symbolic = matches!(d.elimination, Elimination::Symbolic);
         let (add, mul, div, calls) = (
             int(rhs_ops.add),

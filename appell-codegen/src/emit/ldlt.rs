@@ -114,7 +114,7 @@ impl Emitter<'_> {
             && d.equations
                 .mass
                 .iter()
-                .all(|&e| d.model.g.is_parameter_only(e))
+                .all(|&e| self.model.g.is_parameter_only(e))
     }
 
     /// `value / d_j`, as a product with `__r_j` when it is kept.

@@ -22,6 +22,7 @@ use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
 use crate::derivation::Derivation;
+use crate::model::{Load, Model, Scene};
 
 pub use scenes::{emit, stub};
 
@@ -37,7 +38,12 @@ fn int(i: usize) -> Literal {
 
 /// One `Model` implementation: the full model's or a scene's.
 pub struct Emitter<'a> {
+    /// The model; its graph holds every expression.
+    model: &'a Model,
+    /// The equations: the full model's or the scene's.
     d: &'a Derivation,
+    /// The scene, for a scene's implementation.
+    scene: Option<&'a Scene>,
     /// The type the implementation is for.
     type_name: syn::Ident,
     /// How the parameters are reached (`self`, or `self.0` for a scene).
@@ -51,8 +57,56 @@ pub struct Emitter<'a> {
 }
 
 impl Emitter<'_> {
+    /// Whether this implementation keeps the loads of `effect`: a scene
+    /// keeps its effects' only.
+    fn keeps(&self, effect: &str) -> bool {
+        self.scene
+            .is_none_or(|s| s.effects.iter().any(|e| e == effect))
+    }
+
+    /// The forces this implementation describes.
+    fn forces(&self) -> Vec<&Load> {
+        self.model
+            .forces
+            .iter()
+            .filter(|f| self.keeps(&f.effect))
+            .collect()
+    }
+
+    /// The torques this implementation describes.
+    fn torques(&self) -> Vec<&Load> {
+        self.model
+            .torques
+            .iter()
+            .filter(|t| self.keeps(&t.effect))
+            .collect()
+    }
+
+    /// The effects whose loads it keeps, in the model's order.
+    fn effects(&self) -> Vec<String> {
+        self.model
+            .effects
+            .iter()
+            .filter(|e| self.keeps(e))
+            .cloned()
+            .collect()
+    }
+
+    /// The scene's outputs (none for the full model).
+    fn outputs(&self) -> Vec<String> {
+        self.scene.map_or_else(Vec::new, |s| s.outputs.clone())
+    }
+
+    /// The name its `ModelInfo` carries: `Model` or `Model::scene`.
+    fn info_name(&self) -> String {
+        match self.scene {
+            Some(s) => format!("{}::{}", self.model.name, s.name),
+            None => self.model.name.to_string(),
+        }
+    }
+
     fn coord(&self, i: usize) -> syn::Ident {
-        self.d.model.coords[i].0.clone()
+        self.model.coords[i].0.clone()
     }
 
     fn ident(&self, name: &str) -> syn::Ident {
@@ -62,7 +116,7 @@ impl Emitter<'_> {
     /// The parameters bound as locals: as `__T` when `scalar`, else `f64`.
     fn params_as(&self, scalar: bool) -> TokenStream {
         let (p, this) = (p(), &self.this);
-        let fields = self.d.model.params.iter().map(|prm| &prm.ident);
+        let fields = self.model.params.iter().map(|prm| &prm.ident);
         if scalar {
             quote!(#(let #fields: __T = <__T as #p::Scalar>::from_f64(#this.#fields);)*)
         } else {
@@ -74,7 +128,7 @@ impl Emitter<'_> {
     /// `positive`.
     fn positivity(&self) -> TokenStream {
         let (p, this) = (p(), &self.this);
-        let checks = self.d.model.params.iter().filter(|prm| prm.positive).map(|prm| {
+        let checks = self.model.params.iter().filter(|prm| prm.positive).map(|prm| {
             let f = &prm.ident;
             let name = f.to_string();
             quote!(if !(#this.#f > 0.0) { return #p::Err(#p::ModelError::NonPositiveParameter { name: #name, value: #this.#f }); })
@@ -105,33 +159,21 @@ impl Emitter<'_> {
     /// `let u_k = slice[k];` for every privileged speed.
     fn bind_u(&self, slice: &str) -> TokenStream {
         let slice = self.ident(slice);
-        let g = &self.d.model.g;
-        let binds = self
-            .d
-            .model
-            .speed_specs
-            .iter()
-            .enumerate()
-            .map(|(k, spec)| {
-                let (u, k) = (self.ident(g.symbol_name(spec.symbol)), int(k));
-                quote!(let #u = #slice[#k];)
-            });
+        let g = &self.model.g;
+        let binds = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
+            let (u, k) = (self.ident(g.symbol_name(spec.symbol)), int(k));
+            quote!(let #u = #slice[#k];)
+        });
         quote!(#(#binds)*)
     }
 
     /// `let input_k = slice[k];` for every input.
     fn bind_inputs(&self, slice: &str) -> TokenStream {
         let slice = self.ident(slice);
-        let binds = self
-            .d
-            .model
-            .inputs
-            .iter()
-            .enumerate()
-            .map(|(k, (name, _))| {
-                let k = int(k);
-                quote!(let #name = #slice[#k];)
-            });
+        let binds = self.model.inputs.iter().enumerate().map(|(k, (name, _))| {
+            let k = int(k);
+            quote!(let #name = #slice[#k];)
+        });
         quote!(#(#binds)*)
     }
 

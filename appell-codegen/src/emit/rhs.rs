@@ -68,12 +68,12 @@ impl Emitter<'_> {
         let factors = self.factors(&tri_roots, &rhs.outputs, &rhs.hoisted, constant_mass);
         let (solve, solve_ops) = self.ldlt_solve(&rhs.outputs[tri..tri + l]);
         let info = self.info(rhs.ops, factors.ops + solve_ops + elim_ops);
-        let g = &d.model.g;
+        let g = &self.model.g;
         let state_q = retained.iter().enumerate().map(|(k, &r)| {
             let (q, k) = (self.coord(r), int(k));
             quote!(let #q = __state[#k];)
         });
-        let state_u = d.model.speed_specs.iter().enumerate().map(|(k, spec)| {
+        let state_u = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
             let (u, k) = (
                 self.ident(g.symbol_name(spec.symbol)),
                 int(retained.len() + k),
@@ -107,7 +107,7 @@ impl Emitter<'_> {
         let (names, values) = (&factors.names, &factors.values);
         let checks = [
             self.check("__state", ns),
-            self.check("__inputs", d.model.inputs.len()),
+            self.check("__inputs", self.model.inputs.len()),
             self.check("__dstate", ns),
         ];
         let diagnose = self.non_finite_diagnosis();
@@ -183,7 +183,7 @@ impl Emitter<'_> {
                 values: hoisted.to_vec(),
             };
         }
-        let mut mc = code(self.d, tri_roots, Target::Generic { hoist: false });
+        let mut mc = code(&self.model.g, tri_roots, Target::Generic { hoist: false });
         let (fac, _) = self.ldlt_factor(&lower(&mc.outputs), false);
         let factor_names = self.factor_names();
         let count = int(factor_names.len());

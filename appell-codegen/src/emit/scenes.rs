@@ -11,27 +11,27 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use super::{camel, int, p, Emitter};
-use crate::derivation::Derivation;
+use crate::derivation::{Derivation, Derived};
+use crate::model::Scene;
 
 /// The `Model` implementations: the full model's, and one per scene on a
 /// generated newtype (`{Model}{Scene}(pub Model)`), all in one `const _`
 /// block; the scene types are declared beside the struct.
-pub fn emit(
-    full: &Derivation,
-    scenes: &[(syn::Ident, Derivation)],
-    vis: &syn::Visibility,
-) -> TokenStream {
+pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
     let p = p();
-    let base = &full.model.name;
+    let (model, full, scenes) = (&derived.model, &derived.full, &derived.scenes);
+    let base = &model.name;
     let scene_type = |name: &syn::Ident| format_ident!("{}{}", base, camel(&name.to_string()));
-    let scene_infos = scenes.iter().map(|(n, _)| info_static(n));
+    let scene_infos = scenes.iter().map(|(s, _)| info_static(&s.name));
     let count = int(scenes.len());
     let mut body = quote! {
         static __SCENES: [&#p::ModelInfo; #count] = [#(&#scene_infos),*];
     };
     body.extend(
         Emitter {
+            model,
             d: full,
+            scene: None,
             type_name: base.clone(),
             this: quote!(self),
             info_ident: format_ident!("__INFO"),
@@ -41,20 +41,26 @@ pub fn emit(
         .implementation(),
     );
     let mut decls = TokenStream::new();
-    for (name, d) in scenes {
-        let ty = scene_type(name);
-        decls.extend(newtype(base, &ty, name, &d.model.effects, vis));
-        body.extend(
-            Emitter {
-                d,
-                type_name: ty,
-                this: quote!(self.0),
-                info_ident: info_static(name),
-                scene_infos: quote!(&[]),
-                scene_rhs: TokenStream::new(),
-            }
-            .implementation(),
-        );
+    for (scene, d) in scenes {
+        let name = &scene.name;
+        let emitter = Emitter {
+            model,
+            d,
+            scene: Some(scene),
+            type_name: scene_type(name),
+            this: quote!(self.0),
+            info_ident: info_static(name),
+            scene_infos: quote!(&[]),
+            scene_rhs: TokenStream::new(),
+        };
+        decls.extend(newtype(
+            base,
+            &emitter.type_name,
+            name,
+            &emitter.effects(),
+            vis,
+        ));
+        body.extend(emitter.implementation());
     }
     quote! {
         #decls
@@ -75,19 +81,19 @@ fn info_static(name: &syn::Ident) -> syn::Ident {
 
 /// The full model's `scene_rhs` and `visit_scene` (nothing without scenes).
 fn scene_dispatch(
-    scenes: &[(syn::Ident, Derivation)],
+    scenes: &[(Scene, Derivation)],
     scene_type: &dyn Fn(&syn::Ident) -> syn::Ident,
 ) -> TokenStream {
     if scenes.is_empty() {
         return TokenStream::new();
     }
     let p = p();
-    let arms = scenes.iter().enumerate().map(|(i, (n, _))| {
-        let (i, ty) = (int(i), scene_type(n));
+    let arms = scenes.iter().enumerate().map(|(i, (s, _))| {
+        let (i, ty) = (int(i), scene_type(&s.name));
         quote!(#i => { let __s = #ty::from_ref(self); let __p = #p::Model::prepare::<f64>(__s); #p::Model::rhs(__s, &__p, t, __state, __inputs, __dstate) })
     });
-    let visits = scenes.iter().enumerate().map(|(i, (n, _))| {
-        let (i, ty) = (int(i), scene_type(n));
+    let visits = scenes.iter().enumerate().map(|(i, (s, _))| {
+        let (i, ty) = (int(i), scene_type(&s.name));
         quote!(#i => #p::Ok(#p::SceneVisitor::visit(__visitor, #ty::from_ref(self))),)
     });
     quote! {

@@ -87,7 +87,7 @@ impl Emitter<'_> {
         let m = ne.k;
         let mut roots: Vec<Id> = ne.dp.clone();
         roots.extend_from_slice(rhs);
-        let mut c = code(self.d, &roots, Target::Generic { hoist: false });
+        let mut c = code(&self.model.g, &roots, Target::Generic { hoist: false });
         let statements = c.take_statements();
         let a_rows = matrix(&c.outputs, 0, m, m);
         let b_rows = matrix(&c.outputs, m * m, m, width);
@@ -113,7 +113,7 @@ impl Emitter<'_> {
     pub(super) fn staged_rhs(&self, roots: &[Id]) -> (Code, TokenStream, usize) {
         let d = self.d;
         let Elimination::Numeric(ne) = &d.elimination else {
-            let c = code(d, roots, Target::Generic { hoist: true });
+            let c = code(&self.model.g, roots, Target::Generic { hoist: true });
             let body = &c.body;
             let text = quote!(#(#body)*);
             return (c, text, 0);
@@ -134,10 +134,10 @@ impl Emitter<'_> {
         for &w in &ne.w {
             o.symbol_stage.insert(w, 2);
         }
-        let mut c = code_with(d, &all, &o);
+        let mut c = code_with(&self.model.g, &all, &o);
         let eo: Vec<TokenStream> = c.outputs.drain(..head).collect();
         let width = cols.len();
-        let entry = |i: usize, j: usize| !d.model.g.is_zero(ne.dp[i * m + j]);
+        let entry = |i: usize, j: usize| !self.model.g.is_zero(ne.dp[i * m + j]);
         let solver = Solver {
             order: singleton_rows(m, entry),
             entry: &entry,
@@ -163,7 +163,7 @@ impl Emitter<'_> {
             solve_ops += 1;
         }
         let x_name = |j: usize, k: usize| format_ident!("__x_{}_{}", j, cols[k]);
-        let rhs_zero = |i: usize, k: usize| d.model.g.is_zero(ne.rhs[i * (l + 1) + cols[k]]);
+        let rhs_zero = |i: usize, k: usize| self.model.g.is_zero(ne.rhs[i * (l + 1) + cols[k]]);
         let (x_solve, x_ops) = solver.solve("__x0", width, &x_name, &rhs_zero, true);
         out.extend(x_solve);
         out.extend(c.take_stage(1));

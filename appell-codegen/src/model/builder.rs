@@ -110,9 +110,6 @@ pub(super) fn build_in(
         torques: loads.torques,
         effects: loads.effects,
         scenes,
-        quadrature: Vec::new(),
-        outputs: Vec::new(),
-        info_name: ast.name.to_string(),
         gravity: loads.gravity,
         norms: b.norms,
     };

@@ -190,13 +190,6 @@ pub struct Model {
     pub effects: Vec<String>,
     /// Declared scenes.
     pub scenes: Vec<Scene>,
-    /// Coordinates forced into the reduced state (a scene's quadrature
-    /// outputs); empty for the full model.
-    pub quadrature: Vec<usize>,
-    /// A scene's outputs (see [`Scene::outputs`]); empty for the full model.
-    pub outputs: Vec<String>,
-    /// The name the generated `ModelInfo` carries.
-    pub info_name: String,
     /// The `gravity(...)` acceleration (N components), if declared.
     pub gravity: Option<Vec3>,
     /// The squared length of every `norm(...)` and `unit(...)` argument, with
@@ -294,20 +287,6 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Kinematics> {
         _ => None,
     };
     Some(Kinematics { model, twin })
-}
-
-/// The model of one scene: loads of the scene's effects only, its
-/// quadrature coordinates kept in the state.
-pub fn scene_model(full: &Model, scene: &Scene) -> Model {
-    let mut m = full.clone();
-    m.forces.retain(|f| scene.effects.contains(&f.effect));
-    m.torques.retain(|t| scene.effects.contains(&t.effect));
-    m.effects.retain(|e| scene.effects.contains(e));
-    m.quadrature = scene.quadrature.clone();
-    m.outputs = scene.outputs.clone();
-    m.info_name = format!("{}::{}", full.name, scene.name);
-    m.scenes = Vec::new();
-    m
 }
 
 /// Whether a symbol is of a kind that may appear in a parameter-only value.
