@@ -25,6 +25,7 @@ pub mod derivation;
 pub mod emit;
 pub mod model;
 pub mod parse;
+pub mod probe;
 
 use proc_macro2::TokenStream;
 

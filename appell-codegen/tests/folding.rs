@@ -4,7 +4,8 @@
 //! otherwise be chosen (a particle bolted to a rigid arm; a gyroscope).
 
 use appell_codegen::ctxt::Ctxt;
-use appell_codegen::derivation::{derive_with, pseudo_value, Options};
+use appell_codegen::derivation::{derive_with, Options};
+use appell_codegen::probe::pseudo_value;
 use appell_codegen::{model, parse};
 use appell_symbolic::Tape;
 

@@ -17,7 +17,7 @@
 //! | 12. reduced state, cyclic coordinates (eq. 42) | [`reduction`] | equations → [`Reduction`] |
 //!
 //! Scenes ([`scenes`]) re-derive only stages 10-12 from a full derivation.
-//! [`algebra`](crate::algebra) holds the vector helpers, [`probe`] the
+//! [`algebra`](crate::algebra) holds the vector helpers, [`probe`](crate::probe) the
 //! numeric identity and rank tests, [`structure`] the sparsity analysis of
 //! square systems, [`text`] the readable equations.
 //!
@@ -33,7 +33,6 @@ pub mod folding;
 pub mod loads;
 pub mod numeric;
 pub mod partials;
-pub mod probe;
 pub mod reduction;
 pub mod remainders;
 pub mod rows;
@@ -52,7 +51,6 @@ pub use folding::Folded;
 pub use loads::Equations;
 pub use numeric::{Elimination, NumericElimination};
 pub use partials::{BodyTerms, PartialVelocities};
-pub use probe::pseudo_value;
 pub use reduction::Reduction;
 pub use remainders::Remainders;
 pub use rows::{ConstraintRows, RowSource};

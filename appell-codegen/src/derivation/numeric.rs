@@ -18,10 +18,10 @@
 use appell_symbolic::{Id, Substitution, Symbol, SymbolKind, SymbolicError};
 
 use super::elimination::SchurComplement;
-use super::probe::same_function;
 use super::rows::ConstraintRows;
 use super::speed_map::{Rates, SpeedMap};
 use crate::model::Model;
+use crate::probe::same_function;
 
 /// How the dependent speeds are obtained.
 #[derive(Clone)]

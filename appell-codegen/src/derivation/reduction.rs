@@ -15,8 +15,8 @@ use appell_symbolic::{Graph, Id, Substitution, Symbol, SymbolSet, SymbolicError,
 use super::energies::Energies;
 use super::loads::Equations;
 use super::numeric::Elimination;
-use super::probe::pseudo_value;
 use super::speed_map::SpeedMap;
+use crate::probe::pseudo_value;
 
 /// The output of stage 12.
 #[derive(Clone)]

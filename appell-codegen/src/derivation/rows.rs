@@ -16,11 +16,11 @@
 use appell_symbolic::{Id, RateRules, Symbol, SymbolKind, SymbolicError};
 use proc_macro2::TokenStream;
 
-use super::probe::same_function;
 use super::Calculus;
 use crate::algebra::{cross, dot, expanded, Vec3};
 use crate::ctxt::Ctxt;
 use crate::model::Model;
+use crate::probe::same_function;
 
 pub use appell_runtime::RowSource;
 

@@ -10,10 +10,10 @@
 
 use appell_symbolic::{Id, Symbol, SymbolKind, SymbolicError};
 
-use super::probe::dependent_row;
 use super::rows::ConstraintRows;
 use crate::ctxt::Ctxt;
 use crate::model::{Model, SpeedSpec};
+use crate::probe::dependent_row;
 
 /// The output of stage 2.
 #[derive(Clone)]

@@ -14,7 +14,6 @@ use appell_symbolic::{Graph, Id, Symbol, Tape};
 use super::elimination::SolvedRates;
 use super::numeric::{Elimination, NumericInputs};
 use super::partials::PartialVelocities;
-use super::probe::pseudo_value;
 use super::remainders::Remainders;
 use super::rows::ConstraintRows;
 use super::speed_map::{Rates, SpeedMap};
@@ -22,6 +21,7 @@ use super::speeds::SpeedDefinitions;
 use super::{elimination, numeric, partials, remainders, rows, speed_map, speeds, Calculus};
 use crate::ctxt::Ctxt;
 use crate::model::{Kinematics, Model};
+use crate::probe::pseudo_value;
 
 /// A particle of mass m on a massless rod of length l, angle q from the
 /// downward vertical, under gravity g.

@@ -140,7 +140,7 @@ impl Builder<'_> {
         roots.extend(local);
         let tape = appell_symbolic::Tape::new(g, &roots);
         for trial in 0..3u64 {
-            let env = |s: Symbol| Some(crate::derivation::pseudo_value(g, s, trial));
+            let env = |s: Symbol| Some(crate::probe::pseudo_value(g, s, trial));
             let Ok(v) = tape.eval(&env) else {
                 return Ok(false);
             };

@@ -1,7 +1,7 @@
 //! Numeric probes: questions about expressions answered by evaluating them
 //! at pseudo-random points.
 //!
-//! The derivation asks three kinds of question the engine's canonical
+//! The kinematics and the derivation ask questions the engine's canonical
 //! forms cannot settle: are two expressions the same function (an identity
 //! like sin² + cos² = 1 hidden in a product), is a row of D a combination of
 //! the others, and does a value depend on a coordinate. Each is answered in
@@ -22,7 +22,7 @@ use appell_symbolic::{Graph, Id, Symbol, SymbolKind, Tape};
 /// independence checks evaluate at such points).
 ///
 /// ```
-/// use appell_codegen::derivation::pseudo_value;
+/// use appell_codegen::probe::pseudo_value;
 /// let mut g = appell_symbolic::Graph::new();
 /// let m = g.parameter("m").unwrap();
 /// let q = g.coordinate("q").unwrap().q;
@@ -73,16 +73,7 @@ pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
     let mut first_dependent: Option<usize> = None;
     let mut trials = 0;
     for trial in 0..6u64 {
-        let value = |s: Symbol| {
-            let mut h = (s.index() as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
-                ^ (trial + 1).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-            h ^= h >> 31;
-            let u = (h >> 11) as f64 / (1u64 << 53) as f64;
-            Some(match g.symbol_kind(s) {
-                SymbolKind::Parameter => 0.5 + u,
-                _ => 2.0 * u - 1.0,
-            })
-        };
+        let value = |s: Symbol| Some(pseudo_value(g, s, trial));
         let Ok(vals) = tape.eval(&value) else {
             continue;
         };
