@@ -3,7 +3,7 @@
 //! the modules the graph is built on (symbol sets, say) can name them
 //! without depending on the graph.
 
-/// The handle of a node in a [`Graph`]. Equal ids mean equal expressions.
+/// The handle of a node in a [`Graph`](crate::Graph). Equal ids mean equal expressions.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Id(pub u32);
 
@@ -14,7 +14,7 @@ impl Id {
     }
 }
 
-/// The handle of a symbol declared in a [`Graph`].
+/// The handle of a symbol declared in a [`Graph`](crate::Graph).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord)]
 pub struct Symbol(pub(crate) u32);
 

@@ -22,6 +22,7 @@
 use crate::error::Result;
 use crate::graph::{Graph, Id, Symbol};
 
+mod code;
 mod inst;
 mod lower;
 mod passes;
@@ -33,10 +34,10 @@ mod tests;
 #[cfg(test)]
 mod token_tests;
 
+pub use code::{EmitOptions, RustCode, RustTokens};
 pub use inst::{Inst, OpCount};
 pub use passes::{LowerOptions, Pass, PassReport, ProgramSize};
 pub use syntax::{ConstantForm, RustPath, ScalarType};
-pub use writer::{EmitOptions, RustCode, RustTokens};
 
 use inst::{parameter_only_flags, use_counts};
 
