@@ -1,0 +1,286 @@
+//! The `eval` and `contacts` subcommands: answering JSON states line by
+//! line with rates, a scene's outputs or the constraint forces.
+
+use super::error::CliError;
+use super::input::{named, number, Point};
+use super::output::{contact_forces_json, finite_or_null, result_number};
+use crate::model::{Model, ModelError, ModelInfo, SceneVisitor};
+use serde_json::{json, Map, Value};
+use std::io::{BufRead, Write};
+
+// Items the documentation links to.
+#[cfg(doc)]
+use super::run_with;
+
+/// Answers every non-empty line of `stdin` on `stdout`.
+pub(super) fn eval_stream<M: Model>(
+    evaluator: &mut Evaluator<M>,
+    stdin: &mut dyn BufRead,
+    stdout: &mut dyn Write,
+) -> Result<(), CliError> {
+    let mut buf = Vec::new();
+    loop {
+        buf.clear();
+        if stdin.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        let answer = match std::str::from_utf8(&buf) {
+            Ok(line) if line.trim().is_empty() => continue,
+            Ok(line) => evaluator.eval_line(line),
+            Err(_) => json!({ "error": "the line is not valid UTF-8" }),
+        };
+        writeln!(stdout, "{answer}")?;
+        stdout.flush()?;
+    }
+    Ok(())
+}
+
+/// Evaluates `eval` lines against a model (the state of the `eval`
+/// subcommand, usable on its own).
+///
+/// Every line starts from the parameter values the model had when the
+/// evaluator was created. The accepted format is described in the module
+/// documentation; see [`run_with`] for an example through the command line.
+pub struct Evaluator<M: Model> {
+    model: M,
+    defaults: Vec<f64>,
+    scene: Option<usize>,
+    /// Answer with the constraint forces instead of the rates (`contacts`).
+    pub(super) contacts: bool,
+}
+
+impl<M: Model> Evaluator<M> {
+    /// Takes the model and records its current parameter values.
+    pub fn new(model: M) -> Result<Self, ModelError> {
+        let mut defaults = vec![0.0; M::info().parameters.len()];
+        model.parameter_values(&mut defaults)?;
+        Ok(Evaluator {
+            model,
+            defaults,
+            scene: None,
+            contacts: false,
+        })
+    }
+
+    /// An evaluator of the scene named `name` (as in `info`'s `scenes`: the
+    /// part after `::`, or the whole name).
+    pub fn with_scene(model: M, name: &str) -> Result<Self, CliError> {
+        let scenes = M::scene_infos();
+        let index = scenes
+            .iter()
+            .position(|s| s.name == name || s.name.rsplit("::").next() == Some(name))
+            .ok_or_else(|| {
+                let names: Vec<&str> = scenes.iter().map(|s| s.name).collect();
+                CliError::Usage(format!(
+                    "unknown scene `{name}`; the model's scenes: {}\n",
+                    if names.is_empty() {
+                        "none".to_string()
+                    } else {
+                        names.join(", ")
+                    }
+                ))
+            })?;
+        let mut e = Evaluator::new(model)?;
+        e.scene = Some(index);
+        Ok(e)
+    }
+
+    /// The model (with the parameters of the last evaluated line).
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// Answers one line: `{"qdot": {..}, "udot": {..}}` or
+    /// `{"error": ".."}`.
+    pub fn eval_line(&mut self, line: &str) -> Value {
+        match self.try_eval(line) {
+            Ok(v) => v,
+            Err(message) => json!({ "error": message }),
+        }
+    }
+
+    /// The info of the model or of the selected scene (a scene has the
+    /// model's coordinates, speeds and parameters but its own reduced state).
+    fn info(&self) -> &'static ModelInfo {
+        match self.scene {
+            Some(i) => M::scene_infos()[i],
+            None => M::info(),
+        }
+    }
+
+    fn try_eval(&mut self, line: &str) -> Result<Value, String> {
+        let info = self.info();
+        let value: Value =
+            serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
+        let Value::Object(obj) = value else {
+            return Err("expected a JSON object".to_string());
+        };
+        let point = self.parse_point(&obj, &[])?;
+        let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);
+        let outputs = |energies: bool, contacts: bool| {
+            let visitor = Outputs {
+                t,
+                q: &q,
+                u: &u,
+                inputs: &inputs,
+                energies,
+                contacts,
+            };
+            match self.scene {
+                Some(i) => self
+                    .model
+                    .visit_scene(i, visitor)
+                    .map_err(|e| e.to_string())?,
+                None => visitor.visit(&self.model),
+            }
+        };
+        if self.contacts {
+            let mut out = outputs(false, true)?;
+            return Ok(out.remove("contact_forces").unwrap_or(Value::Null));
+        }
+        let mut dstate = vec![0.0; info.state_len()];
+        match self.scene {
+            Some(i) => self.model.scene_rhs(i, t, &state, &inputs, &mut dstate),
+            None => {
+                let prepared = self.model.prepare::<f64>();
+                self.model.rhs(&prepared, t, &state, &inputs, &mut dstate)
+            }
+        }
+        .map_err(|e| e.to_string())?;
+        let mut qdot = vec![0.0; info.coordinates.len()];
+        self.model
+            .coordinate_rates(t, &q, &u, &mut qdot)
+            .map_err(|e| e.to_string())?;
+
+        let mut qdot_out = Map::new();
+        for (name, v) in info.coordinates.iter().zip(&qdot) {
+            qdot_out.insert(name.to_string(), result_number(*v, name)?);
+        }
+        let mut udot_out = Map::new();
+        let udot = dstate.get(info.retained.len()..).unwrap_or(&[]);
+        for (name, v) in info.speeds.iter().zip(udot) {
+            udot_out.insert(name.to_string(), result_number(*v, name)?);
+        }
+        let mut answer = Map::new();
+        answer.insert("qdot".into(), Value::Object(qdot_out));
+        answer.insert("udot".into(), Value::Object(udot_out));
+        let (energies, contacts) = (
+            info.has_output("energies"),
+            info.has_output("contact_forces"),
+        );
+        if energies || contacts {
+            answer.extend(outputs(energies, contacts)?);
+        }
+        Ok(Value::Object(answer))
+    }
+
+    /// Reads `t`, `params`, `q`, `u` and `inputs` of a JSON object (fields
+    /// in `extra` are allowed and left to the caller), sets the parameters
+    /// and assembles the reduced state.
+    pub(super) fn parse_point(
+        &mut self,
+        obj: &Map<String, Value>,
+        extra: &[&str],
+    ) -> Result<Point, String> {
+        let info = self.info();
+        for key in obj.keys() {
+            if !["t", "params", "q", "u", "inputs"].contains(&key.as_str())
+                && !extra.contains(&key.as_str())
+            {
+                let mut expected = String::from("t, params, q, u, inputs");
+                for e in extra {
+                    expected += ", ";
+                    expected += e;
+                }
+                return Err(format!("unknown field `{key}` (expected {expected})"));
+            }
+        }
+        let t = match obj.get("t") {
+            None => 0.0,
+            Some(v) => number(v, "`t`")?,
+        };
+        let params = named(obj.get("params"), "params", "parameter", info.parameters)?;
+        let q_given = named(obj.get("q"), "q", "coordinate", info.coordinates)?;
+        let u_given = named(obj.get("u"), "u", "privileged speed", info.speeds)?;
+        let inputs_given = named(obj.get("inputs"), "inputs", "input", info.inputs)?;
+
+        for (i, name) in info.parameters.iter().enumerate() {
+            let value = params[i].unwrap_or(self.defaults[i]);
+            if !self.model.set_parameter(name, value) {
+                return Err(format!("the model does not accept parameter `{name}`"));
+            }
+        }
+        for r in info.retained {
+            if info
+                .coordinate_index(r)
+                .is_some_and(|i| q_given[i].is_none())
+            {
+                return Err(format!("missing coordinate `{r}` in `q`"));
+            }
+        }
+        if let Some(k) = u_given.iter().position(Option::is_none) {
+            return Err(format!(
+                "missing privileged speed `{}` in `u`",
+                info.speeds[k]
+            ));
+        }
+        let q: Vec<f64> = q_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+        let u: Vec<f64> = u_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+        let inputs: Vec<f64> = inputs_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+
+        let mut state = Vec::with_capacity(info.state_len());
+        for r in info.retained {
+            let i = info
+                .coordinate_index(r)
+                .ok_or_else(|| format!("retained `{r}` is not a coordinate"))?;
+            state.push(q[i]);
+        }
+        state.extend_from_slice(&u);
+        Ok(Point {
+            t,
+            q,
+            u,
+            inputs,
+            state,
+        })
+    }
+}
+
+/// The outputs a scene asks for (or the `contacts` answer), computed on
+/// the scene's own type.
+struct Outputs<'a> {
+    t: f64,
+    q: &'a [f64],
+    u: &'a [f64],
+    inputs: &'a [f64],
+    energies: bool,
+    contacts: bool,
+}
+
+impl SceneVisitor for Outputs<'_> {
+    type Output = Result<Map<String, Value>, String>;
+
+    fn visit<S: Model>(self, model: &S) -> Self::Output {
+        let mut out = Map::new();
+        if self.energies {
+            let e = crate::energy::energies(model, self.t, self.q, self.u, self.inputs)
+                .map_err(|e| e.to_string())?;
+            out.insert(
+                "energies".into(),
+                json!({
+                    "kinetic": finite_or_null(e.kinetic),
+                    "potential": finite_or_null(e.potential),
+                    "rate": finite_or_null(e.rate),
+                    "input_power": finite_or_null(e.input_power),
+                }),
+            );
+        }
+        if self.contacts {
+            out.insert(
+                "contact_forces".into(),
+                contact_forces_json(model, self.t, self.q, self.u, self.inputs)?,
+            );
+        }
+        Ok(out)
+    }
+}

@@ -1,0 +1,116 @@
+//! The `accuracy` subcommand: a work-precision sweep of every integrator.
+
+use super::eval::Evaluator;
+use super::input::{number, Point};
+use super::output::finite_or_null;
+use crate::accuracy::{standard_methods, Problem};
+use crate::model::Model;
+use serde_json::{json, Value};
+
+/// The largest reduced state `accuracy` handles (the integrators work on
+/// fixed-size arrays; the sweep is compiled for every size up to this).
+pub const ACCURACY_MAX_STATE: usize = 16;
+
+/// The `accuracy` subcommand: parses one problem (an `eval` object plus
+/// `t_end`, and optionally `checkpoints` (default 10), `levels` (default 4)
+/// and `repeats` (default 3)), computes the reference and runs
+/// [`standard_methods`]`(100, levels)` over it ([`Problem::sweep`]). Returns
+/// the report as one JSON object, or why it could not.
+///
+/// The report: `{"t_end", "checkpoints", "reference_error", "points": [{"method",
+/// "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}, ..]}`
+/// with the fields of [`crate::accuracy::Point`]; methods that fail (a
+/// step-size underflow, say) are left out.
+pub fn accuracy<M: Model>(model: M, text: &str) -> Result<Value, String> {
+    let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
+    let Value::Object(obj) = value else {
+        return Err("expected a JSON object".to_string());
+    };
+    let mut evaluator = Evaluator::new(model).map_err(|e| e.to_string())?;
+    let extra = ["t_end", "checkpoints", "levels", "repeats"];
+    let point = evaluator.parse_point(&obj, &extra)?;
+    if point.t != 0.0 {
+        return Err("`t` must be 0 (or omitted): a sweep starts at t = 0".to_string());
+    }
+    let t_end = match obj.get("t_end") {
+        Some(v) => number(v, "`t_end`")?,
+        None => return Err("missing field `t_end` (the horizon)".to_string()),
+    };
+    if t_end <= 0.0 {
+        return Err(format!("`t_end` must be positive, not {t_end}"));
+    }
+    let count = |key: &str, default: usize, max: usize| -> Result<usize, String> {
+        match obj.get(key) {
+            None => Ok(default),
+            Some(v) => match v.as_u64() {
+                Some(n) if (1..=max as u64).contains(&n) => Ok(n as usize),
+                _ => Err(format!(
+                    "`{key}` must be an integer from 1 to {max}, found {v}"
+                )),
+            },
+        }
+    };
+    let checkpoints = count("checkpoints", 10, 1000)?;
+    let levels = count("levels", 4, 10)?;
+    let repeats = count("repeats", 3, 100)?;
+    let model = evaluator.model();
+    macro_rules! sizes {
+        ($($n:literal)*) => {
+            match point.state.len() {
+                $($n => sweep_report::<M, $n>(model, &point, t_end, checkpoints, levels, repeats),)*
+                n => Err(format!(
+                    "the reduced state has {n} entries; `accuracy` handles up to {ACCURACY_MAX_STATE}"
+                )),
+            }
+        };
+    }
+    sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+}
+
+fn sweep_report<M: Model, const S: usize>(
+    model: &M,
+    point: &Point,
+    t_end: f64,
+    checkpoints: usize,
+    levels: usize,
+    repeats: usize,
+) -> Result<Value, String> {
+    let mut x0 = [0.0; S];
+    x0.copy_from_slice(&point.state);
+    let problem = Problem {
+        model,
+        x0,
+        t_end,
+        inputs: &point.inputs,
+        checkpoints,
+    };
+    let (reference, estimate) = problem
+        .reference()
+        .map_err(|e| format!("the reference integration failed: {e}"))?;
+    let points = problem.sweep(
+        &reference,
+        &standard_methods(100, levels),
+        repeats,
+        |_, _| {},
+    );
+    let points: Vec<Value> = points
+        .iter()
+        .map(|p| {
+            json!({
+                "method": p.method.name(),
+                "setting": p.method.setting(),
+                "error_final": finite_or_null(p.error_final),
+                "error_max": finite_or_null(p.error_max),
+                "seconds": p.seconds,
+                "rhs_calls": p.rhs_calls,
+                "steps": p.steps,
+            })
+        })
+        .collect();
+    Ok(json!({
+        "t_end": t_end,
+        "checkpoints": checkpoints,
+        "reference_error": finite_or_null(estimate),
+        "points": points,
+    }))
+}

@@ -1,0 +1,108 @@
+//! A = ∂rhs/∂state and B = ∂rhs/∂inputs of the reduced equations, one
+//! [`Dual64`] evaluation per column.
+
+use super::checks::finite;
+use crate::model::ModelError;
+use crate::model::{check_len, Model, ModelInfo};
+use nalgebra::DMatrix;
+use num_dual::Dual64;
+
+// Items the documentation links to.
+#[cfg(doc)]
+use super::minimal_linearization;
+
+/// A linearization `ẋ ≈ f(x0, u0) + A (x − x0) + B (u − u0)` of a model's
+/// reduced equations at an operating point `(x0, u0)`. Produced by
+/// [`linearize`] and [`minimal_linearization`] (example in the module
+/// documentation).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Linearization {
+    /// ∂rhs/∂state, one row and one column per state component.
+    pub a: DMatrix<f64>,
+    /// ∂rhs/∂inputs, one row per state component, one column per input.
+    pub b: DMatrix<f64>,
+    /// The state components, in order: coordinate names, then the
+    /// privileged speeds as `"{coordinate}_dot"`.
+    pub state_names: Vec<String>,
+    /// The inputs, in [`ModelInfo::inputs`] order.
+    pub input_names: Vec<String>,
+}
+
+/// The names of the reduced state: the retained coordinates, then the
+/// privileged speeds suffixed `_dot`.
+fn state_names(info: &ModelInfo) -> Vec<String> {
+    info.retained
+        .iter()
+        .map(|r| r.to_string())
+        .chain(info.speeds.iter().map(|s| format!("{s}_dot")))
+        .collect()
+}
+
+/// A = ∂rhs/∂state and B = ∂rhs/∂inputs of the reduced equations
+/// ([`Model::rhs`], after [`Model::prepare`]) at time `t`, reduced `state`
+/// (the [retained](ModelInfo::retained) coordinates, then the privileged
+/// speeds) and `inputs`.
+///
+/// Each column is one evaluation of the generated code in [`Dual64`], seeded
+/// on that state component or input: the derivatives are exact to rounding.
+/// The operating point need not be an equilibrium (A and B are the Jacobians
+/// there; the affine term is `rhs(t, state, inputs)`). The state names are
+/// the retained coordinates, then the speeds' coordinates suffixed `_dot`.
+///
+/// Errors: wrong lengths ([`ModelError::Length`]), a non-finite argument or
+/// derivative ([`ModelError::NonFinite`]), and any error of
+/// [`Model::rhs`] at this point (a singular configuration). Example in the
+/// module documentation.
+pub fn linearize<M: Model>(
+    model: &M,
+    t: f64,
+    state: &[f64],
+    inputs: &[f64],
+) -> Result<Linearization, ModelError> {
+    let info = M::info();
+    let s = info.state_len();
+    let ni = info.inputs.len();
+    check_len("state", state, s)?;
+    check_len("inputs", inputs, ni)?;
+    finite(&[t], "t")?;
+    finite(state, "state")?;
+    finite(inputs, "inputs")?;
+
+    let prepared = model.prepare::<Dual64>();
+    let td = Dual64::from_re(t);
+    let mut x: Vec<Dual64> = state.iter().map(|&v| Dual64::from_re(v)).collect();
+    let mut w: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
+    let mut out = vec![Dual64::from_re(0.0); s];
+    let mut a = DMatrix::<f64>::zeros(s, s);
+    let mut b = DMatrix::<f64>::zeros(s, ni);
+    for j in 0..s {
+        x[j].eps = 1.0;
+        let r = model.rhs(&prepared, td, &x, &w, &mut out);
+        x[j].eps = 0.0;
+        r?;
+        for (i, o) in out.iter().enumerate() {
+            a[(i, j)] = o.eps;
+        }
+    }
+    for j in 0..ni {
+        w[j].eps = 1.0;
+        let r = model.rhs(&prepared, td, &x, &w, &mut out);
+        w[j].eps = 0.0;
+        r?;
+        for (i, o) in out.iter().enumerate() {
+            b[(i, j)] = o.eps;
+        }
+    }
+    if s + ni == 0 {
+        // Nothing to differentiate; still report a failing rhs.
+        model.rhs(&model.prepare::<f64>(), t, state, inputs, &mut [])?;
+    }
+    finite(a.as_slice(), "the state Jacobian")?;
+    finite(b.as_slice(), "the input Jacobian")?;
+    Ok(Linearization {
+        a,
+        b,
+        state_names: state_names(info),
+        input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
+    })
+}
