@@ -107,26 +107,15 @@
 //! # Cost
 //!
 //! [`linearize`] evaluates [`Model::rhs`] once per state component and input
-//! in [`Dual64`] (one instantiation of the generated code). The alternative,
-//! num-dual's vector dual number `DualSVec64<W>` carrying W columns per pass,
-//! was measured against it on derived models (release build, this project's
-//! 2-core machine, shared with other builds: medians of 7 runs, about ±15%):
-//!
-//! | model | columns | rhs ops | Dual64 columns | one `DualSVec64` pass | chunks of 4 | chunks of 8 |
-//! | --- | ---: | ---: | ---: | ---: | ---: | ---: |
-//! | triple pendulum | 6 | 125 | 0.48 µs | 0.79× | 0.90× | 1.10× |
-//! | triple pendulum on a cart (s = 7, one input) | 8 | 186 | 0.80 µs | 0.96× | 0.99× | 0.96× |
-//! | quadruple pendulum | 8 | 286 | 1.1 µs | 1.11× | 1.07× | 1.11× |
-//! | Whipple bicycle | 6 | 4,303 | 16 µs | 0.73× | 0.88× | 0.90× |
-//!
-//! The vector pass shares the real parts and the function calls, but every
-//! operation carries W derivatives behind an `Option`. It gains about a
-//! quarter on the large bicycle rhs, and only when W is the exact column
-//! count (a compile-time constant: one more instantiation of the generated
-//! rhs per width); on small models it is even or slower. The columns are
-//! therefore Dual64. `tests/linearize.rs` repeats the comparison on
-//! hand-written models (ignored test `dual64_vs_dualsvec64_timing`).
-
+//! in [`Dual64`] (one instantiation of the generated code). num-dual's
+//! vector dual number `DualSVec64<W>`, carrying W columns per pass, shares
+//! the real parts and the function calls, but every operation carries W
+//! derivatives behind an `Option`: it gains on a large rhs only when W is
+//! the exact column count (a compile-time constant, one more instantiation
+//! of the generated rhs per width), and is even or slower on small models.
+//! The columns are therefore Dual64 (the measurements are in
+//! `docs/log.md`; `tests/linearize.rs` repeats the comparison on
+//! hand-written models in the ignored test `dual64_vs_dualsvec64_timing`).
 // Items the documentation links to.
 #[cfg(doc)]
 use crate::model::Model;
