@@ -116,17 +116,13 @@ impl Builder<'_> {
             let Some(p) = self.point_named(&l.target) else {
                 continue;
             };
-            let Some(v) = self.vector(&l.vector) else {
+            let Some((vector, effect)) = self.load_value(l, &mut effects) else {
                 continue;
             };
-            let effect = l.effect.to_string();
-            if !effects.contains(&effect) {
-                effects.push(effect.clone());
-            }
             forces.push(Load {
                 point: p,
                 frame: 0,
-                vector: v,
+                vector,
                 effect,
                 weight_of: None,
             });
@@ -135,17 +131,13 @@ impl Builder<'_> {
             let Some(fi) = self.frame_named(&l.target) else {
                 continue;
             };
-            let Some(v) = self.vector(&l.vector) else {
+            let Some((vector, effect)) = self.load_value(l, &mut effects) else {
                 continue;
             };
-            let effect = l.effect.to_string();
-            if !effects.contains(&effect) {
-                effects.push(effect.clone());
-            }
             torques.push(Load {
                 point: [zero; 3],
                 frame: fi,
-                vector: v,
+                vector,
                 effect,
                 weight_of: None,
             });
@@ -156,6 +148,17 @@ impl Builder<'_> {
             torques,
             gravity,
         })
+    }
+
+    /// A force's or torque's vector and effect; a new effect is added to
+    /// `effects` in order of first use.
+    fn load_value(&mut self, l: &LoadDef, effects: &mut Vec<String>) -> Option<(Vec3, String)> {
+        let v = self.vector(&l.vector)?;
+        let effect = l.effect.to_string();
+        if !effects.contains(&effect) {
+            effects.push(effect.clone());
+        }
+        Some((v, effect))
     }
 
     /// The `rolls(...)` contacts: a rigid body, a contact point, and
