@@ -29,7 +29,30 @@ pub mod probe;
 
 use proc_macro2::TokenStream;
 
-/// Expands `#[derive(Appell)]` on `input`.
+/// Expands `#[derive(Appell)]` on `input`: the `Model` implementation, or
+/// the errors (each spanned by the attribute at fault) beside a stub.
+///
+/// ```
+/// let input: syn::DeriveInput = syn::parse_str(r#"
+///     #[appell(coordinates(q), speeds(q))]
+///     #[appell(point(P = O + l * sin(q) * N.x - l * cos(q) * N.y), particle(P, mass = m))]
+///     #[appell(gravity(-g * N.y))]
+///     struct Pendulum { m: f64, l: f64, g: f64 }
+/// "#).unwrap();
+/// let out = appell_codegen::expand(&input).to_string();
+/// assert!(out.contains("impl :: appell :: __private :: Model for Pendulum"));
+/// assert!(!out.contains("compile_error"));
+///
+/// // A misspelled coordinate is an error at the attribute, with a hint.
+/// let input: syn::DeriveInput = syn::parse_str(r#"
+///     #[appell(coordinates(q), speeds(q))]
+///     #[appell(point(P = O + l * sin(qq) * N.x), particle(P, mass = m))]
+///     struct Pendulum { m: f64, l: f64 }
+/// "#).unwrap();
+/// let out = appell_codegen::expand(&input).to_string();
+/// assert!(out.contains("compile_error"));
+/// assert!(out.contains("did you mean `q`?"), "{out}");
+/// ```
 pub fn expand(input: &syn::DeriveInput) -> TokenStream {
     let cx = ctxt::Ctxt::new();
     let ast = parse::parse(&cx, input);

@@ -164,6 +164,32 @@ pub struct Unreduced {
 
 /// Runs the derivation, the full model's and then each scene's; errors go
 /// to `cx`.
+///
+/// ```
+/// use appell_codegen::{ctxt::Ctxt, derivation, model, parse};
+///
+/// // A particle on a rod of length l, angle q from the downward vertical.
+/// let input: syn::DeriveInput = syn::parse_str(r#"
+///     #[appell(coordinates(q), speeds(q))]
+///     #[appell(point(P = O + l * sin(q) * N.x - l * cos(q) * N.y), particle(P, mass = m))]
+///     #[appell(gravity(-g * N.y))]
+///     struct Pendulum { m: f64, l: f64, g: f64 }
+/// "#).unwrap();
+/// let cx = Ctxt::new();
+/// let ast = parse::parse(&cx, &input);
+/// let kinematics = model::build(&cx, &ast).expect("a model");
+/// let derived = derivation::derive(&cx, kinematics).expect("equations");
+/// cx.check().expect("no errors");
+///
+/// // M = m l², f = −m g l sin q (Appell's equations, eq. 56).
+/// let g = &derived.model.g;
+/// let (m, f) = (derived.full.equations.mass[0], derived.full.equations.forcing[0]);
+/// let at = [("m", 2.0), ("l", 0.5), ("g", 9.81), ("q", 0.3)];
+/// let value = |e| g.eval_named(e, &at).unwrap();
+/// assert!((value(m) - 2.0 * 0.25).abs() < 1e-12);
+/// assert!((value(f) + 2.0 * 9.81 * 0.5 * 0.3_f64.sin()).abs() < 1e-12);
+/// assert!(derived.full.text.contains("M[q_dot, q_dot]"));
+/// ```
 pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
     derive_with(cx, kinematics, &Options::default())
 }
