@@ -144,9 +144,12 @@ fn newtype(
 /// code using them sees only the real errors.
 pub fn stub(name: &syn::Ident, scenes: &[syn::Ident], vis: &syn::Visibility) -> TokenStream {
     let p = p();
-    let scene_types = scenes
-        .iter()
-        .map(|sc| format_ident!("{}{}", name, camel(&sc.to_string())));
+    // Raw scene names are an error, reported elsewhere; the stub still
+    // declares a type for them, from the name without `r#`.
+    let scene_types = scenes.iter().map(|sc| {
+        let bare = syn::ext::IdentExt::unraw(sc);
+        format_ident!("{}{}", name, camel(&bare.to_string()))
+    });
     let name_str = name.to_string();
     let fail = quote!(::core::panic!(
         "the model failed to derive; see the compile errors"

@@ -156,6 +156,9 @@ impl Builder<'_> {
         let mut seen: Vec<(String, &'static str)> = Vec::new();
         let mut check = |cx: &Ctxt, ident: &Ident, what: &'static str| -> bool {
             let name = ident.to_string();
+            // Reported, but still declared: references to it resolve and
+            // raise nothing more.
+            not_raw(cx, ident, what);
             if RESERVED.contains(&name.as_str()) {
                 cx.error_spanned_by(
                     ident,
@@ -265,6 +268,9 @@ impl Builder<'_> {
                     }
                 },
                 Some(def) => {
+                    if !not_raw(self.cx, &s.name, "quasi-velocity") {
+                        continue;
+                    }
                     if self.all_names().contains(&name) {
                         self.cx.error_spanned_by(&s.name, format!("the quasi-velocity `{name}` needs a new name; `{name}` is already used"));
                         continue;
@@ -330,6 +336,21 @@ impl Builder<'_> {
             .error_spanned_by(ident, format!("unknown point `{name}`{h}"));
         None
     }
+}
+
+/// Whether `ident` is not a raw identifier (`r#type`); reports it when it
+/// is. The generated code builds other names from a model's names (`q_dot`,
+/// a scene's type name), which a raw identifier cannot form.
+pub(super) fn not_raw(cx: &Ctxt, ident: &Ident, what: &str) -> bool {
+    let name = ident.to_string();
+    let Some(bare) = name.strip_prefix("r#") else {
+        return true;
+    };
+    cx.error_spanned_by(
+        ident,
+        format!("a raw identifier cannot name a {what}, since the generated code builds other names from it; rename `{bare}`"),
+    );
+    false
 }
 
 /// "; did you mean `x`?" when `name` is close to a candidate.

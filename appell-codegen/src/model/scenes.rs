@@ -2,7 +2,7 @@
 //! outputs it asks for (`quadrature(coordinates...)`, `energies`,
 //! `contact_forces`), each checked against the model.
 
-use super::builder::{hint, Builder};
+use super::builder::{hint, not_raw, Builder};
 use super::Scene;
 use crate::ast::*;
 
@@ -92,6 +92,9 @@ impl Builder<'_> {
             }
             if scenes.iter().any(|s: &Scene| s.name == sc.name) {
                 cx.error_spanned_by(&sc.name, format!("duplicate scene `{}`", sc.name));
+                ok = false;
+            }
+            if !not_raw(cx, &sc.name, "scene") {
                 ok = false;
             }
             if ok {
