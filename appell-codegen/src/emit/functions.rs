@@ -239,7 +239,6 @@ impl Emitter<'_> {
         let p = p();
         let d = self.d;
         let model = self.model;
-        let g = &model.g;
         let (n, m) = (d.n, d.m);
         let Common {
             params_t,
@@ -267,7 +266,7 @@ impl Emitter<'_> {
                 quote!(__masses[#k] = #mass; __inertias[#k] = [#(#inertia),*];)
             })
             .collect::<Vec<_>>();
-        let (_, identity) = unit_entries(g);
+        let (_, identity) = unit_entries(model);
         let mut pose_roots = Vec::new();
         for b in &model.bodies {
             pose_roots.extend(b.center);
@@ -335,7 +334,7 @@ impl Emitter<'_> {
         let chk_q = chk("__q", n);
         let (forces, torques) = (self.forces(), self.torques());
         let (nf, nt, nc) = (forces.len(), torques.len(), model.rolling.len());
-        let (zero, identity) = unit_entries(&model.g);
+        let (zero, identity) = unit_entries(model);
         let mut geo_roots = Vec::new();
         for f in &forces {
             geo_roots.extend(f.point);
@@ -496,16 +495,9 @@ impl Emitter<'_> {
     }
 }
 
-/// The graph's zero and the identity matrix made of its zero and one.
-fn unit_entries(g: &appell_symbolic::Graph) -> (Id, [[Id; 3]; 3]) {
-    let zero = g
-        .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ZERO))
-        .expect("zero exists");
-    let one = g
-        .lookup(&appell_symbolic::Node::Num(appell_symbolic::Number::ONE))
-        .expect("one exists");
-    (
-        zero,
-        [[one, zero, zero], [zero, one, zero], [zero, zero, one]],
-    )
+/// The graph's zero and the identity matrix: N's rotation, which the
+/// model builds from them.
+fn unit_entries(model: &crate::model::Model) -> (Id, [[Id; 3]; 3]) {
+    let identity = model.frames[0].rot;
+    (identity[0][1], identity)
 }

@@ -124,8 +124,13 @@ impl Builder<'_> {
     /// points in order; a definition that fails poisons its name, so that
     /// later references to it are not reported again.
     pub(super) fn frames_and_points(&mut self, ast: &ModelAst) -> Option<()> {
-        let zero = self.g.int(0).ok()?;
-        let one = self.g.int(1).ok()?;
+        let (zero, one) = match (self.g.int(0), self.g.int(1)) {
+            (Ok(zero), Ok(one)) => (zero, one),
+            (Err(e), _) | (_, Err(e)) => {
+                engine_error(self.cx, ast.name.span(), e);
+                return None;
+            }
+        };
         self.frames.push(Frame {
             name: "N".into(),
             rot: [[one, zero, zero], [zero, one, zero], [zero, zero, one]],

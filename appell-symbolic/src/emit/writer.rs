@@ -181,10 +181,9 @@ impl<'a> Writer<'a> {
             outputs.push(self.expr(o).0);
         }
         // Constants first in each section (stable order by instruction):
-        // every statement whose name starts with `k`.
+        // the typed statements, which bind constants only.
         let split = |v: Vec<Let>| {
-            let (mut c, rest): (Vec<Let>, Vec<Let>) =
-                v.into_iter().partition(|s| s.name.starts_with('k'));
+            let (mut c, rest): (Vec<Let>, Vec<Let>) = v.into_iter().partition(|s| s.typed);
             c.extend(rest);
             c
         };
