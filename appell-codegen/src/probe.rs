@@ -44,8 +44,10 @@ pub fn pseudo_value(g: &Graph, s: Symbol, trial: u64) -> f64 {
 }
 
 /// Whether `a` and `b` are the same function: equal to 1e-10, relative, at
-/// three pseudo-random points (see [`pseudo_value`]) where they are not
-/// zero. `None` when some evaluation fails.
+/// three pseudo-random points (see [`pseudo_value`]). A point where `a` is
+/// below 1e-6 answers `false`, since a relative comparison says nothing
+/// there: two expressions that vanish together are not called equal.
+/// `None` when some evaluation fails.
 pub fn same_function(g: &Graph, a: Id, b: Id) -> Option<bool> {
     let tape = Tape::new(g, &[a, b]);
     for trial in 0..3u64 {
@@ -61,10 +63,13 @@ pub fn same_function(g: &Graph, a: Id, b: Id) -> Option<bool> {
     Some(true)
 }
 
-/// The first row of D that is numerically a combination of the rows before
-/// it at every one of three pseudo-random configurations (parameters in
-/// [0.5, 1.5], coordinates and rates in [−1, 1]). A dependence that holds only
-/// at special configurations is not reported.
+/// A row of D that is numerically a combination of the rows before it,
+/// when at each of three pseudo-random configurations (parameters in
+/// [0.5, 1.5], coordinates and rates in [−1, 1]; up to six tried, those
+/// that fail to evaluate skipped) some row is: the earliest such row found
+/// at any of them. Rows independent at one configuration are independent,
+/// so a dependence that holds only at special configurations is not
+/// reported.
 pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
     if m < 2 {
         return None;
@@ -106,6 +111,33 @@ pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
         }
     }
     first_dependent
+}
+
+/// Whether the values of `tape` stay the same (to 1e-9 of 1 + the larger magnitude) when the
+/// symbol `q` alone changes, at three pseudo-random points and two shifts.
+/// Any evaluation failure counts as a dependence.
+pub fn numerically_independent(g: &Graph, tape: &Tape, q: Symbol) -> bool {
+    for trial in 0..3u64 {
+        let base = |s: Symbol| Some(pseudo_value(g, s, trial));
+        let Ok(v0) = tape.eval(&base) else {
+            return false;
+        };
+        for shift in [0.7, 1.9] {
+            let moved =
+                |s: Symbol| Some(pseudo_value(g, s, trial) + if s == q { shift } else { 0.0 });
+            let Ok(v1) = tape.eval(&moved) else {
+                return false;
+            };
+            let same = v0
+                .iter()
+                .zip(&v1)
+                .all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs())));
+            if !same {
+                return false;
+            }
+        }
+    }
+    true
 }
 
 #[cfg(test)]

@@ -11,7 +11,7 @@
 //! produced them (S x_f − R_s [ẏ; 1] = T (D q̇ + d), tracked by an identity
 //! block beside the right sides).
 
-use appell_symbolic::{Assumptions, Id, SymMatrix, Symbol, SymbolKind, SymbolicError};
+use appell_symbolic::{Id, SymMatrix, Symbol, SymbolKind, SymbolicError};
 
 use super::speeds::SpeedDefinitions;
 use super::structure::{structural_solution, unmatched_column};
@@ -52,17 +52,6 @@ pub struct SolvedRates {
     /// differentiation, since their rate carries w = Ẋ [ẏ; 1] into the
     /// accelerations, and are set to zero afterwards.
     pub vanishing: Vec<Symbol>,
-}
-
-/// What the model declares about signs: parameters marked `positive`.
-pub fn assumptions(model: &Model) -> Assumptions {
-    let mut assume = Assumptions::new();
-    for p in &model.params {
-        if p.positive {
-            assume = assume.positive(p.symbol);
-        }
-    }
-    assume
 }
 
 /// Stage 3. `None` when errors were recorded in `cx`.
@@ -114,7 +103,7 @@ pub fn eliminate(
         );
         return Ok(None);
     }
-    let assume = assumptions(model);
+    let assume = model.assumptions();
     let g = &mut model.g;
     let dp_m = SymMatrix::from_rows(k_unknowns, k_unknowns, dp)?;
     // Without quasi-velocities the rows are the constraint rows themselves:

@@ -364,7 +364,7 @@ mod tests {
             .iter()
             .map(|b| b.frame.map(|f| m.frames[f].rot))
             .collect();
-        let assume = super::super::elimination::assumptions(&m);
+        let assume = m.assumptions();
         let found = composite_bodies(&mut m.g, &m.bodies, &rotations, &assume).unwrap();
         assert!(matches!(found[1], Composite::Member(0)));
         let Composite::Leader { mass, shift, .. } = &found[0] else {

@@ -94,7 +94,7 @@ fn force_terms(
     rules: &RateRules,
 ) -> Result<Vec<(String, Vec<Id>)>, SymbolicError> {
     let l = map.speed_rates.len();
-    let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let rates = model.coordinate_rates();
     let g = &mut model.g;
     let zero = g.int(0)?;
     let mut out = Vec::new();

@@ -5,7 +5,7 @@
 //! | --- | --- | --- |
 //! | 1. velocity constraints D q̇ + d = 0 (eq. 25) | [`rows`] | `Model` → [`ConstraintRows`] |
 //! | 2. privileged speeds, u = W q̇ + w | [`speeds`] | rows → [`SpeedDefinitions`] |
-//! | 3. elimination of the unknown rates (eq. 27) | [`elimination`] | D, d, speeds → [`SolvedRates`] |
+//! | 3. elimination of the unknown rates (eqs. 27-29) | [`elimination`] | D, d, speeds → [`SolvedRates`] |
 //! | 4. q̇ = C ẏ + c (eqs. 30-31) | [`speed_map`] | solved rates → [`SpeedMap`], [`Rates`] |
 //! | 5. numeric elimination, S X = R, S w = (Ṙ − Ṡ X)[ẏ; 1] | [`numeric`] | [`SchurComplement`] → [`NumericElimination`] |
 //! | 6. partial velocities β̄_k, γ̄_k (eq. 54) | [`partials`] | speed map → [`PartialVelocities`] |
@@ -42,7 +42,7 @@ pub mod speeds;
 pub mod structure;
 pub mod text;
 
-use appell_symbolic::{Id, RateRules, Substitution, Symbol, SymbolicError};
+use appell_symbolic::{Id, RateRules, Substitution, SymbolicError};
 
 pub use assembly::Assembled;
 pub use elimination::{SchurComplement, SolvedRates};
@@ -54,7 +54,6 @@ pub use partials::{BodyTerms, PartialVelocities};
 pub use reduction::Reduction;
 pub use remainders::Remainders;
 pub use rows::{ConstraintRows, RowSource};
-pub use scenes::derive_scene;
 pub use speed_map::{Rates, SpeedMap};
 pub use speeds::SpeedDefinitions;
 pub use structure::{singleton_rows, SingletonOrder};
@@ -210,7 +209,7 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
     };
     let mut scenes = Vec::new();
     for scene in model.scenes.clone() {
-        if let Some(d) = derive_scene(cx, &mut model, &full, &scene) {
+        if let Some(d) = scenes::derive_scene(cx, &mut model, &full, &scene) {
             scenes.push((scene, d));
         }
     }
@@ -318,7 +317,7 @@ fn stages(
         &calculus.rules,
     )?;
     let mut energies = energies::energies(model, &partials, &map)?;
-    reduction::drop_vanishing(
+    numeric::drop_vanishing(
         &mut model.g,
         &solved.vanishing,
         &mut map,
@@ -359,7 +358,6 @@ fn stages(
 
 /// Stages 8 and 9: M and f's inertial terms, folded where that is
 /// cheaper.
-#[allow(clippy::too_many_arguments)] // the outputs of stages 4 to 7, each its own type
 fn assemble_and_fold(
     model: &mut Model,
     partials: &PartialVelocities,
@@ -369,8 +367,8 @@ fn assemble_and_fold(
     calculus: &mut Calculus,
     options: &Options,
 ) -> Result<Folded, SymbolicError> {
-    let assume = elimination::assumptions(model);
-    let coordinate_rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let assume = model.assumptions();
+    let coordinate_rates = model.coordinate_rates();
     let mut assembler = assembly::Assembler {
         bodies: &model.bodies,
         partials,

@@ -15,9 +15,11 @@
 //! constraint row differentiated as the model wrote it, which shares its
 //! work with the bodies' acceleration remainders.
 
-use appell_symbolic::{Id, Substitution, Symbol, SymbolKind, SymbolicError};
+use appell_symbolic::{Graph, Id, Substitution, Symbol, SymbolKind, SymbolicError};
 
 use super::elimination::SchurComplement;
+use super::energies::Energies;
+use super::loads::Equations;
 use super::rows::ConstraintRows;
 use super::speed_map::{Rates, SpeedMap};
 use crate::model::Model;
@@ -41,10 +43,12 @@ pub struct NumericElimination {
     /// Number of unknowns solved numerically.
     pub k: usize,
     /// S (k×k), row-major.
-    pub dp: Vec<Id>,
+    pub s: Vec<Id>,
     /// R (k×(l+1)), row-major.
-    pub rhs: Vec<Id>,
-    /// (Ṙ − Ṡ X) [ẏ; 1] (k), the right side for w; contains X and ẏ.
+    pub r: Vec<Id>,
+    /// (Ṙ − Ṡ X) [ẏ; 1] (k), the right side for w; contains X and ẏ. With
+    /// the row operations T it is built as −T ∂(D q̇ + d), each constraint
+    /// row differentiated as written (see the module docs).
     pub rhs_rate: Vec<Id>,
     /// The columns j of R that are not identically zero (X_fj = 0 in the
     /// others, and their symbols occur nowhere).
@@ -59,14 +63,14 @@ impl NumericElimination {
     /// The expressions the generated code evaluates: S, R and the right
     /// side for w.
     pub fn expressions(&self) -> impl Iterator<Item = &Id> {
-        self.dp.iter().chain(&self.rhs).chain(&self.rhs_rate)
+        self.s.iter().chain(&self.r).chain(&self.rhs_rate)
     }
 
     /// The same, to rewrite in place.
     pub fn expressions_mut(&mut self) -> impl Iterator<Item = &mut Id> {
-        self.dp
+        self.s
             .iter_mut()
-            .chain(self.rhs.iter_mut())
+            .chain(self.r.iter_mut())
             .chain(self.rhs_rate.iter_mut())
     }
 }
@@ -101,7 +105,7 @@ pub fn numeric_elimination(
     let l = model.speed_specs.len();
     let k = schur.k;
     let k_unknowns = dependent.len();
-    let coordinate_rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let coordinate_rates = model.coordinate_rates();
     let (mut s_mat, mut s_rhs) = (schur.s, schur.r);
     if !schur.row_ops.is_empty() {
         let speed_cols: Vec<Symbol> = model
@@ -194,12 +198,75 @@ pub fn numeric_elimination(
     Ok(NumericElimination {
         k,
         columns,
-        dp: s_mat,
-        rhs: s_rhs,
+        s: s_mat,
+        r: s_rhs,
         rhs_rate,
         x: schur.x,
         w,
     })
+}
+
+/// Sets the symbols of X's vanishing last column to zero everywhere: they
+/// have done their work (carrying w into the accelerations).
+pub fn drop_vanishing(
+    g: &mut Graph,
+    vanishing: &[Symbol],
+    map: &mut SpeedMap,
+    equations: &mut Equations,
+    energies: &mut Energies,
+    elimination: &mut Elimination,
+) -> Result<(), SymbolicError> {
+    if vanishing.is_empty() {
+        return Ok(());
+    }
+    let zero = g.int(0)?;
+    let mut zero_x = Substitution::new();
+    for &s in vanishing {
+        zero_x.insert(s, zero);
+    }
+    let mut fix = |g: &mut Graph, e: &mut Id| -> Result<(), SymbolicError> {
+        *e = zero_x.apply(g, *e)?;
+        Ok(())
+    };
+    for e in map
+        .c
+        .iter_mut()
+        .chain(map.c0.iter_mut())
+        .chain(map.qdot.iter_mut())
+    {
+        fix(g, e)?;
+    }
+    for e in equations
+        .mass
+        .iter_mut()
+        .chain(equations.forcing.iter_mut())
+    {
+        fix(g, e)?;
+    }
+    for e in [
+        &mut energies.kinetic,
+        &mut energies.potential,
+        &mut energies.input_power,
+    ] {
+        fix(g, e)?;
+    }
+    for e in equations.inertial_terms.iter_mut().flatten() {
+        fix(g, e)?;
+    }
+    for (_, terms) in equations.load_terms.iter_mut() {
+        for e in terms.iter_mut() {
+            fix(g, e)?;
+        }
+    }
+    for (_, e) in energies.power_terms.iter_mut() {
+        fix(g, e)?;
+    }
+    if let Elimination::Numeric(ne) = elimination {
+        for e in ne.expressions_mut() {
+            fix(g, e)?;
+        }
+    }
+    Ok(())
 }
 
 /// The rate of each constraint row as written, along q̇, rates fixed. When
@@ -341,10 +408,10 @@ mod tests {
         let g = &mut run.model.g;
         assert_eq!(ne.columns, vec![0]);
         let x = g.parse("__x_0_0").unwrap();
-        let s_x = g.mul(ne.dp[0], x).unwrap();
+        let s_x = g.mul(ne.s[0], x).unwrap();
         let tan = [("__x_0_0", "sin(theta)/cos(theta)")];
         assert_agrees_with(g, s_x, "sin(theta)", &tan);
-        assert_agrees_with(g, ne.rhs[0], "sin(theta)", &tan);
+        assert_agrees_with(g, ne.r[0], "sin(theta)", &tan);
         assert_agrees_with(
             g,
             ne.rhs_rate[0],
@@ -361,7 +428,7 @@ mod tests {
         let mut run = testing::run(testing::CARTESIAN);
         let ne = numeric(&run).clone();
         let g = &mut run.model.g;
-        let w = g.div(ne.rhs_rate[0], ne.dp[0]).unwrap();
+        let w = g.div(ne.rhs_rate[0], ne.s[0]).unwrap();
         assert_agrees_with(
             g,
             w,

@@ -77,7 +77,7 @@ pub fn partial_velocities(
     rules: &RateRules,
     fixed: &Substitution,
 ) -> Result<PartialVelocities, SymbolicError> {
-    let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let rates = model.coordinate_rates();
     let l = map.speed_rates.len();
     let g = &mut model.g;
     let zero = g.int(0)?;

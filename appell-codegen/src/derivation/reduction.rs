@@ -12,11 +12,8 @@ use std::collections::BTreeSet;
 
 use appell_symbolic::{Graph, Id, Substitution, Symbol, SymbolSet, SymbolicError, Tape};
 
-use super::energies::Energies;
-use super::loads::Equations;
 use super::numeric::Elimination;
-use super::speed_map::SpeedMap;
-use crate::probe::pseudo_value;
+use crate::probe::numerically_independent;
 
 /// The output of stage 12.
 #[derive(Clone)]
@@ -154,96 +151,6 @@ fn fix_independent_coordinates(
     if let Elimination::Numeric(ne) = elimination {
         for e in ne.expressions_mut() {
             *e = fix.apply(g, *e)?;
-        }
-    }
-    Ok(())
-}
-
-/// Whether the values of `tape` stay the same (to 1e-9, relative) when the
-/// symbol `q` alone changes, at three pseudo-random points and two shifts.
-/// Any evaluation failure counts as a dependence.
-fn numerically_independent(g: &Graph, tape: &Tape, q: Symbol) -> bool {
-    for trial in 0..3u64 {
-        let base = |s: Symbol| Some(pseudo_value(g, s, trial));
-        let Ok(v0) = tape.eval(&base) else {
-            return false;
-        };
-        for shift in [0.7, 1.9] {
-            let moved =
-                |s: Symbol| Some(pseudo_value(g, s, trial) + if s == q { shift } else { 0.0 });
-            let Ok(v1) = tape.eval(&moved) else {
-                return false;
-            };
-            let same = v0
-                .iter()
-                .zip(&v1)
-                .all(|(a, b)| (a - b).abs() <= 1e-9 * (1.0 + a.abs().max(b.abs())));
-            if !same {
-                return false;
-            }
-        }
-    }
-    true
-}
-
-/// Sets the symbols of X's vanishing last column to zero everywhere: they
-/// have done their work (carrying w into the accelerations).
-pub fn drop_vanishing(
-    g: &mut Graph,
-    vanishing: &[Symbol],
-    map: &mut SpeedMap,
-    equations: &mut Equations,
-    energies: &mut Energies,
-    elimination: &mut Elimination,
-) -> Result<(), SymbolicError> {
-    if vanishing.is_empty() {
-        return Ok(());
-    }
-    let zero = g.int(0)?;
-    let mut zero_x = Substitution::new();
-    for &s in vanishing {
-        zero_x.insert(s, zero);
-    }
-    let mut fix = |g: &mut Graph, e: &mut Id| -> Result<(), SymbolicError> {
-        *e = zero_x.apply(g, *e)?;
-        Ok(())
-    };
-    for e in map
-        .c
-        .iter_mut()
-        .chain(map.c0.iter_mut())
-        .chain(map.qdot.iter_mut())
-    {
-        fix(g, e)?;
-    }
-    for e in equations
-        .mass
-        .iter_mut()
-        .chain(equations.forcing.iter_mut())
-    {
-        fix(g, e)?;
-    }
-    for e in [
-        &mut energies.kinetic,
-        &mut energies.potential,
-        &mut energies.input_power,
-    ] {
-        fix(g, e)?;
-    }
-    for e in equations.inertial_terms.iter_mut().flatten() {
-        fix(g, e)?;
-    }
-    for (_, terms) in equations.load_terms.iter_mut() {
-        for e in terms.iter_mut() {
-            fix(g, e)?;
-        }
-    }
-    for (_, e) in energies.power_terms.iter_mut() {
-        fix(g, e)?;
-    }
-    if let Elimination::Numeric(ne) = elimination {
-        for e in ne.expressions_mut() {
-            fix(g, e)?;
         }
     }
     Ok(())

@@ -1,5 +1,6 @@
 //! Stage 7: acceleration remainders, the accelerations with ÿ = 0 (eq. 37,
-//! corrected; see the paper's notes).
+//! which reads, with the OCR slip of the printed text mended,
+//! r̈ = Σ_k (β̄_k ÿ_k + β̄̇_k ẏ_k) + β̄̇: the remainder is its last two terms).
 //!
 //! For a velocity v(q, q̇, t) linear in q̇ the remainder is
 //! Σ_s ∂v/∂q_s q̇_s + ∂v/∂t (the directional derivative along q̇, rates held

@@ -13,7 +13,7 @@
 //! vanishes on the constrained motion ("complete"), in which case the rate
 //! of v·e is (rate of v)·e.
 
-use appell_symbolic::{Id, RateRules, Symbol, SymbolKind, SymbolicError};
+use appell_symbolic::{Id, RateRules, SymbolKind, SymbolicError};
 use proc_macro2::TokenStream;
 
 use super::Calculus;
@@ -317,7 +317,7 @@ fn linear_rows(
     holonomic: Vec<Id>,
     contacts: Vec<ContactMotion>,
 ) -> ConstraintRows {
-    let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let rates = model.coordinate_rates();
     let mut out = ConstraintRows {
         holonomic,
         d: Vec::new(),

@@ -2,13 +2,13 @@
 //!
 //! Each speed is defined by u = W q̇ + w: a unit row of W for a coordinate
 //! rate (Method II), or the defining combination of a quasi-velocity
-//! (Method III, eq. 56), which must be linear in q̇. The stage checks that
+//! (Method III), which must be linear in q̇. The stage checks that
 //! the constraint rows are independent, that l + m = n, that [D; W] is
 //! invertible with quasi-velocities, and that each holonomic constraint
 //! involves a dependent coordinate. The unknowns are the dependent rates ż
 //! (Method II) or every rate (Method III, [D; W] q̇ = [−d; u − w]).
 
-use appell_symbolic::{Id, Symbol, SymbolKind, SymbolicError};
+use appell_symbolic::{Id, SymbolKind, SymbolicError};
 
 use super::rows::ConstraintRows;
 use crate::ctxt::Ctxt;
@@ -115,7 +115,7 @@ fn quasi_velocity_row(
     spec: &SpeedSpec,
     def: Id,
 ) -> Option<(Vec<Id>, Id)> {
-    let rates: Vec<Symbol> = model.coords.iter().map(|(_, c)| c.rate).collect();
+    let rates = model.coordinate_rates();
     let bad: Vec<String> = model
         .g
         .dependencies(def)
@@ -156,7 +156,7 @@ fn quasi_velocity_row(
         Err(SymbolicError::NonLinear { symbol, .. }) => {
             cx.error_spanned_by(
                 &model.speeds_at,
-                format!("the quasi-velocity `{}` must be linear in the coordinate rates (Method III, eq. 56), and it is not linear in `{symbol}`", spec.name),
+                format!("the quasi-velocity `{}` must be linear in the coordinate rates (Method III), and it is not linear in `{symbol}`", spec.name),
             );
             None
         }

@@ -48,9 +48,9 @@ pub(super) struct Common {
     bind_u: TokenStream,
     pub(super) bind_inputs: TokenStream,
     /// S X = R and S w = … solved (M and f need w).
-    elim_full: TokenStream,
+    solve_x_and_w: TokenStream,
     /// S X = R solved.
-    elim_pos: TokenStream,
+    solve_x: TokenStream,
 }
 
 impl Emitter<'_> {
@@ -65,8 +65,8 @@ impl Emitter<'_> {
             bind_qdot: self.bind_qdot("__qdot"),
             bind_u: self.bind_u("__u"),
             bind_inputs: self.bind_inputs("__inputs"),
-            elim_full: self.elimination(true),
-            elim_pos: self.elimination(false),
+            solve_x_and_w: self.elimination(true),
+            solve_x: self.elimination(false),
         };
         let rhs = self.rhs(&common);
         let info = &rhs.info;
@@ -140,8 +140,8 @@ impl Emitter<'_> {
             bind_qdot,
             bind_u,
             bind_inputs,
-            elim_full,
-            elim_pos,
+            solve_x_and_w,
+            solve_x,
             ..
         } = c;
         let ni = self.model.inputs.len();
@@ -192,7 +192,7 @@ impl Emitter<'_> {
         let (ke_body, ke_out) = single(d.energies.kinetic);
         let checks_mf = [chk("__m", l * l), chk("__f", l)];
         let mf_fn = braced([
-            quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #elim_full),
+            quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #solve_x_and_w),
             mf_body,
             quote!(#mf_m #mf_f #p::Ok(())),
         ]);
@@ -203,11 +203,11 @@ impl Emitter<'_> {
         quote! {
             fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
             fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_ct)* #pos #params_t #bind_q #elim_pos #ct_body #ct_c #ct_c0
+                #chk_q #(#checks_ct)* #pos #params_t #bind_q #solve_x #ct_body #ct_c #ct_c0
                 #p::Ok(())
             }
             fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #elim_pos #cr_body #cr_out
+                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #solve_x #cr_body #cr_out
                 #p::Ok(())
             }
             fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
@@ -219,7 +219,7 @@ impl Emitter<'_> {
                 #p::Ok(())
             }
             fn input_power<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
-                #chk_q #chk_u #chk_inputs #params_t #bind_q #bind_u #bind_inputs #elim_pos #ip_body
+                #chk_q #chk_u #chk_inputs #params_t #bind_q #bind_u #bind_inputs #solve_x #ip_body
                 #p::Ok(#ip_out)
             }
             fn potential_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T]) -> #p::Result<__T, #p::ModelError> {
@@ -227,7 +227,7 @@ impl Emitter<'_> {
                 #p::Ok(#pe_out)
             }
             fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> {
-                #chk_q #chk_u #pos #params_t #bind_q #bind_u #elim_pos #ke_body
+                #chk_q #chk_u #pos #params_t #bind_q #bind_u #solve_x #ke_body
                 #p::Ok(#ke_out)
             }
         }

@@ -1,30 +1,32 @@
 //! The `Model` implementation, built with `quote!`.
 //!
 //! Every numeric function is one straight-line program lowered by the engine
-//! (shared subexpressions bound once, see [`code`]), generic over the scalar
-//! `__T`. The reduced rhs reads parameter-only values from `Prepared`,
-//! computed once per parameter set, solves the numeric part of the
-//! elimination ([`solve`]) and Appell's equations by an unrolled LDLᵀ
-//! factorization ([`ldlt`]). [`info`] writes the `ModelInfo` metadata and
-//! [`functions`] the trait's methods. Paths go through `::appell::__private`;
-//! everything is wrapped in `const _: () = { ... };`, beside the scene
-//! newtypes ([`scenes`]).
+//! (shared subexpressions bound once; `code.rs`), generic over the scalar
+//! `__T`. The reduced rhs (`rhs.rs`) reads parameter-only values from
+//! `Prepared`, computed once per parameter set, solves the numeric part of
+//! the elimination (`solve.rs`) and Appell's equations by an unrolled LDLᵀ
+//! factorization (`ldlt.rs`). `info.rs` writes the `ModelInfo` metadata and
+//! `functions.rs` the other trait methods. Paths go through
+//! `::appell::__private`; everything is wrapped in `const _: () = { ... };`,
+//! beside the scene newtypes (`scenes.rs`). On errors, [`stub`] stands in.
 
-pub mod code;
-pub mod functions;
-pub mod info;
-pub mod ldlt;
-pub mod rhs;
-pub mod scenes;
-pub mod solve;
+mod code;
+mod functions;
+mod info;
+mod ldlt;
+mod rhs;
+mod scenes;
+mod solve;
+mod stub;
 
 use proc_macro2::{Literal, TokenStream};
 use quote::{format_ident, quote};
 
-use crate::derivation::Derivation;
+use crate::derivation::{Derivation, Derived};
 use crate::model::{Load, Model, Scene};
+use scenes::{info_static, newtype, scene_dispatch};
 
-pub use scenes::{emit, stub};
+pub use stub::stub;
 
 /// The runtime's items, as the generated code reaches them.
 fn p() -> TokenStream {
@@ -37,7 +39,7 @@ fn int(i: usize) -> Literal {
 }
 
 /// One `Model` implementation: the full model's or a scene's.
-pub struct Emitter<'a> {
+struct Emitter<'a> {
     /// The model; its graph holds every expression.
     model: &'a Model,
     /// The equations: the full model's or the scene's.
@@ -198,4 +200,62 @@ fn camel(s: &str) -> String {
             }
         })
         .collect()
+}
+
+/// The `Model` implementations: the full model's, and one per scene on a
+/// generated newtype (`{Model}{Scene}(pub Model)`), all in one `const _`
+/// block; the scene types are declared beside the struct.
+pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
+    let p = p();
+    let (model, full, scenes) = (&derived.model, &derived.full, &derived.scenes);
+    let base = &model.name;
+    let scene_type = |name: &syn::Ident| format_ident!("{}{}", base, camel(&name.to_string()));
+    let scene_infos = scenes.iter().map(|(s, _)| info_static(&s.name));
+    let count = int(scenes.len());
+    let mut body = quote! {
+        static __SCENES: [&#p::ModelInfo; #count] = [#(&#scene_infos),*];
+    };
+    body.extend(
+        Emitter {
+            model,
+            d: full,
+            scene: None,
+            type_name: base.clone(),
+            this: quote!(self),
+            info_ident: format_ident!("__INFO"),
+            scene_infos: quote!(&__SCENES),
+            scene_rhs: scene_dispatch(scenes, &scene_type),
+        }
+        .implementation(),
+    );
+    let mut decls = TokenStream::new();
+    for (scene, d) in scenes {
+        let name = &scene.name;
+        let emitter = Emitter {
+            model,
+            d,
+            scene: Some(scene),
+            type_name: scene_type(name),
+            this: quote!(self.0),
+            info_ident: info_static(name),
+            scene_infos: quote!(&[]),
+            scene_rhs: TokenStream::new(),
+        };
+        decls.extend(newtype(
+            base,
+            &emitter.type_name,
+            name,
+            &emitter.effects(),
+            vis,
+        ));
+        body.extend(emitter.implementation());
+    }
+    quote! {
+        #decls
+        const _: () = {
+            #[allow(unused_imports)]
+            use #p::Scalar as _;
+            #body
+        };
+    }
 }

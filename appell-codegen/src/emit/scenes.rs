@@ -1,86 +1,24 @@
-//! The derive's output: the scene newtypes beside the struct, and in one
-//! `const _` block the full model's implementation and one per scene.
-//!
-//! A scene `name` of model `Model` is a `repr(transparent)` newtype
-//! `ModelName(pub Model)` whose implementation reads the parameters through
-//! `self.0`; the full model reaches its scenes through `scene_rhs` and
-//! `visit_scene`. On errors, [`stub`] stands in for the implementation so
-//! that the user sees only the real errors.
+//! Scenes in the generated code. A scene `name` of model `Model` is a
+//! `repr(transparent)` newtype `ModelName(pub Model)` whose implementation
+//! reads the parameters through `self.0`; the full model reaches its scenes
+//! through `scene_rhs` and `visit_scene`.
 
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use super::{camel, int, p, Emitter};
-use crate::derivation::{Derivation, Derived};
+use super::{int, p};
+use crate::derivation::Derivation;
 use crate::model::Scene;
-
-/// The `Model` implementations: the full model's, and one per scene on a
-/// generated newtype (`{Model}{Scene}(pub Model)`), all in one `const _`
-/// block; the scene types are declared beside the struct.
-pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
-    let p = p();
-    let (model, full, scenes) = (&derived.model, &derived.full, &derived.scenes);
-    let base = &model.name;
-    let scene_type = |name: &syn::Ident| format_ident!("{}{}", base, camel(&name.to_string()));
-    let scene_infos = scenes.iter().map(|(s, _)| info_static(&s.name));
-    let count = int(scenes.len());
-    let mut body = quote! {
-        static __SCENES: [&#p::ModelInfo; #count] = [#(&#scene_infos),*];
-    };
-    body.extend(
-        Emitter {
-            model,
-            d: full,
-            scene: None,
-            type_name: base.clone(),
-            this: quote!(self),
-            info_ident: format_ident!("__INFO"),
-            scene_infos: quote!(&__SCENES),
-            scene_rhs: scene_dispatch(scenes, &scene_type),
-        }
-        .implementation(),
-    );
-    let mut decls = TokenStream::new();
-    for (scene, d) in scenes {
-        let name = &scene.name;
-        let emitter = Emitter {
-            model,
-            d,
-            scene: Some(scene),
-            type_name: scene_type(name),
-            this: quote!(self.0),
-            info_ident: info_static(name),
-            scene_infos: quote!(&[]),
-            scene_rhs: TokenStream::new(),
-        };
-        decls.extend(newtype(
-            base,
-            &emitter.type_name,
-            name,
-            &emitter.effects(),
-            vis,
-        ));
-        body.extend(emitter.implementation());
-    }
-    quote! {
-        #decls
-        const _: () = {
-            #[allow(unused_imports)]
-            use #p::Scalar as _;
-            #body
-        };
-    }
-}
 
 /// The `ModelInfo` static of scene `name`. Named at the call site: a span
 /// in the user's attribute would make the compiler's lints on generated
 /// items (an upper-case static name) point at the user's code.
-fn info_static(name: &syn::Ident) -> syn::Ident {
+pub(super) fn info_static(name: &syn::Ident) -> syn::Ident {
     format_ident!("__INFO_{}", name, span = proc_macro2::Span::call_site())
 }
 
 /// The full model's `scene_rhs` and `visit_scene` (nothing without scenes).
-fn scene_dispatch(
+pub(super) fn scene_dispatch(
     scenes: &[(Scene, Derivation)],
     scene_type: &dyn Fn(&syn::Ident) -> syn::Ident,
 ) -> TokenStream {
@@ -113,7 +51,7 @@ fn scene_dispatch(
 }
 
 /// A scene's newtype and its `from_ref`.
-fn newtype(
+pub(super) fn newtype(
     base: &syn::Ident,
     ty: &syn::Ident,
     name: &syn::Ident,
@@ -136,56 +74,5 @@ fn newtype(
                 unsafe { &*(model as *const #base as *const Self) }
             }
         }
-    }
-}
-
-/// A stub implementation emitted beside errors, so the user sees only the
-/// real ones (thiserror's fallback). The scene types are declared too, so
-/// code using them sees only the real errors.
-pub fn stub(name: &syn::Ident, scenes: &[syn::Ident], vis: &syn::Visibility) -> TokenStream {
-    let p = p();
-    // Raw scene names are an error, reported elsewhere; the stub still
-    // declares a type for them, from the name without `r#`.
-    let scene_types = scenes.iter().map(|sc| {
-        let bare = syn::ext::IdentExt::unraw(sc);
-        format_ident!("{}{}", name, camel(&bare.to_string()))
-    });
-    let name_str = name.to_string();
-    let fail = quote!(::core::panic!(
-        "the model failed to derive; see the compile errors"
-    ));
-    quote! {
-        #(
-            #[allow(dead_code)]
-            #vis struct #scene_types(pub #name);
-        )*
-        const _: () = {
-            static __INFO: #p::ModelInfo = #p::ModelInfo {
-                name: #name_str, parameters: &[], coordinates: &[], speeds: &[], dependent: &[], cyclic: &[],
-                ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], holonomic: 0, constraints: 0,
-                row_sources: &[], contacts: &[],
-                bodies: &[], force_points: 0, torques: 0, symbolic_elimination: true,
-                rhs_ops: #p::OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
-            };
-            #[allow(unused_variables, clippy::all)]
-            impl #p::Model for #name {
-                type Prepared<__T: #p::Scalar> = [__T; 0];
-                fn info() -> &'static #p::ModelInfo { &__INFO }
-                fn parameter_values(&self, __out: &mut [f64]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn set_parameter(&mut self, __name: &str, __value: f64) -> bool { #fail }
-                fn prepare<__T: #p::Scalar>(&self) -> [__T; 0] { #fail }
-                fn rhs<__T: #p::Scalar>(&self, __p: &[__T; 0], t: __T, __s: &[__T], __i: &[__T], __d: &mut [__T]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __i: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qd: &mut [__T]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qd: &[__T], __h: &mut [__T], __v: &mut [__T]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> { #fail }
-                fn mass_properties(&self, __m: &mut [f64], __i: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn body_poses<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __p: &mut [[__T; 3]], __r: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn load_geometry<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __p: &mut [[__T; 3]], __f: &mut [[__T; 9]]) -> #p::Result<(), #p::ModelError> { #fail }
-                fn load_values<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qd: &[__T], __i: &[__T], __f: &mut [[__T; 3]], __t: &mut [[__T; 3]]) -> #p::Result<(), #p::ModelError> { #fail }
-            }
-        };
     }
 }

@@ -44,7 +44,7 @@ impl Emitter<'_> {
         let mi = int(m);
         let wi = int(cols.len());
         let rhs: Vec<Id> = (0..m)
-            .flat_map(|i| cols.iter().map(move |&j| ne.rhs[i * (l + 1) + j]))
+            .flat_map(|i| cols.iter().map(move |&j| ne.r[i * (l + 1) + j]))
             .collect();
         let first = self.lu_block(ne, &rhs, cols.len(), 0);
         let binds = (0..m).flat_map(|i| {
@@ -85,7 +85,7 @@ impl Emitter<'_> {
     ) -> TokenStream {
         let p = p();
         let m = ne.k;
-        let mut roots: Vec<Id> = ne.dp.clone();
+        let mut roots: Vec<Id> = ne.s.clone();
         roots.extend_from_slice(rhs);
         let mut c = code(&self.model.g, &roots, Target::Generic { hoist: false });
         let statements = c.take_statements();
@@ -120,9 +120,9 @@ impl Emitter<'_> {
         };
         let (m, l) = (ne.k, d.l);
         let cols = &ne.columns;
-        let mut all: Vec<Id> = ne.dp.clone();
+        let mut all: Vec<Id> = ne.s.clone();
         for i in 0..m {
-            all.extend(cols.iter().map(|&j| ne.rhs[i * (l + 1) + j]));
+            all.extend(cols.iter().map(|&j| ne.r[i * (l + 1) + j]));
         }
         all.extend(&ne.rhs_rate);
         let head = all.len();
@@ -137,7 +137,7 @@ impl Emitter<'_> {
         let mut c = code_with(&self.model.g, &all, &o);
         let eo: Vec<TokenStream> = c.outputs.drain(..head).collect();
         let width = cols.len();
-        let entry = |i: usize, j: usize| !self.model.g.is_zero(ne.dp[i * m + j]);
+        let entry = |i: usize, j: usize| !self.model.g.is_zero(ne.s[i * m + j]);
         let solver = Solver {
             order: singleton_rows(m, entry),
             entry: &entry,
@@ -163,7 +163,7 @@ impl Emitter<'_> {
             solve_ops += 1;
         }
         let x_name = |j: usize, k: usize| format_ident!("__x_{}_{}", j, cols[k]);
-        let rhs_zero = |i: usize, k: usize| self.model.g.is_zero(ne.rhs[i * (l + 1) + cols[k]]);
+        let rhs_zero = |i: usize, k: usize| self.model.g.is_zero(ne.r[i * (l + 1) + cols[k]]);
         let (x_solve, x_ops) = solver.solve("__x0", width, &x_name, &rhs_zero, true);
         out.extend(x_solve);
         out.extend(c.take_stage(1));

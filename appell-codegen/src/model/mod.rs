@@ -24,7 +24,7 @@ mod scenes;
 
 use syn::Ident;
 
-use appell_symbolic::{Coordinate, Graph, Id, RateRules, Symbol, SymbolKind};
+use appell_symbolic::{Coordinate, Graph, Id, RateRules, Symbol};
 
 use crate::ast::ModelAst;
 use crate::ctxt::Ctxt;
@@ -198,6 +198,24 @@ pub struct Model {
     pub norms: Vec<(Id, String)>,
 }
 
+impl Model {
+    /// The symbols q̇_r of the coordinates' rates, in order.
+    pub fn coordinate_rates(&self) -> Vec<Symbol> {
+        self.coords.iter().map(|(_, c)| c.rate).collect()
+    }
+
+    /// What the model declares about signs: parameters marked `positive`.
+    pub fn assumptions(&self) -> appell_symbolic::Assumptions {
+        let mut assume = appell_symbolic::Assumptions::new();
+        for p in &self.params {
+            if p.positive {
+                assume = assume.positive(p.symbol);
+            }
+        }
+        assume
+    }
+}
+
 /// A direction cosine standing as a symbol in the twin model: its rate is a
 /// component of ω × column, so a derivative through nested rotations stays
 /// a few cross products instead of the product rule over every factor of
@@ -287,9 +305,4 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Kinematics> {
         _ => None,
     };
     Some(Kinematics { model, twin })
-}
-
-/// Whether a symbol is of a kind that may appear in a parameter-only value.
-pub fn is_parameter(g: &Graph, s: Symbol) -> bool {
-    g.symbol_kind(s) == SymbolKind::Parameter
 }
