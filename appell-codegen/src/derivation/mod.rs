@@ -16,7 +16,10 @@
 //! | 11. energies | [`energies`] | partials → [`Energies`] |
 //! | 12. reduced state, cyclic coordinates (eq. 42) | [`reduction`] | equations → [`Reduction`] |
 //!
-//! Scenes ([`scenes`]) re-derive only stages 10-12 from a full derivation.
+//! Between stages 11 and 12, X's identically zero last column (kept so far
+//! because its rate carries w) is set to zero everywhere
+//! ([`numeric::drop_vanishing`]). Scenes ([`scenes`]) re-derive only stages
+//! 10-12 from a full derivation.
 //! [`algebra`](crate::algebra) holds the vector helpers, [`probe`](crate::probe) the
 //! numeric identity and rank tests, [`structure`] the sparsity analysis of
 //! square systems, [`text`] the readable equations.

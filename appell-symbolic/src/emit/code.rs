@@ -13,7 +13,8 @@ use crate::graph::Symbol;
 use super::inst::OpCount;
 use super::syntax::{ConstantForm, RustPath, ScalarType};
 
-/// Choices for [`Program::to_rust`](super::Program::to_rust).
+/// Choices for [`Program::to_rust`](super::Program::to_rust) and
+/// [`Program::to_tokens`](super::Program::to_tokens).
 #[derive(Clone, Debug)]
 pub struct EmitOptions {
     /// The scalar type in the emitted code (a generic parameter or a

@@ -345,9 +345,9 @@ impl Frag {
 /// A float literal as tokens: a `-` for a negative value, then the
 /// magnitude (suffixed for [`ConstantForm::F64Literal`]). The literal is
 /// built from the value, so it reads back as exactly that `f64`; its
-/// spelling is the shortest decimal that does (`0.5`, `2.0`; very small and
-/// very large magnitudes in positional notation, where the text form writes
-/// an exponent).
+/// spelling is the shortest decimal that does: unsuffixed `0.5`, `2.0`,
+/// suffixed `0.5f64`, `2f64`, `0f64`; very small and very large magnitudes
+/// in positional notation, where the text form writes an exponent.
 fn float_tokens(x: f64, form: &ConstantForm) -> TokenStream {
     let mut out = TokenStream::new();
     if x.is_sign_negative() {
