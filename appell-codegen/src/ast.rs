@@ -117,6 +117,10 @@ pub struct ConstraintDef {
     pub lhs: Expr,
     /// Right side.
     pub rhs: Expr,
+    /// For an equation between points or vectors: the directions its
+    /// components are taken along (`along = [N.x, N.y]`); N's axes when
+    /// absent.
+    pub along: Option<Vec<Expr>>,
     /// The whole constraint's tokens, for errors that underline it.
     pub at: proc_macro2::TokenStream,
 }

@@ -498,10 +498,31 @@ fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {
 
 fn parse_constraint(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<ConstraintDef> {
     let e: syn::Expr = s.parse()?;
+    let mut along = None;
+    for (k, v) in key_values(s)? {
+        match (k.to_string().as_str(), &v) {
+            ("along", syn::Expr::Array(a)) => {
+                along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?)
+            }
+            ("along", other) => {
+                return Err(syn::Error::new(
+                    other.span(),
+                    "`along` takes a list of directions: `along = [N.x, N.y]`",
+                ))
+            }
+            (other, _) => {
+                return Err(syn::Error::new(
+                    k.span(),
+                    format!("unknown constraint property `{other}`; an equation between points or vectors takes `along = [u, v]`"),
+                ))
+            }
+        }
+    }
     match &e {
         syn::Expr::Binary(b) if matches!(b.op, syn::BinOp::Eq(_)) => Ok(ConstraintDef {
             lhs: convert(&b.left)?,
             rhs: convert(&b.right)?,
+            along,
             at,
         }),
         _ => Err(syn::Error::new(

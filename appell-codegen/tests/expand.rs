@@ -98,3 +98,77 @@ fn ldlt_keeps_a_pivots_reciprocal_where_it_saves_a_division_or_waits_for_f() {
     assert!(!out.contains("__z_0 / __d_0"), "{out}");
     assert!(!out.contains("__z_1 / __d_1"), "{out}");
 }
+
+/// A planar four-bar: crank O–P1, coupler P1–P2, rocker from D = O + d N.x
+/// to P3; the loop closes where P2 meets P3.
+fn four_bar(closure: &str) -> String {
+    format!(
+        r#"
+        #[appell(coordinates(q1, q2, q3), speeds(q1))]
+        #[appell(frame(A = N.rotate_z(q1)), frame(B = N.rotate_z(q2)), frame(C = N.rotate_z(q3)))]
+        #[appell(point(P1 = O + l1 * A.x), point(P2 = P1 + l2 * B.x), point(P3 = O + d * N.x + l3 * C.x))]
+        #[appell(particle(P1, mass = m1), particle(P2, mass = m2))]
+        #[appell(gravity(-g * N.y))]
+        {closure}
+        struct FourBar {{ m1: f64, m2: f64, l1: f64, l2: f64, l3: f64, d: f64, g: f64 }}
+        "#
+    )
+}
+
+#[test]
+fn a_loop_closed_by_two_points_is_its_planar_components() {
+    // P2 == P3 gives the N.x and N.y rows (the N.z row is identically zero
+    // and dropped): the same equations as the two scalar rows written out.
+    let by_points = expand_str(&four_bar("#[appell(holonomic(P2 == P3))]"));
+    let by_rows = expand_str(&four_bar(
+        "#[appell(holonomic(dot(P2 - P3, N.x) == 0), holonomic(dot(P2 - P3, N.y) == 0))]",
+    ));
+    assert!(!by_points.contains("compile_error"), "{by_points}");
+    assert_eq!(by_points, by_rows);
+    // `along` picks the components; the difference can also face `0`.
+    let along = expand_str(&four_bar(
+        "#[appell(holonomic(P2 - P3 == 0, along = [N.x, N.y]))]",
+    ));
+    assert_eq!(along, by_rows);
+}
+
+#[test]
+fn sides_of_different_kinds_are_an_error_that_says_what_to_write() {
+    let out = expand_str(&four_bar("#[appell(holonomic(P2 == l1))]"));
+    assert!(out.contains("a point and a scalar"), "{out}");
+    let out = expand_str(&four_bar("#[appell(holonomic(P2 == P3, along = [N.z]))]"));
+    assert!(
+        out.contains("identically zero: it constrains nothing"),
+        "{out}"
+    );
+    let out = expand_str(&four_bar("#[appell(holonomic(q1 == q2, along = [N.x]))]"));
+    assert!(
+        out.contains("`along` is for an equation between points or vectors"),
+        "{out}"
+    );
+}
+
+#[test]
+fn a_velocity_equation_between_vectors_is_its_components() {
+    // v(P) = ẋ (N.x + N.y + N.z): the N.x row is identically zero and
+    // dropped, the others are ẏ = ẋ and ż = ẋ.
+    let model = |c: &str| {
+        format!(
+            r#"
+            #[appell(coordinates(x, y, z), speeds(x))]
+            #[appell(point(P = O + x * N.x + y * N.y + z * N.z), particle(P, mass = m))]
+            {c}
+            struct Glide {{ m: f64 }}
+            "#
+        )
+    };
+    let by_vectors = expand_str(&model(
+        "#[appell(nonholonomic(velocity(P) == dt(x) * (N.x + N.y + N.z)))]",
+    ));
+    let by_rows = expand_str(&model(
+        "#[appell(nonholonomic(dt(y) - dt(x) == 0), nonholonomic(dt(z) - dt(x) == 0))]",
+    ));
+    assert!(!by_vectors.contains("compile_error"), "{by_vectors}");
+    assert!(by_vectors.contains("constraints : 2"), "{by_vectors}");
+    assert_eq!(by_vectors, by_rows);
+}

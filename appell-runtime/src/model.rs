@@ -45,14 +45,18 @@ pub struct BodyInfo {
 /// the `nonholonomic(...)` ones, then the components of each `rolls(...)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RowSource {
-    /// The time derivative of the `index`-th `holonomic(...)` constraint.
+    /// The time derivative of the `index`-th holonomic constraint.
     Holonomic {
-        /// Declaration index among the holonomic constraints.
+        /// Index among the scalar holonomic constraints, in declaration
+        /// order (an equation between points contributes one per
+        /// component it keeps).
         index: usize,
     },
-    /// The `index`-th `nonholonomic(...)` constraint.
+    /// The `index`-th nonholonomic constraint.
     Nonholonomic {
-        /// Declaration index among the nonholonomic constraints.
+        /// Index among the scalar nonholonomic constraints, in declaration
+        /// order (an equation between vectors contributes one per
+        /// component it keeps).
         index: usize,
     },
     /// The velocity component e·v of the body's material point at a rolling

@@ -1,6 +1,8 @@
 //! Points, bodies, constraints, loads and rolling contacts.
 
-use appell_symbolic::Id;
+use appell_symbolic::{Id, SymbolicError};
+
+use crate::algebra::dot;
 
 use super::builder::{hint, Builder};
 use super::expr::Val;
@@ -71,20 +73,105 @@ impl Builder<'_> {
         })
     }
 
-    pub(super) fn constraint(&mut self, c: &ConstraintDef) -> Option<Constraint> {
+    /// A constraint's residuals, lhs − rhs: one for an equation between
+    /// scalars; for one between points or vectors (a loop closure), one per
+    /// component along N's axes, identically zero ones dropped, or along the
+    /// `along` directions. Either side may be the literal `0`.
+    pub(super) fn constraint(&mut self, c: &ConstraintDef) -> Vec<Constraint> {
         self.context = "a constraint".to_string();
-        let l = self.scalar(&c.lhs)?;
-        let r = self.scalar(&c.rhs)?;
-        match self.g.sub(l, r) {
-            Ok(residual) => Some(Constraint {
-                residual,
-                at: c.at.clone(),
-            }),
+        let residuals = match self.constraint_sides(c) {
+            Some(Side::Scalar(l, r)) => {
+                if let Some(first) = c.along.as_ref().and_then(|a| a.first()) {
+                    self.cx.error_at(
+                        first.span(),
+                        "`along` is for an equation between points or vectors; this one is between scalars",
+                    );
+                    return Vec::new();
+                }
+                self.g.sub(l, r).map(|e| vec![e])
+            }
+            Some(Side::Vector(l, r)) => self.vector_residuals(c, l, r),
+            None => return Vec::new(),
+        };
+        match residuals {
+            Ok(v) => v
+                .into_iter()
+                .map(|residual| Constraint {
+                    residual,
+                    at: c.at.clone(),
+                })
+                .collect(),
             Err(e) => {
                 self.cx.error_spanned_by(&c.at, e);
+                Vec::new()
+            }
+        }
+    }
+
+    /// Both sides of `c`, as scalars or as vectors (a point's position, or
+    /// zero where a side is the literal `0` facing a point or a vector).
+    fn constraint_sides(&mut self, c: &ConstraintDef) -> Option<Side> {
+        let zero_literal = |e: &Expr| matches!(e, Expr::Int(0, _));
+        let (l, r) = match (zero_literal(&c.lhs), zero_literal(&c.rhs)) {
+            (true, false) => {
+                let r = self.eval(&c.rhs)?;
+                (zero_like(&mut self.g, r)?, r)
+            }
+            (false, true) => {
+                let l = self.eval(&c.lhs)?;
+                let z = zero_like(&mut self.g, l)?;
+                (l, z)
+            }
+            _ => (self.eval(&c.lhs)?, self.eval(&c.rhs)?),
+        };
+        match (l, r) {
+            (Val::Scalar(a), Val::Scalar(b)) => Some(Side::Scalar(a, b)),
+            (Val::Point(a), Val::Point(b)) | (Val::Vector(a), Val::Vector(b)) => {
+                Some(Side::Vector(a, b))
+            }
+            (a, b) => {
+                self.cx.error_spanned_by(
+                    &c.at,
+                    format!(
+                        "the two sides of this constraint are a {} and a {}: write an equation between scalars, between points (a loop closure, `P == Q`), or between vectors",
+                        a.kind(),
+                        b.kind()
+                    ),
+                );
                 None
             }
         }
+    }
+
+    /// The components of l − r along `c.along`, or along N's axes with the
+    /// identically zero ones dropped.
+    fn vector_residuals(
+        &mut self,
+        c: &ConstraintDef,
+        l: Vec3,
+        r: Vec3,
+    ) -> Result<Vec<Id>, SymbolicError> {
+        let g = &mut self.g;
+        let diff = [g.sub(l[0], r[0])?, g.sub(l[1], r[1])?, g.sub(l[2], r[2])?];
+        let Some(list) = &c.along else {
+            return Ok(diff.into_iter().filter(|e| !g.is_zero(*e)).collect());
+        };
+        let mut out = Vec::new();
+        for e in list {
+            let Some(dir) = self.vector(e) else {
+                continue;
+            };
+            let component = dot(&mut self.g, diff, dir)?;
+            if self.g.is_zero(component) {
+                self.cx.error_at(
+                    e.span(),
+                    "the constraint's component along this direction is identically zero: it constrains nothing",
+                );
+                continue;
+            }
+            out.push(component);
+        }
+        Ok(out)
     }
 
     /// Each body's weight (effect `gravity`), then the forces and torques.
@@ -208,4 +295,23 @@ impl Builder<'_> {
         }
         rolling
     }
+}
+
+/// The two sides of a constraint.
+enum Side {
+    /// lhs and rhs, scalars.
+    Scalar(Id, Id),
+    /// lhs and rhs, N components of points or vectors.
+    Vector(Vec3, Vec3),
+}
+
+/// A zero of the same kind as `v` (a scalar, or the zero vector for a
+/// point or a vector).
+fn zero_like(g: &mut appell_symbolic::Graph, v: Val) -> Option<Val> {
+    let zero = g.int(0).ok()?;
+    Some(match v {
+        Val::Scalar(_) => Val::Scalar(zero),
+        Val::Point(_) => Val::Point([zero; 3]),
+        Val::Vector(_) => Val::Vector([zero; 3]),
+    })
 }

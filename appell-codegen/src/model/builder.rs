@@ -66,15 +66,11 @@ pub(super) fn build_in(
     b.declare_symbols(ast);
     b.frames_and_points(ast)?;
     let bodies: Vec<super::Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
-    let holonomic = ast
-        .holonomic
-        .iter()
-        .filter_map(|c| b.constraint(c))
-        .collect();
+    let holonomic = ast.holonomic.iter().flat_map(|c| b.constraint(c)).collect();
     let nonholonomic = ast
         .nonholonomic
         .iter()
-        .filter_map(|c| b.constraint(c))
+        .flat_map(|c| b.constraint(c))
         .collect();
     let loads = b.loads(ast, &bodies)?;
     let rolling = b.rolling_contacts(ast, &bodies);

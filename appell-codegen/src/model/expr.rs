@@ -20,18 +20,33 @@ pub(super) enum Val {
     Point(Vec3),
 }
 
+impl Val {
+    /// "scalar", "vector" or "point", for messages.
+    pub(super) fn kind(&self) -> &'static str {
+        match self {
+            Val::Scalar(_) => "scalar",
+            Val::Vector(_) => "vector",
+            Val::Point(_) => "point",
+        }
+    }
+}
+
 impl Builder<'_> {
     pub(super) fn scalar(&mut self, e: &Expr) -> Option<Id> {
         match self.eval(e)? {
             Val::Scalar(s) => Some(s),
             Val::Vector(_) => {
-                self.cx
-                    .error_at(e.span(), "expected a scalar, found a vector");
+                self.cx.error_at(
+                    e.span(),
+                    "expected a scalar, found a vector; `dot(u, v)` or `norm(v)` makes a scalar of it, and a constraint may equate two vectors",
+                );
                 None
             }
             Val::Point(_) => {
-                self.cx
-                    .error_at(e.span(), "expected a scalar, found a point");
+                self.cx.error_at(
+                    e.span(),
+                    "expected a scalar, found a point; a point's coordinates are `dot(P - O, N.x)` and so on, and a constraint may equate two points (`P == Q`)",
+                );
                 None
             }
         }
