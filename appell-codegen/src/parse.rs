@@ -150,7 +150,7 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
                 }
                 ast.speeds = Some((list, item.all.clone()));
             }
-            "frame" => ast.frames.push(Parser::parse2(parse_frame, tokens)?),
+            "frame" => ast.frames.extend(Parser::parse2(parse_frame, tokens)?),
             "point" => ast.points.push(Parser::parse2(parse_point, tokens)?),
             "particle" => {
                 let span = item.span;
@@ -233,26 +233,63 @@ fn ident_list(tokens: proc_macro2::TokenStream) -> syn::Result<Vec<Ident>> {
     Ok(list.into_iter().collect())
 }
 
-fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
+/// `A = P.rotate_z(a)`, or a chain `A = P.rotate_z(a).rotate_x(b)`: each
+/// rotation but the last makes a frame named after the new one, `A_1`,
+/// `A_2`, ... (usable like any frame), and the last makes `A`.
+fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
     let name: Ident = s.parse()?;
     s.parse::<Token![=]>()?;
     let e: syn::Expr = s.parse()?;
-    let syn::Expr::MethodCall(call) = &e else {
-        return Err(syn::Error::new(
-            e.span(),
-            "a frame is a rotation of another frame: `A = N.rotate_z(angle)` or `A = N.rotate(axis, angle)`",
-        ));
+    // The calls of the chain, innermost (applied first) first.
+    let mut calls = Vec::new();
+    let mut at = &e;
+    let parent = loop {
+        match at {
+            syn::Expr::MethodCall(call) => {
+                calls.push(call);
+                at = &call.receiver;
+            }
+            syn::Expr::Path(p) if !calls.is_empty() => {
+                break p.path.get_ident().cloned().ok_or_else(|| {
+                    syn::Error::new(p.span(), "expected the name of the parent frame")
+                })?;
+            }
+            other if calls.is_empty() => {
+                return Err(syn::Error::new(
+                    other.span(),
+                    "a frame is a rotation of another frame: `A = N.rotate_z(angle)`, `A = N.rotate(axis, angle)`, or a chain `A = N.rotate_z(a).rotate_x(b)`",
+                ))
+            }
+            other => {
+                return Err(syn::Error::new(
+                    other.span(),
+                    "expected the name of the parent frame",
+                ))
+            }
+        }
     };
-    let syn::Expr::Path(parent) = &*call.receiver else {
-        return Err(syn::Error::new(
-            call.receiver.span(),
-            "expected the name of the parent frame",
-        ));
-    };
-    let parent =
-        parent.path.get_ident().cloned().ok_or_else(|| {
-            syn::Error::new(parent.span(), "expected the name of the parent frame")
-        })?;
+    calls.reverse();
+    let mut frames = Vec::with_capacity(calls.len());
+    let mut from = parent;
+    for (k, call) in calls.iter().enumerate() {
+        let this = if k + 1 == calls.len() {
+            name.clone()
+        } else {
+            Ident::new(&format!("{name}_{}", k + 1), name.span())
+        };
+        frames.push(FrameDef {
+            name: this.clone(),
+            parent: from,
+            rotations: rotations_of(call)?,
+        });
+        from = this;
+    }
+    Ok(frames)
+}
+
+/// The rotations of one call of a frame definition: `rotate_x/y/z(angle)`,
+/// `rotate(axis, angle)` or a body sequence `body_zxy(a, b, c)`.
+fn rotations_of(call: &syn::ExprMethodCall) -> syn::Result<Vec<(RotationAxis, Expr)>> {
     let args: Vec<&syn::Expr> = call.args.iter().collect();
     let method = call.method.to_string();
     let axis_of = |c: char| match c {
@@ -261,7 +298,7 @@ fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
         'z' => Some(2),
         _ => None,
     };
-    let rotations = match (method.as_str(), args.as_slice()) {
+    Ok(match (method.as_str(), args.as_slice()) {
         ("rotate_x", [a]) => vec![(RotationAxis::Parent(0), convert(a)?)],
         ("rotate_y", [a]) => vec![(RotationAxis::Parent(1), convert(a)?)],
         ("rotate_z", [a]) => vec![(RotationAxis::Parent(2), convert(a)?)],
@@ -291,11 +328,6 @@ fn parse_frame(s: ParseStream) -> syn::Result<FrameDef> {
                 format!("unknown rotation `{method}`; use rotate_x, rotate_y, rotate_z, rotate(axis, angle) or a body sequence such as body_zxy(a, b, c)"),
             ))
         }
-    };
-    Ok(FrameDef {
-        name,
-        parent,
-        rotations,
     })
 }
 

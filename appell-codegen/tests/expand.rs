@@ -172,3 +172,23 @@ fn a_velocity_equation_between_vectors_is_its_components() {
     assert!(by_vectors.contains("constraints : 2"), "{by_vectors}");
     assert_eq!(by_vectors, by_rows);
 }
+
+#[test]
+fn a_chain_of_rotations_is_the_frames_written_one_by_one() {
+    // The rolling disc with its yaw, lean and spin frames as one chain: the
+    // intermediate frames are named C_1 and C_2 and usable as such.
+    let src = model_struct(include_str!("../../examples/models/rolling_disc.rs"));
+    let chained = src
+        .replace(
+            "frame(A = N.rotate_z(yaw)), frame(B = A.rotate_x(lean)), frame(C = B.rotate_y(spin))",
+            "frame(C = N.rotate_z(yaw).rotate_x(lean).rotate_y(spin))",
+        )
+        .replace("r * B.z", "r * C_2.z");
+    assert_ne!(chained, src);
+    let (a, b) = (expand_str(&src), expand_str(&chained));
+    assert!(!b.contains("compile_error"), "{b}");
+    assert_eq!(a, b);
+    // A chain that does not start from a frame's name says so.
+    let bad = src.replace("frame(A = N.rotate_z(yaw))", "frame(A = (N).rotate_z(yaw))");
+    assert!(expand_str(&bad).contains("expected the name of the parent frame"));
+}
