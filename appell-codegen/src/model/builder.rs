@@ -31,6 +31,9 @@ pub(super) struct Builder<'a> {
     pub(super) cut_from: Option<Vec<Mat3>>,
     pub(super) cuts: Vec<Cut>,
     pub(super) rules: RateRules,
+    /// Every declared frame and point, built or not yet: a name used
+    /// before its declaration is reported as such.
+    pub(super) declared: Vec<Ident>,
 }
 
 pub(super) fn engine_error(cx: &Ctxt, span: proc_macro2::Span, e: SymbolicError) {
@@ -62,6 +65,12 @@ pub(super) fn build_in(
         cut_from,
         cuts: Vec::new(),
         rules: RateRules::coordinates(),
+        declared: ast
+            .frames
+            .iter()
+            .map(|f| f.name.clone())
+            .chain(ast.points.iter().map(|p| p.name.clone()))
+            .collect(),
     };
     b.declare_symbols(ast);
     b.frames_and_points(ast)?;
@@ -310,12 +319,30 @@ impl Builder<'_> {
         v
     }
 
+    /// Whether `ident` names a frame or point declared but not built yet:
+    /// one declared below its use (frames and points are built in
+    /// declaration order). Reports it at the use and at the declaration.
+    pub(super) fn declared_below(&self, ident: &Ident) -> bool {
+        let Some(decl) = self.declared.iter().find(|d| *d == ident) else {
+            return false;
+        };
+        self.cx.error_spanned_by(
+            ident,
+            format!("`{ident}` is used before its declaration: frames and points are built in order, so declare it above its first use"),
+        );
+        self.cx.error_spanned_by(
+            decl,
+            format!("`{ident}` is declared here, below its first use"),
+        );
+        true
+    }
+
     pub(super) fn frame_named(&self, ident: &Ident) -> Option<usize> {
         let name = ident.to_string();
         if let Some(i) = self.frames.iter().position(|f| f.name == name) {
             return Some(i);
         }
-        if self.poisoned.contains(&name) {
+        if self.poisoned.contains(&name) || self.declared_below(ident) {
             return None;
         }
         let h = hint(&name, self.frames.iter().map(|f| f.name.clone()));
@@ -329,7 +356,7 @@ impl Builder<'_> {
         if let Some(p) = self.points.iter().find(|p| p.name == name) {
             return Some(p.pos);
         }
-        if self.poisoned.contains(&name) {
+        if self.poisoned.contains(&name) || self.declared_below(ident) {
             return None;
         }
         let h = hint(&name, self.points.iter().map(|p| p.name.clone()));

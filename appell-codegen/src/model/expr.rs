@@ -148,6 +148,12 @@ impl Builder<'_> {
         if self.poisoned.contains(&name) {
             return None;
         }
+        if self.points.iter().all(|p| p.name != name)
+            && self.frames.iter().all(|f| f.name != name)
+            && self.declared_below(ident)
+        {
+            return None;
+        }
         if self.frames.iter().any(|f| f.name == name) {
             self.cx.error_spanned_by(
                 ident,
