@@ -1,4 +1,4 @@
-//! The n-link planar pendulum, n = 2, 4 or 8 (`--n N`, default 4), with the
+//! The n-link planar pendulum, n = 2, 4, 8 or 16 (`--n N`, default 4), with the
 //! model command line: `cargo run --release --example n_link_pendulum --
 //! --n 8 bench`. The default action integrates 10 s with RK4 and reports the
 //! time it took.
@@ -10,16 +10,16 @@ use std::error::Error;
 use std::process::ExitCode;
 
 use appell::Model;
-use model::{Pendulum2, Pendulum4, Pendulum8};
+use model::{Pendulum16, Pendulum2, Pendulum4, Pendulum8};
 
 fn main() -> ExitCode {
     let mut args: Vec<String> = std::env::args().collect();
     let mut n = 4;
     if let Some(i) = args.iter().position(|a| a == "--n") {
         match args.get(i + 1).and_then(|s| s.parse().ok()) {
-            Some(v @ (2 | 4 | 8)) => n = v,
+            Some(v @ (2 | 4 | 8 | 16)) => n = v,
             _ => {
-                eprintln!("--n takes 2, 4 or 8");
+                eprintln!("--n takes 2, 4, 8 or 16");
                 return ExitCode::from(2);
             }
         }
@@ -28,6 +28,7 @@ fn main() -> ExitCode {
     match n {
         2 => run(Pendulum2::default(), &args),
         8 => run(Pendulum8::default(), &args),
+        16 => run(Pendulum16::default(), &args),
         _ => run(Pendulum4::default(), &args),
     }
 }

@@ -6,7 +6,7 @@ mod n_link_pendulum;
 
 use appell::Model;
 use common::Rng;
-use n_link_pendulum::{Pendulum2, Pendulum4, Pendulum8};
+use n_link_pendulum::{Pendulum16, Pendulum2, Pendulum4, Pendulum8};
 
 fn oracle_agreement<M: Model>(model: &M, seed: u64) -> f64 {
     let info = M::info();
@@ -38,6 +38,78 @@ fn all_sizes_agree_with_the_oracle() {
     assert!(oracle_agreement(&Pendulum2::default(), 1) < 1e-9);
     assert!(oracle_agreement(&Pendulum4::default(), 2) < 1e-9);
     assert!(oracle_agreement(&Pendulum8::default(), 3) < 1e-9);
+    assert!(oracle_agreement(&Pendulum16::default(), 5) < 1e-9);
+}
+
+/// The four-link pendulum with every link written out by hand, as the
+/// family was before `repeat`.
+#[derive(appell::Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(q1, q2, q3, q4), speeds(q1, q2, q3, q4))]
+#[appell(point(P1 = O + l1 * sin(q1) * N.x - l1 * cos(q1) * N.y), particle(P1, mass = m1))]
+#[appell(point(P2 = P1 + l2 * sin(q2) * N.x - l2 * cos(q2) * N.y), particle(P2, mass = m2))]
+#[appell(point(P3 = P2 + l3 * sin(q3) * N.x - l3 * cos(q3) * N.y), particle(P3, mass = m3))]
+#[appell(point(P4 = P3 + l4 * sin(q4) * N.x - l4 * cos(q4) * N.y), particle(P4, mass = m4))]
+#[appell(gravity(-g * N.y))]
+struct WrittenOut4 {
+    m1: f64,
+    m2: f64,
+    m3: f64,
+    m4: f64,
+    l1: f64,
+    l2: f64,
+    l3: f64,
+    l4: f64,
+    g: f64,
+}
+
+#[test]
+fn the_repeated_declaration_is_the_chain_written_out() {
+    let info = Pendulum4::info();
+    assert_eq!(info.coordinates, ["q_0", "q_1", "q_2", "q_3"]);
+    assert_eq!(
+        info.parameters,
+        ["m_0", "m_1", "m_2", "m_3", "l_0", "l_1", "l_2", "l_3", "g"]
+    );
+    assert_eq!(info.rhs_ops.total, WrittenOut4::info().rhs_ops.total);
+    let mut rng = Rng(6);
+    for _ in 0..200 {
+        let m: [f64; 4] = core::array::from_fn(|_| rng.uniform(0.5, 3.0));
+        let l: [f64; 4] = core::array::from_fn(|_| rng.uniform(0.5, 2.0));
+        let repeated = Pendulum4 { m, l, g: 9.81 };
+        let written = WrittenOut4 {
+            m1: m[0],
+            m2: m[1],
+            m3: m[2],
+            m4: m[3],
+            l1: l[0],
+            l2: l[1],
+            l3: l[2],
+            l4: l[3],
+            g: 9.81,
+        };
+        let s: [f64; 8] = core::array::from_fn(|_| rng.uniform(-3.0, 3.0));
+        let (mut a, mut b) = ([0.0; 8], [0.0; 8]);
+        repeated
+            .rhs(&repeated.prepare::<f64>(), 0.0, &s, &[], &mut a)
+            .unwrap();
+        written
+            .rhs(&written.prepare::<f64>(), 0.0, &s, &[], &mut b)
+            .unwrap();
+        assert_eq!(a, b);
+    }
+}
+
+#[test]
+fn an_element_of_an_array_parameter_is_checked_by_name() {
+    let mut p = Pendulum2::default();
+    p.m[1] = f64::NAN;
+    let mut d = [0.0; 4];
+    let err = p
+        .rhs(&p.prepare::<f64>(), 0.0, &[0.1; 4], &[], &mut d)
+        .unwrap_err();
+    assert!(err.to_string().contains("m[1]"), "{err}");
+    assert!(p.set_parameter("m_1", 2.0));
+    assert_eq!(p.m[1], 2.0);
 }
 
 #[test]
@@ -87,10 +159,8 @@ fn two_links_match_the_textbook_formula() {
     let mut rng = Rng(4);
     for _ in 0..1000 {
         let p = Pendulum2 {
-            m1: rng.uniform(0.5, 3.0),
-            m2: rng.uniform(0.5, 3.0),
-            l1: rng.uniform(0.5, 2.0),
-            l2: rng.uniform(0.5, 2.0),
+            m: [rng.uniform(0.5, 3.0), rng.uniform(0.5, 3.0)],
+            l: [rng.uniform(0.5, 2.0), rng.uniform(0.5, 2.0)],
             g: 9.81,
         };
         let s = [
@@ -101,7 +171,8 @@ fn two_links_match_the_textbook_formula() {
         ];
         let mut d = [0.0; 4];
         p.rhs(&p.prepare::<f64>(), 0.0, &s, &[], &mut d).unwrap();
-        let (a1, a2) = common::double_pendulum_accelerations(p.m1, p.m2, p.l1, p.l2, p.g, s);
+        let (a1, a2) =
+            common::double_pendulum_accelerations(p.m[0], p.m[1], p.l[0], p.l[1], p.g, s);
         assert!(common::close(d[2], a1, 1e-12) && common::close(d[3], a2, 1e-12));
     }
 }

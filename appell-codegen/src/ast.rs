@@ -173,13 +173,26 @@ pub struct SceneDef {
     pub outputs: Vec<(Ident, Vec<Ident>)>,
 }
 
+/// One parameter: an `f64` field, or one element of an `[f64; N]` field.
+#[derive(Clone, Debug)]
+pub struct ParamDef {
+    /// Its name in the model: the field's, or `m_3` for element 3 of `m`
+    /// (written `m[3]`, see [`crate::parse`]).
+    pub name: Ident,
+    /// The struct field.
+    pub field: Ident,
+    /// The element, for an array field.
+    pub index: Option<usize>,
+}
+
 /// The whole model as written.
 #[derive(Clone, Debug)]
 pub struct ModelAst {
     /// The struct's name.
     pub name: Ident,
-    /// Its fields (the parameters), with whether their type is `f64`.
-    pub fields: Vec<(Ident, bool)>,
+    /// The parameters: each `f64` field, and each element of an
+    /// `[f64; N]` field.
+    pub fields: Vec<ParamDef>,
     /// `coordinates(...)`.
     pub coordinates: Vec<Ident>,
     /// `speeds(...)` and its tokens (for errors).

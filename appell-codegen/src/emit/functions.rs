@@ -104,12 +104,11 @@ impl Emitter<'_> {
         let params = &self.model.params;
         let check = self.check("__out", params.len());
         let gets = params.iter().enumerate().map(|(k, prm)| {
-            let (f, k) = (&prm.ident, int(k));
+            let (f, k) = (prm.place(), int(k));
             quote!(__out[#k] = #this.#f;)
         });
         let sets = params.iter().map(|prm| {
-            let f = &prm.ident;
-            let name = f.to_string();
+            let (f, name) = (prm.place(), prm.ident.to_string());
             quote!(#name => { #this.#f = __value; true })
         });
         quote! {
@@ -440,8 +439,7 @@ impl Emitter<'_> {
             out.extend(quote!(if !#p::Scalar::re(__inputs[#k]).is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
         }
         for prm in &model.params {
-            let f = &prm.ident;
-            let what = format!("parameter `{f}`");
+            let (f, what) = (prm.place(), format!("parameter `{}`", prm.display()));
             out.extend(quote!(if !#this.#f.is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
         }
         out.extend(self.zero_length_checks());

@@ -118,11 +118,12 @@ impl Emitter<'_> {
     /// The parameters bound as locals: as `__T` when `scalar`, else `f64`.
     fn params_as(&self, scalar: bool) -> TokenStream {
         let (p, this) = (p(), &self.this);
-        let fields = self.model.params.iter().map(|prm| &prm.ident);
+        let locals = self.model.params.iter().map(|prm| &prm.ident);
+        let places = self.model.params.iter().map(|prm| prm.place());
         if scalar {
-            quote!(#(let #fields: __T = <__T as #p::Scalar>::from_f64(#this.#fields);)*)
+            quote!(#(let #locals: __T = <__T as #p::Scalar>::from_f64(#this.#places);)*)
         } else {
-            quote!(#(let #fields: f64 = #this.#fields;)*)
+            quote!(#(let #locals: f64 = #this.#places;)*)
         }
     }
 
@@ -131,8 +132,7 @@ impl Emitter<'_> {
     fn positivity(&self) -> TokenStream {
         let (p, this) = (p(), &self.this);
         let checks = self.model.params.iter().filter(|prm| prm.positive).map(|prm| {
-            let f = &prm.ident;
-            let name = f.to_string();
+            let (f, name) = (prm.place(), prm.display());
             quote!(if !(#this.#f > 0.0) { return #p::Err(#p::ModelError::NonPositiveParameter { name: #name, value: #this.#f }); })
         });
         quote!(#(#checks)*)

@@ -196,22 +196,24 @@ impl Builder<'_> {
             seen.push((name, what));
             true
         };
-        for (f, _) in &ast.fields {
-            if check(self.cx, f, "parameter") {
-                let s = self.g.parameter(&f.to_string()).expect("fresh name");
-                let positive = ast.positive.iter().any(|p| p == f);
+        for f in &ast.fields {
+            if check(self.cx, &f.name, "parameter") {
+                let s = self.g.parameter(&f.name.to_string()).expect("fresh name");
+                let positive = ast.positive.iter().any(|p| *p == f.name || *p == f.field);
                 self.params.push(Param {
-                    ident: f.clone(),
+                    ident: f.name.clone(),
                     symbol: s,
                     positive,
+                    field: f.field.clone(),
+                    index: f.index,
                 });
             }
         }
         for p in &ast.positive {
-            if !ast.fields.iter().any(|(f, _)| f == p) {
+            if !ast.fields.iter().any(|f| f.name == *p || f.field == *p) {
                 let hint = hint(
                     &p.to_string(),
-                    ast.fields.iter().map(|(f, _)| f.to_string()),
+                    ast.fields.iter().map(|f| f.name.to_string()),
                 );
                 self.cx.error_spanned_by(
                     p,

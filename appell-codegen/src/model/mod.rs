@@ -34,12 +34,39 @@ pub use crate::algebra::{Mat3, Vec3};
 /// A parameter (struct field).
 #[derive(Clone)]
 pub struct Param {
-    /// The field.
+    /// Its name in the model (`m_3` for element 3 of the array field `m`),
+    /// also the local that holds its value in the generated code.
     pub ident: Ident,
     /// Its symbol.
     pub symbol: Symbol,
     /// Declared positive.
     pub positive: bool,
+    /// The struct field.
+    pub field: Ident,
+    /// The element, for an array field.
+    pub index: Option<usize>,
+}
+
+impl Param {
+    /// The field access after `self.`: `m` or `m[3]`.
+    pub fn place(&self) -> proc_macro2::TokenStream {
+        let field = &self.field;
+        match self.index {
+            None => quote::quote!(#field),
+            Some(k) => {
+                let k = proc_macro2::Literal::usize_unsuffixed(k);
+                quote::quote!(#field[#k])
+            }
+        }
+    }
+
+    /// How error messages name it: `m` or `m[3]`.
+    pub fn display(&self) -> String {
+        match self.index {
+            None => self.field.to_string(),
+            Some(k) => format!("{}[{k}]", self.field),
+        }
+    }
 }
 
 /// A frame: rotation (columns = unit vectors in N) and angular velocity in N.

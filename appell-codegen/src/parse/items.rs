@@ -1,5 +1,5 @@
-//! Stage 1: `#[appell(...)]` attributes (syn) to [`ModelAst`]. Only syntax
-//! is checked here; names are resolved by [`crate::model`].
+//! The parsers of the items: frames, points, bodies, constraints, loads,
+//! rolling contacts and scenes, each from its `name(...)` contents.
 
 use proc_macro2::Span;
 use syn::parse::{ParseStream, Parser};
@@ -7,236 +7,14 @@ use syn::punctuated::Punctuated;
 use syn::spanned::Spanned;
 use syn::{Ident, Token};
 
+use super::expr::convert;
+use super::{ident_list, Item};
 use crate::ast::*;
-use crate::ctxt::Ctxt;
-
-/// Parses the derive input; errors go to `cx`.
-pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
-    let mut ast = ModelAst {
-        name: input.ident.clone(),
-        fields: Vec::new(),
-        coordinates: Vec::new(),
-        speeds: None,
-        inputs: Vec::new(),
-        positive: Vec::new(),
-        frames: Vec::new(),
-        points: Vec::new(),
-        bodies: Vec::new(),
-        holonomic: Vec::new(),
-        nonholonomic: Vec::new(),
-        forces: Vec::new(),
-        torques: Vec::new(),
-        gravity: None,
-        rolls: Vec::new(),
-        scenes: Vec::new(),
-        vis: input.vis.clone(),
-    };
-    match &input.data {
-        syn::Data::Struct(s) => match &s.fields {
-            syn::Fields::Named(named) => {
-                for f in &named.named {
-                    let is_f64 = matches!(&f.ty, syn::Type::Path(p) if p.path.is_ident("f64"));
-                    if !is_f64 {
-                        cx.error_spanned_by(&f.ty, "model parameters must be `f64` fields");
-                    }
-                    ast.fields
-                        .push((f.ident.clone().expect("named field"), is_f64));
-                }
-            }
-            syn::Fields::Unit => {}
-            other => cx.error_spanned_by(
-                other,
-                "a model is a struct with named `f64` fields (its parameters)",
-            ),
-        },
-        _ => cx.error_at(
-            input.ident.span(),
-            "#[derive(Appell)] works on structs whose fields are the model's parameters",
-        ),
-    }
-    if !input.generics.params.is_empty() {
-        cx.error_spanned_by(&input.generics, "a model struct cannot be generic");
-    }
-    for attr in &input.attrs {
-        if !attr.path().is_ident("appell") {
-            continue;
-        }
-        let parser = |stream: ParseStream| {
-            let items = Punctuated::<Item, Token![,]>::parse_terminated(stream)?;
-            Ok(items)
-        };
-        match attr.parse_args_with(parser) {
-            Ok(items) => {
-                for item in items {
-                    add_item(cx, &mut ast, item);
-                }
-            }
-            Err(e) => cx.syn_error(e),
-        }
-    }
-    ast
-}
-
-/// One `name(...)` entry of an `#[appell(...)]` attribute, kept raw.
-struct Item {
-    name: Ident,
-    content: proc_macro2::TokenStream,
-    /// The whole `name(...)`, for errors.
-    all: proc_macro2::TokenStream,
-    span: Span,
-}
-
-impl syn::parse::Parse for Item {
-    fn parse(input: ParseStream) -> syn::Result<Item> {
-        let name: Ident = input.parse()?;
-        let content;
-        let paren = syn::parenthesized!(content in input);
-        let content: proc_macro2::TokenStream = content.parse()?;
-        let span = name.span();
-        let mut all = quote::quote!(#name);
-        let group = proc_macro2::Group::new(proc_macro2::Delimiter::Parenthesis, content.clone());
-        let mut group = group;
-        group.set_span(paren.span.join());
-        all.extend(std::iter::once(proc_macro2::TokenTree::Group(group)));
-        Ok(Item {
-            name,
-            content,
-            all,
-            span,
-        })
-    }
-}
-
-const ITEMS: &[&str] = &[
-    "coordinates",
-    "speeds",
-    "inputs",
-    "positive",
-    "frame",
-    "point",
-    "particle",
-    "body",
-    "holonomic",
-    "nonholonomic",
-    "force",
-    "torque",
-    "gravity",
-    "rolls",
-    "scene",
-];
-
-fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
-    let name = item.name.to_string();
-    let tokens = item.content.clone();
-    let result: syn::Result<()> = (|| {
-        match name.as_str() {
-            "coordinates" => ast.coordinates.extend(ident_list(tokens)?),
-            "inputs" => ast.inputs.extend(ident_list(tokens)?),
-            "positive" => ast.positive.extend(ident_list(tokens)?),
-            "speeds" => {
-                let list =
-                    Parser::parse2(Punctuated::<SpeedItem, Token![,]>::parse_terminated, tokens)?;
-                let list: Vec<SpeedDef> = list
-                    .into_iter()
-                    .map(|i| {
-                        Ok(SpeedDef {
-                            name: i.name,
-                            definition: i.definition.as_ref().map(convert).transpose()?,
-                        })
-                    })
-                    .collect::<syn::Result<_>>()?;
-                if ast.speeds.is_some() {
-                    cx.error_spanned_by(&item.all, "`speeds` is given twice");
-                }
-                ast.speeds = Some((list, item.all.clone()));
-            }
-            "frame" => ast.frames.extend(Parser::parse2(parse_frame, tokens)?),
-            "point" => ast.points.push(Parser::parse2(parse_point, tokens)?),
-            "particle" => {
-                let span = item.span;
-                ast.bodies.push(Parser::parse2(
-                    move |s: ParseStream| parse_particle(s, span),
-                    tokens,
-                )?)
-            }
-            "body" => {
-                let span = item.span;
-                ast.bodies.push(Parser::parse2(
-                    move |s: ParseStream| parse_body(s, span),
-                    tokens,
-                )?)
-            }
-            "holonomic" | "nonholonomic" => {
-                let at = item.content.clone();
-                let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, at), tokens)?;
-                if name == "holonomic" {
-                    ast.holonomic.push(c)
-                } else {
-                    ast.nonholonomic.push(c)
-                }
-            }
-            "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
-            "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
-            "scene" => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
-            "rolls" => {
-                let at = item.all.clone();
-                ast.rolls.push(Parser::parse2(
-                    move |s: ParseStream| parse_rolls(s, at),
-                    tokens,
-                )?)
-            }
-            "gravity" => {
-                let e: syn::Expr = syn::parse2(tokens)?;
-                if ast.gravity.is_some() {
-                    cx.error_at(item.span, "`gravity` is given twice");
-                }
-                ast.gravity = Some(convert(&e)?);
-            }
-            _ => {
-                let hint = crate::ctxt::did_you_mean(&name, ITEMS.iter().copied())
-                    .map(|s| format!("; did you mean `{s}`?"))
-                    .unwrap_or_default();
-                return Err(syn::Error::new(
-                    item.name.span(),
-                    format!("unknown model item `{name}`{hint}"),
-                ));
-            }
-        }
-        Ok(())
-    })();
-    if let Err(e) = result {
-        cx.syn_error(e);
-    }
-}
-
-/// `name` or `name = expression` inside `speeds(...)`.
-struct SpeedItem {
-    name: Ident,
-    definition: Option<syn::Expr>,
-}
-
-impl syn::parse::Parse for SpeedItem {
-    fn parse(input: ParseStream) -> syn::Result<SpeedItem> {
-        let name: Ident = input.parse()?;
-        let definition = if input.peek(Token![=]) {
-            input.parse::<Token![=]>()?;
-            Some(input.parse()?)
-        } else {
-            None
-        };
-        Ok(SpeedItem { name, definition })
-    }
-}
-
-fn ident_list(tokens: proc_macro2::TokenStream) -> syn::Result<Vec<Ident>> {
-    let list = Parser::parse2(Punctuated::<Ident, Token![,]>::parse_terminated, tokens)?;
-    Ok(list.into_iter().collect())
-}
 
 /// `A = P.rotate_z(a)`, or a chain `A = P.rotate_z(a).rotate_x(b)`: each
 /// rotation but the last makes a frame named after the new one, `A_1`,
 /// `A_2`, ... (usable like any frame), and the last makes `A`.
-fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
+pub(super) fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
     let name: Ident = s.parse()?;
     s.parse::<Token![=]>()?;
     let e: syn::Expr = s.parse()?;
@@ -289,7 +67,7 @@ fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
 
 /// The rotations of one call of a frame definition: `rotate_x/y/z(angle)`,
 /// `rotate(axis, angle)` or a body sequence `body_zxy(a, b, c)`.
-fn rotations_of(call: &syn::ExprMethodCall) -> syn::Result<Vec<(RotationAxis, Expr)>> {
+pub(super) fn rotations_of(call: &syn::ExprMethodCall) -> syn::Result<Vec<(RotationAxis, Expr)>> {
     let args: Vec<&syn::Expr> = call.args.iter().collect();
     let method = call.method.to_string();
     let axis_of = |c: char| match c {
@@ -351,7 +129,7 @@ impl syn::parse::Parse for OutputItem {
     }
 }
 
-fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
+pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
     let name: Ident = s.parse()?;
     let mut effects = Vec::new();
     let mut outputs = Vec::new();
@@ -389,7 +167,7 @@ fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
     })
 }
 
-fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<RollsDef> {
+pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<RollsDef> {
     let body: Ident = s.parse()?;
     let (mut contact, mut along) = (None, None);
     for (k, v) in key_values(s)? {
@@ -418,7 +196,7 @@ fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<Roll
     })
 }
 
-fn parse_point(s: ParseStream) -> syn::Result<PointDef> {
+pub(super) fn parse_point(s: ParseStream) -> syn::Result<PointDef> {
     let name: Ident = s.parse()?;
     s.parse::<Token![=]>()?;
     let e: syn::Expr = s.parse()?;
@@ -429,7 +207,7 @@ fn parse_point(s: ParseStream) -> syn::Result<PointDef> {
 }
 
 /// `key = value` pairs after the leading positional arguments.
-fn key_values(s: ParseStream) -> syn::Result<Vec<(Ident, syn::Expr)>> {
+pub(super) fn key_values(s: ParseStream) -> syn::Result<Vec<(Ident, syn::Expr)>> {
     let mut out = Vec::new();
     while !s.is_empty() {
         s.parse::<Token![,]>()?;
@@ -444,7 +222,7 @@ fn key_values(s: ParseStream) -> syn::Result<Vec<(Ident, syn::Expr)>> {
     Ok(out)
 }
 
-fn parse_particle(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
+pub(super) fn parse_particle(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
     let point: Ident = s.parse()?;
     let mut mass = None;
     for (k, v) in key_values(s)? {
@@ -469,7 +247,7 @@ fn parse_particle(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
     })
 }
 
-fn parse_body(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
+pub(super) fn parse_body(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
     let name: Ident = s.parse()?;
     let (mut center, mut frame, mut mass, mut inertia) = (None, None, None, None);
     for (k, v) in key_values(s)? {
@@ -498,7 +276,7 @@ fn parse_body(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
     })
 }
 
-fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {
+pub(super) fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {
     let syn::Expr::Call(call) = e else {
         return Err(syn::Error::new(
             e.span(),
@@ -528,7 +306,10 @@ fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {
     }
 }
 
-fn parse_constraint(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<ConstraintDef> {
+pub(super) fn parse_constraint(
+    s: ParseStream,
+    at: proc_macro2::TokenStream,
+) -> syn::Result<ConstraintDef> {
     let e: syn::Expr = s.parse()?;
     let mut along = None;
     for (k, v) in key_values(s)? {
@@ -564,7 +345,7 @@ fn parse_constraint(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result
     }
 }
 
-fn parse_load(s: ParseStream) -> syn::Result<LoadDef> {
+pub(super) fn parse_load(s: ParseStream) -> syn::Result<LoadDef> {
     let target: Ident = s.parse()?;
     s.parse::<Token![,]>()?;
     let vector: syn::Expr = s.parse()?;
@@ -584,7 +365,7 @@ fn parse_load(s: ParseStream) -> syn::Result<LoadDef> {
     })
 }
 
-fn expr_ident(e: &syn::Expr) -> syn::Result<Ident> {
+pub(super) fn expr_ident(e: &syn::Expr) -> syn::Result<Ident> {
     match e {
         syn::Expr::Path(p) => p
             .path
@@ -593,93 +374,4 @@ fn expr_ident(e: &syn::Expr) -> syn::Result<Ident> {
             .ok_or_else(|| syn::Error::new(e.span(), "expected a name")),
         _ => Err(syn::Error::new(e.span(), "expected a name")),
     }
-}
-
-/// syn's expression to the model language's, rejecting what it lacks.
-pub fn convert(e: &syn::Expr) -> syn::Result<Expr> {
-    Ok(match e {
-        syn::Expr::Lit(lit) => match &lit.lit {
-            syn::Lit::Int(i) => Expr::Int(i.base10_parse()?, i.span()),
-            syn::Lit::Float(f) => Expr::Float(f.base10_parse()?, f.span()),
-            other => return Err(syn::Error::new(other.span(), "expected a number")),
-        },
-        syn::Expr::Path(p) => Expr::Name(
-            p.path
-                .get_ident()
-                .cloned()
-                .ok_or_else(|| syn::Error::new(p.span(), "expected a name"))?,
-        ),
-        syn::Expr::Paren(p) => convert(&p.expr)?,
-        syn::Expr::Group(g) => convert(&g.expr)?,
-        syn::Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) => {
-            Expr::Neg(Box::new(convert(&u.expr)?), u.span())
-        }
-        syn::Expr::Binary(b) => {
-            let op = match b.op {
-                syn::BinOp::Add(_) => BinOp::Add,
-                syn::BinOp::Sub(_) => BinOp::Sub,
-                syn::BinOp::Mul(_) => BinOp::Mul,
-                syn::BinOp::Div(_) => BinOp::Div,
-                _ => {
-                    return Err(syn::Error::new(
-                        b.op.span(),
-                        "only `+ - * /` (and `==` in constraints) are allowed here",
-                    ))
-                }
-            };
-            Expr::Binary(
-                op,
-                Box::new(convert(&b.left)?),
-                Box::new(convert(&b.right)?),
-                b.span(),
-            )
-        }
-        syn::Expr::Call(c) => {
-            let func = match &*c.func {
-                syn::Expr::Path(p) => p.path.get_ident().cloned(),
-                _ => None,
-            }
-            .ok_or_else(|| syn::Error::new(c.func.span(), "expected a function name"))?;
-            let args = c.args.iter().map(convert).collect::<syn::Result<_>>()?;
-            Expr::Call(func, args, c.span())
-        }
-        syn::Expr::MethodCall(m) => {
-            // `x.sin()`, `x.powi(2)`: method syntax for scalar functions.
-            let mut args = vec![convert(&m.receiver)?];
-            for a in &m.args {
-                args.push(convert(a)?);
-            }
-            Expr::Call(m.method.clone(), args, m.span())
-        }
-        syn::Expr::Field(f) => {
-            let frame = match &*f.base {
-                syn::Expr::Path(p) => p.path.get_ident().cloned(),
-                _ => None,
-            }
-            .ok_or_else(|| {
-                syn::Error::new(
-                    f.base.span(),
-                    "expected a frame name before `.x`, `.y` or `.z`",
-                )
-            })?;
-            let axis = match &f.member {
-                syn::Member::Named(m) if m == "x" => 0,
-                syn::Member::Named(m) if m == "y" => 1,
-                syn::Member::Named(m) if m == "z" => 2,
-                other => {
-                    return Err(syn::Error::new(
-                        other.span(),
-                        "a frame's unit vectors are `.x`, `.y` and `.z`",
-                    ))
-                }
-            };
-            Expr::Axis(frame, axis, f.span())
-        }
-        other => {
-            return Err(syn::Error::new(
-                other.span(),
-                "this is not part of the model language",
-            ))
-        }
-    })
 }

@@ -1,0 +1,278 @@
+//! Stage 1: `#[appell(...)]` attributes (syn) to [`ModelAst`]. Only syntax
+//! is checked here; names are resolved by [`crate::model`].
+
+use proc_macro2::Span;
+use syn::parse::{ParseStream, Parser};
+use syn::punctuated::Punctuated;
+use syn::{Ident, Token};
+
+use crate::ast::*;
+use crate::ctxt::Ctxt;
+
+mod expr;
+mod items;
+mod repeat;
+
+pub use expr::convert;
+use items::*;
+
+/// Parses the derive input; errors go to `cx`.
+pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
+    let mut ast = ModelAst {
+        name: input.ident.clone(),
+        fields: Vec::new(),
+        coordinates: Vec::new(),
+        speeds: None,
+        inputs: Vec::new(),
+        positive: Vec::new(),
+        frames: Vec::new(),
+        points: Vec::new(),
+        bodies: Vec::new(),
+        holonomic: Vec::new(),
+        nonholonomic: Vec::new(),
+        forces: Vec::new(),
+        torques: Vec::new(),
+        gravity: None,
+        rolls: Vec::new(),
+        scenes: Vec::new(),
+        vis: input.vis.clone(),
+    };
+    match &input.data {
+        syn::Data::Struct(s) => match &s.fields {
+            syn::Fields::Named(named) => {
+                for f in &named.named {
+                    let field = f.ident.clone().expect("named field");
+                    match parameter_elements(&f.ty) {
+                        Some(None) => ast.fields.push(ParamDef {
+                            name: field.clone(),
+                            field,
+                            index: None,
+                        }),
+                        Some(Some(n)) => ast.fields.extend((0..n).map(|k| ParamDef {
+                            name: Ident::new(&format!("{field}_{k}"), field.span()),
+                            field: field.clone(),
+                            index: Some(k),
+                        })),
+                        None => cx.error_spanned_by(
+                            &f.ty,
+                            "model parameters are `f64` fields or arrays `[f64; N]` with a literal N",
+                        ),
+                    }
+                }
+            }
+            syn::Fields::Unit => {}
+            other => cx.error_spanned_by(
+                other,
+                "a model is a struct with named `f64` fields (its parameters)",
+            ),
+        },
+        _ => cx.error_at(
+            input.ident.span(),
+            "#[derive(Appell)] works on structs whose fields are the model's parameters",
+        ),
+    }
+    if !input.generics.params.is_empty() {
+        cx.error_spanned_by(&input.generics, "a model struct cannot be generic");
+    }
+    for attr in &input.attrs {
+        if !attr.path().is_ident("appell") {
+            continue;
+        }
+        let parser = |stream: ParseStream| {
+            let items = Punctuated::<Item, Token![,]>::parse_terminated(stream)?;
+            Ok(items)
+        };
+        let expanded = match &attr.meta {
+            syn::Meta::List(list) => repeat::expand(list.tokens.clone()),
+            other => Err(syn::Error::new_spanned(
+                other,
+                "expected `#[appell(item, item, ...)]`",
+            )),
+        };
+        match expanded.and_then(|tokens| Parser::parse2(parser, tokens)) {
+            Ok(items) => {
+                for item in items {
+                    add_item(cx, &mut ast, item);
+                }
+            }
+            Err(e) => cx.syn_error(e),
+        }
+    }
+    ast
+}
+
+/// `f64`: Some(None); `[f64; N]`: Some(Some(N)); anything else: None.
+fn parameter_elements(ty: &syn::Type) -> Option<Option<usize>> {
+    match ty {
+        syn::Type::Path(p) if p.path.is_ident("f64") => Some(None),
+        syn::Type::Array(a) => match (&*a.elem, &a.len) {
+            (
+                syn::Type::Path(p),
+                syn::Expr::Lit(syn::ExprLit {
+                    lit: syn::Lit::Int(n),
+                    ..
+                }),
+            ) if p.path.is_ident("f64") => n.base10_parse().ok().map(Some),
+            _ => None,
+        },
+        _ => None,
+    }
+}
+
+/// One `name(...)` entry of an `#[appell(...)]` attribute, kept raw.
+pub(super) struct Item {
+    name: Ident,
+    content: proc_macro2::TokenStream,
+    /// The whole `name(...)`, for errors.
+    all: proc_macro2::TokenStream,
+    span: Span,
+}
+
+impl syn::parse::Parse for Item {
+    fn parse(input: ParseStream) -> syn::Result<Item> {
+        let name: Ident = input.parse()?;
+        let content;
+        let paren = syn::parenthesized!(content in input);
+        let content: proc_macro2::TokenStream = content.parse()?;
+        let span = name.span();
+        let mut all = quote::quote!(#name);
+        let group = proc_macro2::Group::new(proc_macro2::Delimiter::Parenthesis, content.clone());
+        let mut group = group;
+        group.set_span(paren.span.join());
+        all.extend(std::iter::once(proc_macro2::TokenTree::Group(group)));
+        Ok(Item {
+            name,
+            content,
+            all,
+            span,
+        })
+    }
+}
+
+const ITEMS: &[&str] = &[
+    "coordinates",
+    "speeds",
+    "inputs",
+    "positive",
+    "frame",
+    "point",
+    "particle",
+    "body",
+    "holonomic",
+    "nonholonomic",
+    "force",
+    "torque",
+    "gravity",
+    "rolls",
+    "scene",
+];
+
+fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
+    let name = item.name.to_string();
+    let tokens = item.content.clone();
+    let result: syn::Result<()> = (|| {
+        match name.as_str() {
+            "coordinates" => ast.coordinates.extend(ident_list(tokens)?),
+            "inputs" => ast.inputs.extend(ident_list(tokens)?),
+            "positive" => ast.positive.extend(ident_list(tokens)?),
+            "speeds" => {
+                let list =
+                    Parser::parse2(Punctuated::<SpeedItem, Token![,]>::parse_terminated, tokens)?;
+                let list: Vec<SpeedDef> = list
+                    .into_iter()
+                    .map(|i| {
+                        Ok(SpeedDef {
+                            name: i.name,
+                            definition: i.definition.as_ref().map(convert).transpose()?,
+                        })
+                    })
+                    .collect::<syn::Result<_>>()?;
+                // Several `speeds(...)` (a repeat writes one per link)
+                // add up, in order; errors point at the first.
+                match &mut ast.speeds {
+                    Some((all, _)) => all.extend(list),
+                    None => ast.speeds = Some((list, item.all.clone())),
+                }
+            }
+            "frame" => ast.frames.extend(Parser::parse2(parse_frame, tokens)?),
+            "point" => ast.points.push(Parser::parse2(parse_point, tokens)?),
+            "particle" => {
+                let span = item.span;
+                ast.bodies.push(Parser::parse2(
+                    move |s: ParseStream| parse_particle(s, span),
+                    tokens,
+                )?)
+            }
+            "body" => {
+                let span = item.span;
+                ast.bodies.push(Parser::parse2(
+                    move |s: ParseStream| parse_body(s, span),
+                    tokens,
+                )?)
+            }
+            "holonomic" | "nonholonomic" => {
+                let at = item.content.clone();
+                let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, at), tokens)?;
+                if name == "holonomic" {
+                    ast.holonomic.push(c)
+                } else {
+                    ast.nonholonomic.push(c)
+                }
+            }
+            "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
+            "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
+            "scene" => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
+            "rolls" => {
+                let at = item.all.clone();
+                ast.rolls.push(Parser::parse2(
+                    move |s: ParseStream| parse_rolls(s, at),
+                    tokens,
+                )?)
+            }
+            "gravity" => {
+                let e: syn::Expr = syn::parse2(tokens)?;
+                if ast.gravity.is_some() {
+                    cx.error_at(item.span, "`gravity` is given twice");
+                }
+                ast.gravity = Some(convert(&e)?);
+            }
+            _ => {
+                let hint = crate::ctxt::did_you_mean(&name, ITEMS.iter().copied())
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_default();
+                return Err(syn::Error::new(
+                    item.name.span(),
+                    format!("unknown model item `{name}`{hint}"),
+                ));
+            }
+        }
+        Ok(())
+    })();
+    if let Err(e) = result {
+        cx.syn_error(e);
+    }
+}
+
+/// `name` or `name = expression` inside `speeds(...)`.
+struct SpeedItem {
+    name: Ident,
+    definition: Option<syn::Expr>,
+}
+
+impl syn::parse::Parse for SpeedItem {
+    fn parse(input: ParseStream) -> syn::Result<SpeedItem> {
+        let name: Ident = input.parse()?;
+        let definition = if input.peek(Token![=]) {
+            input.parse::<Token![=]>()?;
+            Some(input.parse()?)
+        } else {
+            None
+        };
+        Ok(SpeedItem { name, definition })
+    }
+}
+
+pub(super) fn ident_list(tokens: proc_macro2::TokenStream) -> syn::Result<Vec<Ident>> {
+    let list = Parser::parse2(Punctuated::<Ident, Token![,]>::parse_terminated, tokens)?;
+    Ok(list.into_iter().collect())
+}
