@@ -221,6 +221,11 @@ pub struct ModelAst {
     pub rolls: Vec<RollsDef>,
     /// `scene(name, effects(...), outputs(...))`.
     pub scenes: Vec<SceneDef>,
+    /// Frames made by joints, with their origin points (`B`, `B_origin`).
+    pub origins: Vec<(Ident, Ident)>,
+    /// The coordinates whose rates joints make privileged speeds, added
+    /// after those of `speeds(...)` that are not among them.
+    pub joint_speeds: Vec<Ident>,
     /// The struct's visibility (scene types get the same).
     pub vis: syn::Visibility,
 }

@@ -27,7 +27,18 @@ pub(super) fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
                 calls.push(call);
                 at = &call.receiver;
             }
-            syn::Expr::Path(p) if !calls.is_empty() => {
+            syn::Expr::Path(p) if calls.is_empty() => {
+                // `A = P`: the same axes as P (a link welded to its parent).
+                let parent = p.path.get_ident().cloned().ok_or_else(|| {
+                    syn::Error::new(p.span(), "expected the name of the parent frame")
+                })?;
+                return Ok(vec![FrameDef {
+                    name,
+                    parent,
+                    rotations: Vec::new(),
+                }]);
+            }
+            syn::Expr::Path(p) => {
                 break p.path.get_ident().cloned().ok_or_else(|| {
                     syn::Error::new(p.span(), "expected the name of the parent frame")
                 })?;
@@ -247,12 +258,26 @@ pub(super) fn parse_particle(s: ParseStream, span: Span) -> syn::Result<BodyDef>
     })
 }
 
-pub(super) fn parse_body(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
+/// A body, and the point its `center` declares when it is an expression
+/// rather than a point's name (`center = L1_origin + 0.25 * L1.z` declares
+/// `{body}_center`).
+pub(super) fn parse_body(s: ParseStream, span: Span) -> syn::Result<(BodyDef, Option<PointDef>)> {
     let name: Ident = s.parse()?;
     let (mut center, mut frame, mut mass, mut inertia) = (None, None, None, None);
+    let mut center_point = None;
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
-            "center" => center = Some(expr_ident(&v)?),
+            "center" => match &v {
+                syn::Expr::Path(_) => center = Some(expr_ident(&v)?),
+                other => {
+                    let point = Ident::new(&format!("{name}_center"), other.span());
+                    center_point = Some(PointDef {
+                        name: point.clone(),
+                        location: convert(other)?,
+                    });
+                    center = Some(point);
+                }
+            },
             "frame" => frame = Some(expr_ident(&v)?),
             "mass" => mass = Some(convert(&v)?),
             "inertia" => inertia = Some(parse_inertia(&v)?),
@@ -266,14 +291,15 @@ pub(super) fn parse_body(s: ParseStream, span: Span) -> syn::Result<BodyDef> {
     }
     let missing =
         |what: &str| syn::Error::new(span, format!("body `{name}` has no `{what} = ...`"));
-    Ok(BodyDef {
+    let body = BodyDef {
         center: center.ok_or_else(|| missing("center"))?,
         frame: Some(frame.ok_or_else(|| missing("frame"))?),
         mass: mass.ok_or_else(|| missing("mass"))?,
         inertia: Some(inertia.ok_or_else(|| missing("inertia"))?),
         name,
         span,
-    })
+    };
+    Ok((body, center_point))
 }
 
 pub(super) fn parse_inertia(e: &syn::Expr) -> syn::Result<Inertia> {

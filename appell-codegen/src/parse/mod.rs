@@ -11,6 +11,7 @@ use crate::ctxt::Ctxt;
 
 mod expr;
 mod items;
+pub mod joints;
 mod repeat;
 
 pub use expr::convert;
@@ -35,6 +36,8 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
         gravity: None,
         rolls: Vec::new(),
         scenes: Vec::new(),
+        origins: Vec::new(),
+        joint_speeds: Vec::new(),
         vis: input.vis.clone(),
     };
     match &input.data {
@@ -98,7 +101,50 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
             Err(e) => cx.syn_error(e),
         }
     }
+    add_joint_speeds(&mut ast);
     ast
+}
+
+/// The joints' coordinates' rates as privileged speeds, after those of
+/// `speeds(...)`, each once.
+fn add_joint_speeds(ast: &mut ModelAst) {
+    if ast.joint_speeds.is_empty() {
+        return;
+    }
+    let (list, _) = ast
+        .speeds
+        .get_or_insert_with(|| (Vec::new(), proc_macro2::TokenStream::new()));
+    for q in std::mem::take(&mut ast.joint_speeds) {
+        if !list.iter().any(|s| s.name == q) {
+            list.push(SpeedDef {
+                name: q,
+                definition: None,
+            });
+        }
+    }
+}
+
+/// Adds a joint's frames, points, coordinates, speeds, inputs and loads.
+fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
+    let parent_origin = if joint.parent == "N" {
+        Some(Ident::new("O", joint.parent.span()))
+    } else {
+        ast.origins
+            .iter()
+            .find(|(f, _)| *f == joint.parent)
+            .map(|(_, p)| Ident::new(&p.to_string(), joint.parent.span()))
+    };
+    let lowered = joints::lower(joint, parent_origin)?;
+    ast.origins
+        .push((joint.child.clone(), lowered.points[0].name.clone()));
+    ast.frames.extend(lowered.frames);
+    ast.points.extend(lowered.points);
+    ast.coordinates.extend(lowered.coordinates);
+    ast.joint_speeds.extend(lowered.speeds);
+    ast.inputs.extend(lowered.inputs);
+    ast.forces.extend(lowered.forces);
+    ast.torques.extend(lowered.torques);
+    Ok(())
 }
 
 /// `f64`: Some(None); `[f64; N]`: Some(Some(N)); anything else: None.
@@ -165,6 +211,8 @@ const ITEMS: &[&str] = &[
     "gravity",
     "rolls",
     "scene",
+    "joint",
+    "repeat",
 ];
 
 fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
@@ -205,10 +253,16 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
             }
             "body" => {
                 let span = item.span;
-                ast.bodies.push(Parser::parse2(
-                    move |s: ParseStream| parse_body(s, span),
-                    tokens,
-                )?)
+                let (body, center) =
+                    Parser::parse2(move |s: ParseStream| parse_body(s, span), tokens)?;
+                ast.points.extend(center);
+                ast.bodies.push(body)
+            }
+            "joint" => {
+                let span = item.span;
+                let joint =
+                    Parser::parse2(move |s: ParseStream| joints::parse_joint(s, span), tokens)?;
+                add_joint(ast, &joint)?
             }
             "holonomic" | "nonholonomic" => {
                 let at = item.content.clone();

@@ -1,0 +1,456 @@
+//! Joints, written as the frames, points, coordinates, speeds, inputs and
+//! loads they stand for, so a mechanism written with joints and the same
+//! mechanism written with frames and points expand identically.
+//!
+//! `joint(name, kind, parent = A, child = B, xyz = [x, y, z], rpy = [r, p, y])`
+//! places the joint frame as URDF does: its origin at A's origin (or at
+//! `at = P`) plus x A.x + y A.y + z A.z, its axes A's turned by the
+//! fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)); the kind
+//! moves the child frame `B` and its origin point `B_origin` from there.
+
+use proc_macro2::Span;
+use syn::parse::ParseStream;
+use syn::spanned::Spanned;
+use syn::{Ident, Token};
+
+use super::expr::convert;
+use crate::ast::*;
+
+/// The direction a joint moves along or about, in the joint frame.
+#[derive(Clone, Debug)]
+pub enum JointAxis {
+    /// `x`, `y`, `z` (0, 1, 2), negated with `-z`.
+    Unit(usize, bool),
+    /// `[ax, ay, az]`: components in the joint frame, any length.
+    Components([Expr; 3]),
+}
+
+/// What a joint lets the child do relative to the joint frame.
+#[derive(Clone, Debug)]
+pub enum JointKind {
+    /// Turn about the axis: one coordinate, the joint's name.
+    Revolute(JointAxis),
+    /// Slide along the axis: one coordinate, the joint's name.
+    Prismatic(JointAxis),
+    /// Turn about and slide along the axis: `{name}_angle`, `{name}_slide`.
+    Cylindrical(JointAxis),
+    /// Slide in the plane normal to a unit axis and turn about it:
+    /// `{name}_x`, `{name}_y` (along the next two axes in cyclic order)
+    /// and `{name}_angle`.
+    Planar(usize),
+    /// No motion: the child is fixed in the parent.
+    Weld,
+}
+
+/// `joint(...)` as written.
+#[derive(Clone, Debug)]
+pub struct JointDef {
+    /// The joint's name (its coordinate's, for one degree of freedom).
+    pub name: Ident,
+    /// Its kind.
+    pub kind: JointKind,
+    /// The parent frame (`N` or a frame declared above).
+    pub parent: Ident,
+    /// The child frame it declares.
+    pub child: Ident,
+    /// The joint frame's origin before `xyz`: the parent's origin unless
+    /// given.
+    pub at: Option<Ident>,
+    /// Offset of the joint frame in the parent frame.
+    pub xyz: Option<[Expr; 3]>,
+    /// Fixed-axis roll, pitch, yaw of the joint frame in the parent frame.
+    pub rpy: Option<[Expr; 3]>,
+    /// Declares the input `tau_{name}` and applies it (a torque about, or a
+    /// force along, the axis, on the child, and its reaction on the parent).
+    pub actuated: bool,
+    /// The joint's rates are not privileged speeds (a joint a loop closure
+    /// makes dependent).
+    pub dependent: bool,
+    /// The whole item, for errors.
+    pub span: Span,
+}
+
+const KINDS: &str = "revolute(axis), prismatic(axis), cylindrical(axis), planar(normal), weld";
+
+pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
+    let name: Ident = s.parse()?;
+    s.parse::<Token![,]>()?;
+    let kind = parse_kind(&s.parse::<syn::Expr>()?)?;
+    let mut joint = JointDef {
+        parent: Ident::new("N", name.span()),
+        child: name.clone(),
+        name,
+        kind,
+        at: None,
+        xyz: None,
+        rpy: None,
+        actuated: false,
+        dependent: false,
+        span,
+    };
+    let (mut parent, mut child) = (None, None);
+    while !s.is_empty() {
+        s.parse::<Token![,]>()?;
+        if s.is_empty() {
+            break;
+        }
+        let key: Ident = s.parse()?;
+        if !s.peek(Token![=]) {
+            match key.to_string().as_str() {
+                "actuated" => joint.actuated = true,
+                "dependent" => joint.dependent = true,
+                other => return Err(unknown_property(&key, other)),
+            }
+            continue;
+        }
+        s.parse::<Token![=]>()?;
+        let value: syn::Expr = s.parse()?;
+        match key.to_string().as_str() {
+            "parent" => parent = Some(super::items::expr_ident(&value)?),
+            "child" => child = Some(super::items::expr_ident(&value)?),
+            "at" => joint.at = Some(super::items::expr_ident(&value)?),
+            "xyz" => joint.xyz = Some(triple(&value, "xyz = [x, y, z]")?),
+            "rpy" => joint.rpy = Some(triple(&value, "rpy = [roll, pitch, yaw]")?),
+            other => return Err(unknown_property(&key, other)),
+        }
+    }
+    joint.parent = parent.ok_or_else(|| {
+        syn::Error::new(
+            span,
+            format!("joint `{}` needs `parent = A` (a frame, or N)", joint.name),
+        )
+    })?;
+    joint.child = child.ok_or_else(|| {
+        syn::Error::new(
+            span,
+            format!(
+                "joint `{}` needs `child = B`, the frame it declares",
+                joint.name
+            ),
+        )
+    })?;
+    if joint.actuated && !matches!(joint.kind, JointKind::Revolute(_) | JointKind::Prismatic(_)) {
+        return Err(syn::Error::new(
+            span,
+            "`actuated` is for revolute and prismatic joints; drive other joints with `torque(...)` and `force(...)`",
+        ));
+    }
+    Ok(joint)
+}
+
+fn unknown_property(key: &Ident, other: &str) -> syn::Error {
+    syn::Error::new(
+        key.span(),
+        format!("unknown joint property `{other}`; a joint has `parent`, `child`, `xyz`, `rpy`, `at` and the flags `actuated`, `dependent`"),
+    )
+}
+
+fn parse_kind(e: &syn::Expr) -> syn::Result<JointKind> {
+    let unknown = |at: Span, what: String| {
+        syn::Error::new(
+            at,
+            format!("unknown joint kind `{what}`; the kinds are {KINDS}"),
+        )
+    };
+    match e {
+        syn::Expr::Path(p) => {
+            let id = super::items::expr_ident(e)?;
+            match id.to_string().as_str() {
+                "weld" | "fixed" => Ok(JointKind::Weld),
+                k @ ("revolute" | "prismatic" | "cylindrical" | "planar") => Err(syn::Error::new(
+                    p.span(),
+                    format!(
+                        "`{k}` needs its axis: `{k}(z)` or `{k}([ax, ay, az])`, in the joint frame"
+                    ),
+                )),
+                other => Err(unknown(p.span(), other.to_string())),
+            }
+        }
+        syn::Expr::Call(c) => {
+            let name = super::items::expr_ident(&c.func)?.to_string();
+            let [arg] = c.args.iter().collect::<Vec<_>>()[..] else {
+                return Err(syn::Error::new(
+                    c.span(),
+                    format!("`{name}` takes one axis"),
+                ));
+            };
+            let axis = parse_axis(arg)?;
+            match name.as_str() {
+                "revolute" => Ok(JointKind::Revolute(axis)),
+                "prismatic" => Ok(JointKind::Prismatic(axis)),
+                "cylindrical" => Ok(JointKind::Cylindrical(axis)),
+                "planar" => match axis {
+                    JointAxis::Unit(k, _) => Ok(JointKind::Planar(k)),
+                    JointAxis::Components(_) => Err(syn::Error::new(
+                        arg.span(),
+                        "a planar joint's normal is an axis of the joint frame: `planar(z)`; turn the joint frame with `rpy` for another plane",
+                    )),
+                },
+                other => Err(unknown(c.func.span(), other.to_string())),
+            }
+        }
+        other => Err(syn::Error::new(
+            other.span(),
+            format!("expected the joint's kind: {KINDS}"),
+        )),
+    }
+}
+
+fn parse_axis(e: &syn::Expr) -> syn::Result<JointAxis> {
+    let unit = |e: &syn::Expr| match e {
+        syn::Expr::Path(p) => match p.path.get_ident().map(|i| i.to_string()).as_deref() {
+            Some("x") => Some(0),
+            Some("y") => Some(1),
+            Some("z") => Some(2),
+            _ => None,
+        },
+        _ => None,
+    };
+    match e {
+        syn::Expr::Unary(u) if matches!(u.op, syn::UnOp::Neg(_)) && unit(&u.expr).is_some() => {
+            Ok(JointAxis::Unit(unit(&u.expr).expect("checked"), true))
+        }
+        syn::Expr::Array(_) => Ok(JointAxis::Components(triple(e, "[ax, ay, az]")?)),
+        _ => unit(e).map(|k| JointAxis::Unit(k, false)).ok_or_else(|| {
+            syn::Error::new(
+                e.span(),
+                "a joint axis is `x`, `y`, `z` (or `-z`, ...) of the joint frame, or its components `[ax, ay, az]`",
+            )
+        }),
+    }
+}
+
+fn triple(e: &syn::Expr, form: &str) -> syn::Result<[Expr; 3]> {
+    match e {
+        syn::Expr::Array(a) if a.elems.len() == 3 => {
+            let v: Vec<Expr> = a.elems.iter().map(convert).collect::<syn::Result<_>>()?;
+            Ok(v.try_into().expect("three"))
+        }
+        _ => Err(syn::Error::new(e.span(), format!("expected `{form}`"))),
+    }
+}
+
+/// What one joint adds to the model, in declaration order.
+pub(super) struct Lowered {
+    pub frames: Vec<FrameDef>,
+    pub points: Vec<PointDef>,
+    pub coordinates: Vec<Ident>,
+    pub speeds: Vec<Ident>,
+    pub inputs: Vec<Ident>,
+    pub forces: Vec<LoadDef>,
+    pub torques: Vec<LoadDef>,
+}
+
+/// The joint's frames, points, coordinates, privileged speeds, inputs and
+/// loads; `parent_origin` is the origin of the parent frame (None for a
+/// frame not made by a joint, which then needs `at`).
+pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<Lowered> {
+    let name = |suffix: &str| Ident::new(&format!("{}{suffix}", j.name), j.name.span());
+    let origin_name = Ident::new(&format!("{}_origin", j.child), j.child.span());
+    let at = match (&j.at, parent_origin) {
+        (Some(p), _) => p.clone(),
+        (None, Some(p)) => p,
+        (None, None) => {
+            return Err(syn::Error::new(
+                j.parent.span(),
+                format!(
+                    "frame `{}` was not made by a joint, so it has no origin: give the joint `at = P`, a point fixed in it",
+                    j.parent
+                ),
+            ))
+        }
+    };
+    let mut out = Lowered {
+        frames: Vec::new(),
+        points: Vec::new(),
+        coordinates: Vec::new(),
+        speeds: Vec::new(),
+        inputs: Vec::new(),
+        forces: Vec::new(),
+        torques: Vec::new(),
+    };
+    // The joint frame: the parent's axes turned by rpy, when it turns them.
+    let rpy: Vec<(RotationAxis, Expr)> = match &j.rpy {
+        Some([r, p, y]) => [(2, y), (1, p), (0, r)]
+            .into_iter()
+            .filter(|(_, a)| !is_zero(a))
+            .map(|(k, a)| (RotationAxis::Parent(k), a.clone()))
+            .collect(),
+        None => Vec::new(),
+    };
+    let joint_frame = if rpy.is_empty() {
+        j.parent.clone()
+    } else {
+        let f = name("_frame");
+        out.frames.push(FrameDef {
+            name: f.clone(),
+            parent: j.parent.clone(),
+            rotations: rpy,
+        });
+        f
+    };
+    let offset = j
+        .xyz
+        .as_ref()
+        .filter(|v| !v.iter().all(is_zero))
+        .map(|v| in_frame(&j.parent, v));
+    let joint_origin = plus(Expr::Name(at), offset);
+    let coordinate = |suffix: &str, out: &mut Lowered| {
+        let q = name(suffix);
+        out.coordinates.push(q.clone());
+        if !j.dependent {
+            out.speeds.push(q.clone());
+        }
+        Expr::Name(q)
+    };
+    let (rotations, slide) = match &j.kind {
+        JointKind::Revolute(axis) => (
+            vec![turn(axis, &joint_frame, coordinate("", &mut out))],
+            None,
+        ),
+        JointKind::Prismatic(axis) => {
+            let q = coordinate("", &mut out);
+            (Vec::new(), Some(times(q, unit_vector(axis, &j.child))))
+        }
+        JointKind::Cylindrical(axis) => {
+            let angle = coordinate("_angle", &mut out);
+            let s = coordinate("_slide", &mut out);
+            (
+                vec![turn(axis, &joint_frame, angle)],
+                Some(times(s, unit_vector(axis, &j.child))),
+            )
+        }
+        JointKind::Planar(k) => {
+            let (x, y) = (coordinate("_x", &mut out), coordinate("_y", &mut out));
+            let angle = coordinate("_angle", &mut out);
+            let span = j.name.span();
+            let along = |i: usize| Expr::Axis(joint_frame.clone(), (k + i) % 3, span);
+            let slide = add(times(x, along(1)), times(y, along(2)));
+            (vec![(RotationAxis::Parent(*k), angle)], Some(slide))
+        }
+        JointKind::Weld => (Vec::new(), None),
+    };
+    out.frames.push(FrameDef {
+        name: j.child.clone(),
+        parent: joint_frame,
+        rotations,
+    });
+    out.points.push(PointDef {
+        name: origin_name.clone(),
+        location: plus(joint_origin.clone(), slide),
+    });
+    if j.actuated {
+        actuate(j, &mut out, &origin_name, joint_origin, name("_at"));
+    }
+    Ok(out)
+}
+
+/// The input `tau_{joint}` and its loads: a torque about the axis on the
+/// child and its reaction on the parent (revolute), or a force along it
+/// at the child's origin and its reaction at the parent's point there
+/// (prismatic). The parent N takes no reaction: it does not move.
+fn actuate(j: &JointDef, out: &mut Lowered, child_origin: &Ident, joint_origin: Expr, at: Ident) {
+    let span = j.name.span();
+    let tau = Ident::new(&format!("tau_{}", j.name), span);
+    out.inputs.push(tau.clone());
+    let effect = Ident::new("actuation", span);
+    let on_parent = j.parent != "N";
+    let load = |target: Ident, vector: Expr| LoadDef {
+        target,
+        vector,
+        effect: effect.clone(),
+    };
+    match &j.kind {
+        JointKind::Revolute(axis) => {
+            let v = times(Expr::Name(tau), unit_vector(axis, &j.child));
+            out.torques.push(load(j.child.clone(), v.clone()));
+            if on_parent {
+                out.torques
+                    .push(load(j.parent.clone(), Expr::Neg(Box::new(v), span)));
+            }
+        }
+        JointKind::Prismatic(axis) => {
+            let v = times(Expr::Name(tau), unit_vector(axis, &j.child));
+            out.forces.push(load(child_origin.clone(), v.clone()));
+            if on_parent {
+                out.points.push(PointDef {
+                    name: at.clone(),
+                    location: joint_origin,
+                });
+                out.forces.push(load(at, Expr::Neg(Box::new(v), span)));
+            }
+        }
+        _ => unreachable!("checked when parsed"),
+    }
+}
+
+/// The rotation of a joint about its axis by `angle`.
+fn turn(axis: &JointAxis, joint_frame: &Ident, angle: Expr) -> (RotationAxis, Expr) {
+    match axis {
+        JointAxis::Unit(k, false) => (RotationAxis::Parent(*k), angle),
+        JointAxis::Unit(k, true) => {
+            let span = angle.span();
+            (RotationAxis::Parent(*k), Expr::Neg(Box::new(angle), span))
+        }
+        JointAxis::Components(c) => (RotationAxis::Vector(in_frame(joint_frame, c)), angle),
+    }
+}
+
+/// The axis as a unit vector written with `frame`'s unit vectors.
+fn unit_vector(axis: &JointAxis, frame: &Ident) -> Expr {
+    let span = frame.span();
+    match axis {
+        JointAxis::Unit(k, negative) => {
+            let e = Expr::Axis(frame.clone(), *k, span);
+            if *negative {
+                Expr::Neg(Box::new(e), span)
+            } else {
+                e
+            }
+        }
+        JointAxis::Components(c) => {
+            Expr::Call(Ident::new("unit", span), vec![in_frame(frame, c)], span)
+        }
+    }
+}
+
+/// c0 F.x + c1 F.y + c2 F.z, leaving out literal zero components.
+fn in_frame(frame: &Ident, c: &[Expr; 3]) -> Expr {
+    let span = frame.span();
+    let terms: Vec<Expr> = c
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| !is_zero(e))
+        .map(|(k, e)| times(e.clone(), Expr::Axis(frame.clone(), k, span)))
+        .collect();
+    terms
+        .into_iter()
+        .reduce(add)
+        .unwrap_or_else(|| times(Expr::Int(0, span), Expr::Axis(frame.clone(), 0, span)))
+}
+
+fn is_zero(e: &Expr) -> bool {
+    match e {
+        Expr::Int(0, _) => true,
+        Expr::Float(x, _) => *x == 0.0,
+        Expr::Neg(inner, _) => is_zero(inner),
+        _ => false,
+    }
+}
+
+fn plus(point: Expr, offset: Option<Expr>) -> Expr {
+    match offset {
+        Some(v) => add(point, v),
+        None => point,
+    }
+}
+
+fn add(a: Expr, b: Expr) -> Expr {
+    let span = a.span();
+    Expr::Binary(BinOp::Add, Box::new(a), Box::new(b), span)
+}
+
+fn times(a: Expr, b: Expr) -> Expr {
+    let span = a.span();
+    Expr::Binary(BinOp::Mul, Box::new(a), Box::new(b), span)
+}
