@@ -72,6 +72,9 @@ pub struct FrameDef {
     /// The rotations, applied in order, each about the axis of the frame
     /// produced by the previous one.
     pub rotations: Vec<(RotationAxis, Expr)>,
+    /// `P.quaternion(qw, qx, qy, qz)`: then turned by this unit quaternion
+    /// (scalar first), the frame's orientation relative to the parent.
+    pub quaternion: Option<Box<[Expr; 4]>>,
 }
 
 /// `point(P = Q + vector)`.

@@ -192,3 +192,30 @@ fn bad_joints_say_what_to_write() {
         "{e}"
     );
 }
+
+#[test]
+fn a_spherical_joint_is_a_quaternion_frame_with_angular_velocity_speeds() {
+    same_expansion(
+        &format!(
+            r#"
+        #[appell(joint(j, spherical, parent = N, child = B, xyz = [0, 0, l]))]
+        #[appell(body(b, center = B_origin + c * B.z, frame = B, mass = m, inertia = principal(i1, i2, i3)))]
+        #[appell(gravity(-g * N.z))]
+        {STRUCT}"#
+        ),
+        &format!(
+            r#"
+        #[appell(coordinates(j_qw, j_qx, j_qy, j_qz))]
+        #[appell(speeds(
+            j_wx = 2 * (j_qw * dt(j_qx) - dt(j_qw) * j_qx - (j_qy * dt(j_qz) - j_qz * dt(j_qy))),
+            j_wy = 2 * (j_qw * dt(j_qy) - dt(j_qw) * j_qy - (j_qz * dt(j_qx) - j_qx * dt(j_qz))),
+            j_wz = 2 * (j_qw * dt(j_qz) - dt(j_qw) * j_qz - (j_qx * dt(j_qy) - j_qy * dt(j_qx)))))]
+        #[appell(holonomic(j_qw * j_qw + j_qx * j_qx + j_qy * j_qy + j_qz * j_qz == 1))]
+        #[appell(frame(B = N.quaternion(j_qw, j_qx, j_qy, j_qz)), point(B_origin = O + l * N.z))]
+        #[appell(point(b_center = B_origin + c * B.z))]
+        #[appell(body(b, center = b_center, frame = B, mass = m, inertia = principal(i1, i2, i3)))]
+        #[appell(gravity(-g * N.z))]
+        {STRUCT}"#
+        ),
+    );
+}

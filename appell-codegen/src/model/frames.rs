@@ -62,6 +62,24 @@ impl Builder<'_> {
                 }
             }
         }
+        if let Some(q) = &f.quaternion {
+            let mut e = Vec::with_capacity(4);
+            for x in q.iter() {
+                let Some(v) = self.scalar(x) else { return };
+                e.push(v);
+            }
+            let e: [Id; 4] = e.try_into().expect("four");
+            match self.quaternion_rotation(e, rot, omega) {
+                Ok((r, w)) => {
+                    rot = r;
+                    omega = w;
+                }
+                Err(err) => {
+                    engine_error(self.cx, q[0].span(), err);
+                    return;
+                }
+            }
+        }
         if let Some(values) = &self.cut_from {
             let index = self.frames.len();
             let values = values[index];
@@ -171,6 +189,71 @@ impl Builder<'_> {
         for i in 0..3 {
             let t = g.mul(rate, parent_rot[i][k])?;
             omega[i] = g.add(omega[i], t)?;
+        }
+        Ok((rot, omega))
+    }
+
+    /// Rotation by the unit quaternion e = (e0, e1, e2, e3), scalar first,
+    /// relative to the parent: R = R_parent R(e) with R(e)'s entries the
+    /// quadratic forms of Euler parameters (exact rotations on |e| = 1,
+    /// which the model's unit-norm constraint keeps), and
+    /// ω = ω_parent + R_parent · 2 (e0 ė − ė0 e⃗ + e⃗ × ė), the relative
+    /// angular velocity in the parent's axes.
+    pub(super) fn quaternion_rotation(
+        &mut self,
+        e: [Id; 4],
+        parent_rot: Mat3,
+        parent_omega: Vec3,
+    ) -> Result<(Mat3, Vec3), SymbolicError> {
+        let g = &mut self.g;
+        let mut rate = [e[0]; 4];
+        for k in 0..4 {
+            rate[k] = g.time_derivative(e[k], &RateRules::coordinates())?;
+        }
+        let two = g.int(2)?;
+        // Products e_i e_j, i ≤ j.
+        let mut p = [[e[0]; 4]; 4];
+        for i in 0..4 {
+            for j in i..4 {
+                p[i][j] = g.mul(e[i], e[j])?;
+                p[j][i] = p[i][j];
+            }
+        }
+        let mut local = [[e[0]; 3]; 3];
+        for i in 0..3 {
+            // Diagonal: e0² + e_i² − the other two squares.
+            let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+            let plus = g.add(p[0][0], p[i + 1][i + 1])?;
+            let minus = g.add(p[a + 1][a + 1], p[b + 1][b + 1])?;
+            local[i][i] = g.sub(plus, minus)?;
+            // Off-diagonal (i, a) and (a, i): 2 (e_i e_a ∓ e0 e_b).
+            let sym = p[i + 1][a + 1];
+            let skew = p[0][b + 1];
+            let lower = g.add(sym, skew)?;
+            let upper = g.sub(sym, skew)?;
+            local[a][i] = g.mul(two, lower)?;
+            local[i][a] = g.mul(two, upper)?;
+        }
+        let rot = mat_mul(g, &parent_rot, &local)?;
+        // 2 (e0 ė − ė0 e⃗ + e⃗ × ė) in the parent's axes.
+        let mut relative = [e[0]; 3];
+        for i in 0..3 {
+            let (a, b) = ((i + 1) % 3, (i + 2) % 3);
+            let t1 = g.mul(e[0], rate[i + 1])?;
+            let t2 = g.mul(rate[0], e[i + 1])?;
+            let c1 = g.mul(e[a + 1], rate[b + 1])?;
+            let c2 = g.mul(e[b + 1], rate[a + 1])?;
+            let s = g.sub(t1, t2)?;
+            let c = g.sub(c1, c2)?;
+            let sum = g.add(s, c)?;
+            relative[i] = g.mul(two, sum)?;
+        }
+        let mut omega = parent_omega;
+        for i in 0..3 {
+            for k in 0..3 {
+                let t = g.mul(parent_rot[i][k], relative[k])?;
+                omega[i] = g.add(omega[i], t)?;
+            }
         }
         Ok((rot, omega))
     }

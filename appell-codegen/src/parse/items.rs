@@ -36,6 +36,7 @@ pub(super) fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
                     name,
                     parent,
                     rotations: Vec::new(),
+                    quaternion: None,
                 }]);
             }
             syn::Expr::Path(p) => {
@@ -66,14 +67,32 @@ pub(super) fn parse_frame(s: ParseStream) -> syn::Result<Vec<FrameDef>> {
         } else {
             Ident::new(&format!("{name}_{}", k + 1), name.span())
         };
+        let (rotations, quaternion) = if call.method == "quaternion" {
+            (Vec::new(), Some(quaternion_of(call)?))
+        } else {
+            (rotations_of(call)?, None)
+        };
         frames.push(FrameDef {
             name: this.clone(),
             parent: from,
-            rotations: rotations_of(call)?,
+            rotations,
+            quaternion,
         });
         from = this;
     }
     Ok(frames)
+}
+
+/// `quaternion(qw, qx, qy, qz)`: four scalars, the scalar part first.
+fn quaternion_of(call: &syn::ExprMethodCall) -> syn::Result<Box<[Expr; 4]>> {
+    let args: Vec<Expr> = call.args.iter().map(convert).collect::<syn::Result<_>>()?;
+    let args: [Expr; 4] = args.try_into().map_err(|_| {
+        syn::Error::new(
+            call.span(),
+            "`quaternion` takes four scalars, the scalar part first: `quaternion(qw, qx, qy, qz)`",
+        )
+    })?;
+    Ok(Box::new(args))
 }
 
 /// The rotations of one call of a frame definition: `rotate_x/y/z(angle)`,
@@ -114,7 +133,7 @@ pub(super) fn rotations_of(call: &syn::ExprMethodCall) -> syn::Result<Vec<(Rotat
         _ => {
             return Err(syn::Error::new(
                 call.method.span(),
-                format!("unknown rotation `{method}`; use rotate_x, rotate_y, rotate_z, rotate(axis, angle) or a body sequence such as body_zxy(a, b, c)"),
+                format!("unknown rotation `{method}`; use rotate_x, rotate_y, rotate_z, rotate(axis, angle) a body sequence such as body_zxy(a, b, c), or quaternion(qw, qx, qy, qz)"),
             ))
         }
     })

@@ -40,6 +40,15 @@ pub enum JointKind {
     Planar(usize),
     /// No motion: the child is fixed in the parent.
     Weld,
+    /// Any rotation about the joint origin, by a unit quaternion
+    /// `{name}_qw, _qx, _qy, _qz`; its speeds are the child's angular
+    /// velocity relative to the joint frame, in the child's axes,
+    /// `{name}_wx, _wy, _wz` (Method III); the unit norm is a holonomic
+    /// constraint.
+    Spherical,
+    /// A spherical joint whose centre also moves: `{name}_x, _y, _z` along
+    /// the joint frame's axes, their rates speeds too.
+    Free,
 }
 
 /// `joint(...)` as written.
@@ -70,7 +79,8 @@ pub struct JointDef {
     pub span: Span,
 }
 
-const KINDS: &str = "revolute(axis), prismatic(axis), cylindrical(axis), planar(normal), weld";
+const KINDS: &str =
+    "revolute(axis), prismatic(axis), cylindrical(axis), planar(normal), spherical, free, weld";
 
 pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
     let name: Ident = s.parse()?;
@@ -157,6 +167,8 @@ fn parse_kind(e: &syn::Expr) -> syn::Result<JointKind> {
             let id = super::items::expr_ident(e)?;
             match id.to_string().as_str() {
                 "weld" | "fixed" => Ok(JointKind::Weld),
+                "spherical" | "ball" => Ok(JointKind::Spherical),
+                "free" | "floating" => Ok(JointKind::Free),
                 k @ ("revolute" | "prismatic" | "cylindrical" | "planar") => Err(syn::Error::new(
                     p.span(),
                     format!(
@@ -239,6 +251,10 @@ pub(super) struct Lowered {
     pub inputs: Vec<Ident>,
     pub forces: Vec<LoadDef>,
     pub torques: Vec<LoadDef>,
+    /// Quasi-velocities (spherical and free joints).
+    pub speed_definitions: Vec<SpeedDef>,
+    /// Holonomic constraints (a quaternion's unit norm).
+    pub holonomic: Vec<ConstraintDef>,
 }
 
 /// The joint's frames, points, coordinates, privileged speeds, inputs and
@@ -268,6 +284,8 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         inputs: Vec::new(),
         forces: Vec::new(),
         torques: Vec::new(),
+        speed_definitions: Vec::new(),
+        holonomic: Vec::new(),
     };
     // The joint frame: the parent's axes turned by rpy, when it turns them.
     let rpy: Vec<(RotationAxis, Expr)> = match &j.rpy {
@@ -286,6 +304,7 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
             name: f.clone(),
             parent: j.parent.clone(),
             rotations: rpy,
+            quaternion: None,
         });
         f
     };
@@ -329,11 +348,31 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
             (vec![(RotationAxis::Parent(*k), angle)], Some(slide))
         }
         JointKind::Weld => (Vec::new(), None),
+        JointKind::Spherical | JointKind::Free => (Vec::new(), None),
+    };
+    let (quaternion, slide) = match j.kind {
+        JointKind::Spherical => (Some(ball(j, &mut out)), slide),
+        JointKind::Free => {
+            let e = ball(j, &mut out);
+            let span = j.name.span();
+            let mut slide = None;
+            for (k, axis) in ["_x", "_y", "_z"].into_iter().enumerate() {
+                let x = coordinate(axis, &mut out);
+                let term = times(x, Expr::Axis(joint_frame.clone(), k, span));
+                slide = Some(match slide {
+                    Some(s) => add(s, term),
+                    None => term,
+                });
+            }
+            (Some(e), slide)
+        }
+        _ => (None, slide),
     };
     out.frames.push(FrameDef {
         name: j.child.clone(),
         parent: joint_frame,
         rotations,
+        quaternion,
     });
     out.points.push(PointDef {
         name: origin_name.clone(),
@@ -343,6 +382,48 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         actuate(j, &mut out, &origin_name, joint_origin, name("_at"));
     }
     Ok(out)
+}
+
+/// A ball's quaternion coordinates, its unit-norm constraint and its
+/// angular-velocity speeds ω = 2 (e0 ė − ė0 e⃗ − e⃗ × ė), the child's
+/// angular velocity relative to the joint frame in the child's axes (on
+/// the unit sphere; Method III).
+fn ball(j: &JointDef, out: &mut Lowered) -> Box<[Expr; 4]> {
+    let span = j.name.span();
+    let named = |suffix: &str| Ident::new(&format!("{}{suffix}", j.name), span);
+    let e: [Ident; 4] = ["_qw", "_qx", "_qy", "_qz"].map(named);
+    out.coordinates.extend(e.iter().cloned());
+    let name = |i: &Ident| Expr::Name(i.clone());
+    let rate = |i: &Ident| Expr::Call(Ident::new("dt", span), vec![name(i)], span);
+    let sub = |a: Expr, b: Expr| Expr::Binary(BinOp::Sub, Box::new(a), Box::new(b), span);
+    for (k, w) in ["_wx", "_wy", "_wz"].into_iter().enumerate() {
+        let (i, a, b) = (k + 1, (k + 1) % 3 + 1, (k + 2) % 3 + 1);
+        let linear = sub(
+            times(name(&e[0]), rate(&e[i])),
+            times(rate(&e[0]), name(&e[i])),
+        );
+        let cross = sub(
+            times(name(&e[a]), rate(&e[b])),
+            times(name(&e[b]), rate(&e[a])),
+        );
+        let definition = times(Expr::Int(2, span), sub(linear, cross));
+        out.speed_definitions.push(SpeedDef {
+            name: named(w),
+            definition: Some(definition),
+        });
+    }
+    let norm = e
+        .iter()
+        .map(|x| times(name(x), name(x)))
+        .reduce(add)
+        .expect("four");
+    out.holonomic.push(ConstraintDef {
+        lhs: norm,
+        rhs: Expr::Int(1, span),
+        along: None,
+        at: quote::quote_spanned!(span=> #(#e)*),
+    });
+    Box::new(e.map(Expr::Name))
 }
 
 /// The input `tau_{joint}` and its loads: a torque about the axis on the

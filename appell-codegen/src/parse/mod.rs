@@ -144,6 +144,13 @@ fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
     ast.inputs.extend(lowered.inputs);
     ast.forces.extend(lowered.forces);
     ast.torques.extend(lowered.torques);
+    ast.holonomic.extend(lowered.holonomic);
+    if !lowered.speed_definitions.is_empty() {
+        let (list, _) = ast
+            .speeds
+            .get_or_insert_with(|| (Vec::new(), proc_macro2::TokenStream::new()));
+        list.extend(lowered.speed_definitions);
+    }
     Ok(())
 }
 
