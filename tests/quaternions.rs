@@ -208,3 +208,27 @@ fn the_chaplygin_ball_rolls_through_every_orientation_conserving_its_integrals()
         "{worst_e:e} {worst_k:e}"
     );
 }
+
+#[test]
+fn the_quaternion_rates_are_solved_in_closed_form() {
+    // ė = Aᵀ ω / (4 |e|²): no run-time solve, and M is I's diagonal.
+    for info in [FreeBody::info(), ChaplyginBall::info()] {
+        println!("{}: {} operations per rhs", info.name, info.rhs_ops.total);
+        assert!(info.symbolic_elimination, "{}", info.name);
+        assert!(!info.equations.contains("__x"), "{}", info.equations);
+    }
+    let eq = FreeBody::info().equations;
+    let m = &eq[eq.find("M[pose_wx, pose_wx]").unwrap()..];
+    println!("{}", &m[..m.find('\n').unwrap()]);
+}
+
+#[test]
+fn a_zero_quaternion_is_a_typed_error_not_a_nan() {
+    let body = FreeBody::default();
+    let mut d = [0.0; 10];
+    let x = [0.0, 0.0, 0.0, 0.0, 1.0, 2.0, 3.0, 0.0, 0.0, 0.0];
+    let err = body
+        .rhs(&body.prepare::<f64>(), 0.0, &x, &[], &mut d)
+        .unwrap_err();
+    assert!(err.to_string().contains("quaternion of frame `B`"), "{err}");
+}

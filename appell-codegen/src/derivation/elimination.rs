@@ -94,6 +94,16 @@ pub fn eliminate(
             rhs.push(g.neg(d0[r])?);
         }
     }
+    // Quaternion rates in closed form; the rest of the system without them.
+    let quaternions = model.quaternions.clone();
+    let closed = if quasi {
+        closed_form_blocks(g, &quaternions, dependent, &dp, &rhs, l)?
+    } else {
+        ClosedForm::none(k_unknowns)
+    };
+    let (dp, rhs) = closed.reduce(g, &dp, &rhs, l)?;
+    let dependent: Vec<usize> = closed.remaining.iter().map(|&c| dependent[c]).collect();
+    let k_unknowns = dependent.len();
     // The structural rank of the system (a matching of rows to unknowns).
     if let Some(col) = unmatched_column(g, &dp, k_unknowns) {
         let name = model.coords[dependent[col]].0.to_string();
@@ -119,14 +129,17 @@ pub fn eliminate(
     }
     let rhs_m = SymMatrix::from_rows(k_unknowns, width, rhs_aug)?;
     if k_unknowns == 0 {
-        return Ok(Some(SolvedRates {
+        let none = SolvedRates {
             x: Vec::new(),
             schur: None,
             vanishing: Vec::new(),
-        }));
+        };
+        return Ok(Some(closed.merge(none, l)));
     }
     match g.eliminate(&dp_m, &rhs_m, &assume) {
-        Ok(part) => Ok(Some(solved_rates(g, &part, k_unknowns, l, track)?)),
+        Ok(part) => Ok(Some(
+            closed.merge(solved_rates(g, &part, k_unknowns, l, track)?, l),
+        )),
         Err(SymbolicError::StructurallySingular { column }) => {
             let name = model.coords[dependent[column]].0.to_string();
             cx.error_spanned_by(
@@ -137,6 +150,181 @@ pub fn eliminate(
         }
         Err(e) => Err(e),
     }
+}
+
+/// Unknowns solved in closed form before the general elimination: the
+/// rates of a quaternion's components.
+///
+/// With quasi-velocities, the rows whose only unknowns are a quaternion's
+/// four rates (its unit norm's row 2 e·ė and the rows of its angular
+/// velocity speeds, 2 (e0 ė − ė0 e⃗ − e⃗ × ė)) form a block A with
+/// A Aᵀ = c I for every e (c = 4 |e|²), so A x = R is x = Aᵀ R / c: no
+/// pivot to prove, no run-time solve. A block is used only when that
+/// identity holds symbolically.
+struct ClosedForm {
+    /// The unknowns solved here, with their rows of [B | b].
+    solved: Vec<(usize, Vec<Id>)>,
+    /// The rows used.
+    rows: Vec<usize>,
+    /// The unknowns left to the general elimination, in order.
+    remaining: Vec<usize>,
+    /// The number of unknowns in all.
+    unknowns: usize,
+}
+
+impl ClosedForm {
+    fn none(unknowns: usize) -> ClosedForm {
+        ClosedForm {
+            solved: Vec::new(),
+            rows: Vec::new(),
+            remaining: (0..unknowns).collect(),
+            unknowns,
+        }
+    }
+
+    /// The system without the solved unknowns and their rows: every other
+    /// row's right side less its terms in them.
+    fn reduce(
+        &self,
+        g: &mut appell_symbolic::Graph,
+        dp: &[Id],
+        rhs: &[Id],
+        l: usize,
+    ) -> Result<(Vec<Id>, Vec<Id>), SymbolicError> {
+        let k = self.unknowns;
+        let mut a = Vec::new();
+        let mut r = Vec::new();
+        for row in (0..k).filter(|row| !self.rows.contains(row)) {
+            a.extend(self.remaining.iter().map(|&c| dp[row * k + c]));
+            for j in 0..=l {
+                let mut terms = vec![rhs[row * (l + 1) + j]];
+                for (col, x) in &self.solved {
+                    let t = g.mul(dp[row * k + col], x[j])?;
+                    terms.push(g.neg(t)?);
+                }
+                let sum = g.sum(&terms)?;
+                r.push(expanded(g, sum)?);
+            }
+        }
+        Ok((a, r))
+    }
+
+    /// The whole [B | b]: the closed-form rows and the general
+    /// elimination's, its free unknowns renumbered.
+    fn merge(self, rest: SolvedRates, l: usize) -> SolvedRates {
+        if self.solved.is_empty() {
+            return rest;
+        }
+        let mut x = vec![None; self.unknowns];
+        for (col, row) in self.solved {
+            x[col] = Some(row);
+        }
+        for (i, &col) in self.remaining.iter().enumerate() {
+            x[col] = Some(rest.x[i * (l + 1)..(i + 1) * (l + 1)].to_vec());
+        }
+        let schur = rest.schur.map(|mut s| {
+            s.free = s.free.iter().map(|&f| self.remaining[f]).collect();
+            s
+        });
+        SolvedRates {
+            x: x.into_iter()
+                .flat_map(|row| row.expect("every unknown"))
+                .collect(),
+            schur,
+            vanishing: rest.vanishing,
+        }
+    }
+}
+
+/// Finds the quaternion blocks of [`ClosedForm`] among the unknowns
+/// (`dependent`: every coordinate's rate, with quasi-velocities).
+fn closed_form_blocks(
+    g: &mut appell_symbolic::Graph,
+    quaternions: &[[usize; 4]],
+    dependent: &[usize],
+    dp: &[Id],
+    rhs: &[Id],
+    l: usize,
+) -> Result<ClosedForm, SymbolicError> {
+    let k = dependent.len();
+    let mut closed = ClosedForm::none(k);
+    for q in quaternions {
+        let Some(cols) = q
+            .iter()
+            .map(|c| dependent.iter().position(|d| d == c))
+            .collect::<Option<Vec<usize>>>()
+        else {
+            continue;
+        };
+        let rows: Vec<usize> = (0..k)
+            .filter(|&r| {
+                let nonzero = |c: usize| !g.is_zero(dp[r * k + c]);
+                cols.iter().any(|&c| nonzero(c)) && (0..k).all(|c| cols.contains(&c) || !nonzero(c))
+            })
+            .collect();
+        if rows.len() != 4 || rows.iter().any(|r| closed.rows.contains(r)) {
+            continue;
+        }
+        let a: Vec<Vec<Id>> = rows
+            .iter()
+            .map(|r| cols.iter().map(|c| dp[r * k + c]).collect())
+            .collect();
+        let Some(c) = orthogonal_scale(g, &a)? else {
+            continue;
+        };
+        // x = Aᵀ R / c, one unknown at a time.
+        for (i, &col) in cols.iter().enumerate() {
+            let mut row = Vec::with_capacity(l + 1);
+            for j in 0..=l {
+                let mut terms = Vec::with_capacity(4);
+                for (t, &r) in rows.iter().enumerate() {
+                    terms.push(g.mul(a[t][i], rhs[r * (l + 1) + j])?);
+                }
+                let sum = g.sum(&terms)?;
+                let x = g.div(sum, c)?;
+                row.push(expanded(g, x)?);
+            }
+            closed.solved.push((col, row));
+        }
+        closed.rows.extend(rows);
+    }
+    closed
+        .remaining
+        .retain(|c| !closed.solved.iter().any(|(s, _)| s == c));
+    Ok(closed)
+}
+
+/// c when the square matrix `a` has A Aᵀ = c I with c not identically
+/// zero (after expansion), else None.
+fn orthogonal_scale(
+    g: &mut appell_symbolic::Graph,
+    a: &[Vec<Id>],
+) -> Result<Option<Id>, SymbolicError> {
+    let n = a.len();
+    let mut scale = None;
+    for i in 0..n {
+        for j in i..n {
+            let products: Vec<Id> = (0..n)
+                .map(|t| g.mul(a[i][t], a[j][t]))
+                .collect::<Result<_, _>>()?;
+            let sum = g.sum(&products)?;
+            let s = g.expand_outside_functions(sum, 64).unwrap_or(sum);
+            match (i == j, scale) {
+                (false, _) if g.is_zero(s) => {}
+                (false, _) => return Ok(None),
+                (true, None) if !g.is_zero(s) => scale = Some(s),
+                (true, Some(c)) => {
+                    let diff = g.sub(s, c)?;
+                    let diff = g.expand_outside_functions(diff, 64).unwrap_or(diff);
+                    if !g.is_zero(diff) {
+                        return Ok(None);
+                    }
+                }
+                (true, None) => return Ok(None),
+            }
+        }
+    }
+    Ok(scale)
 }
 
 /// [B | b] from the partial elimination: X symbols for the free unknowns
@@ -250,6 +438,40 @@ mod tests {
         assert_eq!(solved.vanishing, vec![schur.x[2]]);
         // T: the one row is the constraint row itself.
         assert_agrees(&mut m.g, schur.row_ops[0], "1");
+    }
+
+    #[test]
+    fn a_quaternions_rates_are_solved_in_closed_form() {
+        // A ball joint: ė = Aᵀ [0; ω] / (4 |e|²), A = 2 [e; G(e)]; so
+        // ė0 = −(e1 ωx + e2 ωy + e3 ωz) / (2 |e|²).
+        let src = r#"
+            #[appell(joint(j, spherical, parent = N, child = B))]
+            #[appell(body(b, center = B_origin, frame = B, mass = m, inertia = principal(a, b, c)))]
+            struct Ball { m: f64, a: f64, b: f64, c: f64 }
+        "#;
+        let (mut m, _, _, _, solved) = testing::solve(src);
+        assert!(solved.schur.is_none());
+        // Columns: ωx, ωy, ωz, 1.
+        let e2 = "j_qw^2 + j_qx^2 + j_qy^2 + j_qz^2";
+        assert_agrees(&mut m.g, solved.x[0], &format!("-j_qx / (2 * ({e2}))"));
+        assert_agrees(&mut m.g, solved.x[1], &format!("-j_qy / (2 * ({e2}))"));
+        assert_agrees(&mut m.g, solved.x[4], &format!("j_qw / (2 * ({e2}))"));
+        assert!(m.g.is_zero(solved.x[3]));
+    }
+
+    #[test]
+    fn a_block_that_is_not_orthogonal_is_left_to_the_general_elimination() {
+        let mut g = appell_symbolic::Graph::new();
+        for s in ["a", "b"] {
+            g.parameter(s).unwrap();
+        }
+        let rows = [["a", "b"], ["-b", "a"]].map(|r| r.map(|e| g.parse(e).unwrap()).to_vec());
+        let c = orthogonal_scale(&mut g, &rows)
+            .unwrap()
+            .expect("a rotation-like block");
+        assert_agrees(&mut g, c, "a^2 + b^2");
+        let rows = [["a", "b"], ["b", "a"]].map(|r| r.map(|e| g.parse(e).unwrap()).to_vec());
+        assert!(orthogonal_scale(&mut g, &rows).unwrap().is_none());
     }
 
     #[test]

@@ -26,6 +26,8 @@ pub(super) struct Builder<'a> {
     /// The definition being evaluated (for `norms`).
     pub(super) context: String,
     pub(super) norms: Vec<(Id, String)>,
+    /// Quaternion frames' coordinates (see `Model::quaternions`).
+    pub(super) quaternions: Vec<[usize; 4]>,
     /// When building the twin: the model's frame matrices, whose entries
     /// become symbols.
     pub(super) cut_from: Option<Vec<Mat3>>,
@@ -62,6 +64,7 @@ pub(super) fn build_in(
         poisoned: Vec::new(),
         context: String::new(),
         norms: Vec::new(),
+        quaternions: Vec::new(),
         cut_from,
         cuts: Vec::new(),
         rules: RateRules::coordinates(),
@@ -117,6 +120,7 @@ pub(super) fn build_in(
         scenes,
         gravity: loads.gravity,
         norms: b.norms,
+        quaternions: b.quaternions,
     };
     Some((model, b.cuts))
 }

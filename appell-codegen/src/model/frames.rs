@@ -69,6 +69,7 @@ impl Builder<'_> {
                 e.push(v);
             }
             let e: [Id; 4] = e.try_into().expect("four");
+            self.note_quaternion(f, q, e);
             match self.quaternion_rotation(e, rot, omega) {
                 Ok((r, w)) => {
                     rot = r;
@@ -191,6 +192,32 @@ impl Builder<'_> {
             omega[i] = g.add(omega[i], t)?;
         }
         Ok((rot, omega))
+    }
+
+    /// Records a quaternion of four coordinates for the closed-form
+    /// elimination of their rates, and its squared length for a run-time
+    /// error where it vanishes (no orientation).
+    fn note_quaternion(&mut self, f: &FrameDef, q: &[Expr; 4], e: [Id; 4]) {
+        if self.cut_from.is_some() {
+            return;
+        }
+        let index = |x: &Expr| match x {
+            Expr::Name(n) => self.coords.iter().position(|(c, _)| c == n),
+            _ => None,
+        };
+        let found: Vec<usize> = q.iter().filter_map(index).collect();
+        let distinct = found
+            .iter()
+            .enumerate()
+            .all(|(i, a)| !found[..i].contains(a));
+        if let (Ok(block), true) = (<[usize; 4]>::try_from(found), distinct) {
+            self.quaternions.push(block);
+        }
+        let squares: Result<Vec<Id>, _> = e.iter().map(|&x| self.g.mul(x, x)).collect();
+        if let Ok(n2) = squares.and_then(|s| self.g.sum(&s)) {
+            self.norms
+                .push((n2, format!("the quaternion of frame `{}`", f.name)));
+        }
     }
 
     /// Rotation by the unit quaternion e = (e0, e1, e2, e3), scalar first,

@@ -223,6 +223,10 @@ pub struct Model {
     /// where it occurs, so that the generated code can name a zero-length
     /// one at run time.
     pub norms: Vec<(Id, String)>,
+    /// Frames oriented by a quaternion of coordinates: the indices (into
+    /// `coords`) of its components, scalar first. The elimination solves
+    /// their rates in closed form.
+    pub quaternions: Vec<[usize; 4]>,
 }
 
 impl Model {
