@@ -11,6 +11,8 @@
 mod chaplygin_sleigh;
 #[path = "../examples/models/double_pendulum.rs"]
 mod double_pendulum;
+#[path = "../examples/models/free_body.rs"]
+mod free_body;
 #[path = "../examples/models/n_link_pendulum.rs"]
 mod n_link_pendulum;
 #[path = "../examples/models/rolling_disc.rs"]
@@ -38,8 +40,10 @@ fn derive_input(source: &str, name: &str) -> syn::DeriveInput {
 }
 
 /// Fixed states in [-1, 1] (deterministic) for the retained coordinates and
-/// speeds, with full coordinates for the oracle.
-fn states<M: Model>(count: usize) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
+/// speeds, with full coordinates for the oracle; projected onto the
+/// holonomic constraints (a quaternion's unit norm) where the model has
+/// them.
+fn states<M: Model>(model: &M, count: usize) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
     let info = M::info();
     let mut seed = 0x1234_5678_9abc_def0u64;
     let mut next = move || {
@@ -58,6 +62,14 @@ fn states<M: Model>(count: usize) -> Vec<(Vec<f64>, Vec<f64>, Vec<f64>)> {
                 .map(|c| q[info.coordinate_index(c).unwrap()])
                 .collect();
             s.extend(&u);
+            let mut q = q;
+            if info.holonomic > 0 {
+                appell::linearize::project_holonomic(model, 0.0, &mut s, 1e-14, 30)
+                    .expect("a consistent state");
+                for (k, c) in info.retained.iter().enumerate() {
+                    q[info.coordinate_index(c).unwrap()] = s[k];
+                }
+            }
             (s, q, u)
         })
         .collect()
@@ -73,7 +85,7 @@ fn bench_model<M: Model>(
     let info = M::info();
     let inputs = vec![0.1; info.inputs.len()];
     let prepared = model.prepare::<f64>();
-    let set = states::<M>(64);
+    let set = states(model, 64);
     let mut d = vec![0.0; info.state_len()];
     let mut group = c.benchmark_group(name);
     group.bench_function("rhs generated (per call)", |b| {
@@ -135,7 +147,7 @@ fn scene_line<M: Model>(label: &str, model: &M) {
     let info = M::info();
     let inputs = vec![0.1; info.inputs.len()];
     let prepared = model.prepare::<f64>();
-    let set = states::<M>(64);
+    let set = states(model, 64);
     let mut d = vec![0.0; info.state_len()];
     for (s, _, _) in &set {
         let _ = model.rhs(&prepared, 0.0, s, &inputs, &mut d);
@@ -214,6 +226,27 @@ fn bench(c: &mut Criterion) {
         &n_link_pendulum::Pendulum8::default(),
         include_str!("../examples/models/n_link_pendulum.rs"),
         "Pendulum8",
+    );
+    bench_model(
+        c,
+        "n_link_pendulum_16",
+        &n_link_pendulum::Pendulum16::default(),
+        include_str!("../examples/models/n_link_pendulum.rs"),
+        "Pendulum16",
+    );
+    bench_model(
+        c,
+        "free_body",
+        &free_body::FreeBody::default(),
+        include_str!("../examples/models/free_body.rs"),
+        "FreeBody",
+    );
+    bench_model(
+        c,
+        "chaplygin_ball",
+        &free_body::ChaplyginBall::default(),
+        include_str!("../examples/models/free_body.rs"),
+        "ChaplyginBall",
     );
     bench_model(
         c,
