@@ -227,7 +227,8 @@ pub struct ModelAst {
     /// Frames made by joints, with their origin points (`B`, `B_origin`).
     pub origins: Vec<(Ident, Ident)>,
     /// The coordinates whose rates joints make privileged speeds, added
-    /// after those of `speeds(...)` that are not among them.
+    /// after those of `speeds(...)` that are not among them (when parsing
+    /// ends; kept for error messages).
     pub joint_speeds: Vec<Ident>,
     /// The struct's visibility (scene types get the same).
     pub vis: syn::Visibility,

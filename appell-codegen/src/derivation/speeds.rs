@@ -68,10 +68,18 @@ pub fn speed_definitions(
         return Ok(None);
     }
     if l + m != n {
+        let joints = if model.joint_speeds.is_empty() {
+            String::new()
+        } else {
+            format!(
+                "; joints add the rates of {} unless written with `dependent`",
+                model.joint_speeds.join(", ")
+            )
+        };
         cx.error_spanned_by(
             &model.speeds_at,
             format!(
-                "{l} privileged speed(s) with {m} velocity constraint(s) on {n} coordinates: the constraints leave {} independent speed(s), so `speeds(...)` must name {}",
+                "{l} privileged speed(s) with {m} velocity constraint(s) on {n} coordinates: the constraints leave {} independent speed(s), so `speeds(...)` must name {}{joints}",
                 n.saturating_sub(m),
                 n.saturating_sub(m)
             ),

@@ -121,6 +121,7 @@ pub(super) fn build_in(
         gravity: loads.gravity,
         norms: b.norms,
         quaternions: b.quaternions,
+        joint_speeds: ast.joint_speeds.iter().map(|q| q.to_string()).collect(),
     };
     Some((model, b.cuts))
 }

@@ -227,6 +227,9 @@ pub struct Model {
     /// `coords`) of its components, scalar first. The elimination solves
     /// their rates in closed form.
     pub quaternions: Vec<[usize; 4]>,
+    /// The coordinates whose rates joints made privileged speeds, for
+    /// errors that count speeds.
+    pub joint_speeds: Vec<String>,
 }
 
 impl Model {

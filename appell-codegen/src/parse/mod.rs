@@ -114,7 +114,7 @@ fn add_joint_speeds(ast: &mut ModelAst) {
     let (list, _) = ast
         .speeds
         .get_or_insert_with(|| (Vec::new(), proc_macro2::TokenStream::new()));
-    for q in std::mem::take(&mut ast.joint_speeds) {
+    for q in ast.joint_speeds.clone() {
         if !list.iter().any(|s| s.name == q) {
             list.push(SpeedDef {
                 name: q,
