@@ -148,3 +148,52 @@ fn every_models_expansion_matches_its_snapshot() {
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
+
+/// Expansion time (median of five), emitted size and rhs operation count of
+/// every example model: `cargo test --release -p appell-codegen --test
+/// snapshots -- --ignored --nocapture`. Figures, not a check: the machine
+/// is shared.
+#[test]
+#[ignore]
+fn expansion_costs() {
+    let root = workspace_root();
+    let mut files = Vec::new();
+    rust_files(&root.join("examples"), &mut files);
+    println!("| model | expansion | emitted | rhs ops |\n| --- | ---: | ---: | ---: |");
+    for file in files {
+        let src = std::fs::read_to_string(&file).expect("read");
+        let Ok(parsed) = syn::parse_file(&src) else {
+            continue;
+        };
+        let mut models = Models::default();
+        models.visit_file(&parsed);
+        for item in &models.0 {
+            let input = syn::DeriveInput::from(item.clone());
+            let mut times = Vec::new();
+            let mut text = String::new();
+            for _ in 0..5 {
+                let t = std::time::Instant::now();
+                text = appell_codegen::expand(&input).to_string();
+                times.push(t.elapsed().as_secs_f64());
+            }
+            times.sort_by(f64::total_cmp);
+            let ops = text
+                .find("total :")
+                .map(|i| {
+                    text[i + 7..]
+                        .split(['}', ','])
+                        .next()
+                        .unwrap_or("")
+                        .trim()
+                        .to_string()
+                })
+                .unwrap_or_default();
+            println!(
+                "| {} | {:.1} ms | {:.1} kB | {ops} |",
+                item.ident,
+                times[2] * 1e3,
+                text.len() as f64 / 1e3
+            );
+        }
+    }
+}
