@@ -117,6 +117,7 @@ pub(super) fn build_in(
         scenes,
         gravity: loads.gravity,
         norms: b.norms,
+        files: ast.files.clone(),
     };
     Some((model, b.cuts))
 }

@@ -223,6 +223,9 @@ pub struct Model {
     /// where it occurs, so that the generated code can name a zero-length
     /// one at run time.
     pub norms: Vec<(Id, String)>,
+    /// Files the model was read from (absolute paths): the output includes
+    /// them, so cargo builds the model again when one changes.
+    pub files: Vec<String>,
 }
 
 impl Model {
