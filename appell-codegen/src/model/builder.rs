@@ -34,6 +34,9 @@ pub(super) struct Builder<'a> {
     /// Every declared frame and point, built or not yet: a name used
     /// before its declaration is reported as such.
     pub(super) declared: Vec<Ident>,
+    /// Frames made by joints (and URDF roots) with their origin points,
+    /// for `origin(F)`.
+    pub(super) origins: Vec<(Ident, Ident)>,
 }
 
 pub(super) fn engine_error(cx: &Ctxt, span: proc_macro2::Span, e: SymbolicError) {
@@ -71,6 +74,7 @@ pub(super) fn build_in(
             .map(|f| f.name.clone())
             .chain(ast.points.iter().map(|p| p.name.clone()))
             .collect(),
+        origins: ast.origins.clone(),
     };
     b.declare_symbols(ast);
     b.frames_and_points(ast)?;
