@@ -20,9 +20,15 @@ mod spatial_chain;
 #[path = "../examples/models/ur5.rs"]
 mod ur5;
 
-use appell::Model;
+use appell::{Appell, Model};
 use common::Rng;
 use serde_json::Value;
+
+/// The 4-link chain read from `make_urdf.py`'s file.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("examples/robots/spatial_chain/spatial_chain_4.urdf"))]
+#[appell(gravity(-9.81 * N.z))]
+struct UrdfChain4;
 
 /// One state of a reference file, in Pinocchio's joint order.
 struct State {
@@ -230,4 +236,34 @@ fn the_robots_agree_with_the_oracle() {
     assert!(oracle_agreement(&SpatialChain4, 4) < 1e-9);
     assert!(oracle_agreement(&SpatialChain8, 5) < 1e-9);
     assert!(oracle_agreement(&SpatialChain16, 6) < 1e-9);
+}
+
+#[test]
+fn the_chain_read_from_its_urdf_is_the_chain_written_with_joints() {
+    use spatial_chain::SpatialChain4;
+    let (urdf, joints) = (UrdfChain4::info(), SpatialChain4::info());
+    assert_eq!(urdf.coordinates, joints.coordinates);
+    assert_eq!(urdf.retained, joints.retained);
+    assert_eq!(urdf.speeds, joints.speeds);
+    assert_eq!(urdf.inputs, joints.inputs);
+    let names: Vec<&str> = urdf.bodies.iter().map(|b| b.name).collect();
+    assert_eq!(names, ["link_1", "link_2", "link_3", "link_4"]);
+    let (a, b) = (UrdfChain4, SpatialChain4);
+    let (pa, pb) = (a.prepare::<f64>(), b.prepare::<f64>());
+    let mut rng = Rng(11);
+    let mut worst: f64 = 0.0;
+    for _ in 0..1000 {
+        let s: Vec<f64> = (0..urdf.state_len())
+            .map(|k| if k < urdf.retained.len() { rng.uniform(-3.14, 3.14) } else { rng.uniform(-2.0, 2.0) })
+            .collect();
+        let inputs: Vec<f64> = (0..4).map(|_| rng.uniform(-20.0, 20.0)).collect();
+        let (mut da, mut db) = (vec![0.0; s.len()], vec![0.0; s.len()]);
+        a.rhs(&pa, 0.0, &s, &inputs, &mut da).unwrap();
+        b.rhs(&pb, 0.0, &s, &inputs, &mut db).unwrap();
+        for (x, y) in da.iter().zip(&db) {
+            worst = worst.max((x - y).abs() / (1.0 + y.abs()));
+        }
+    }
+    println!("spatial chain 4, read from its URDF against written with joints: largest relative difference {worst:.1e} over 1,000 states");
+    assert!(worst <= 1e-12, "{worst:.2e}");
 }
