@@ -77,6 +77,9 @@ pub(super) fn build_in(
         origins: ast.origins.clone(),
     };
     b.declare_symbols(ast);
+    if b.cut_from.is_none() {
+        duplicate_bodies(cx, ast);
+    }
     b.frames_and_points(ast)?;
     let bodies: Vec<super::Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
     let holonomic = ast.holonomic.iter().flat_map(|c| b.constraint(c)).collect();
@@ -191,10 +194,11 @@ impl Builder<'_> {
                 return false;
             }
             if let Some((_, other)) = seen.iter().find(|(n, _)| *n == name) {
+                let note = urdf_note(ast, &name);
                 if *other == what {
-                    cx.error_spanned_by(ident, format!("duplicate {what} `{name}`"));
+                    cx.error_spanned_by(ident, format!("duplicate {what} `{name}`{note}"));
                 } else {
-                    cx.error_spanned_by(ident, format!("`{name}` is already a {other}"));
+                    cx.error_spanned_by(ident, format!("`{name}` is already a {other}{note}"));
                 }
                 return false;
             }
@@ -386,6 +390,26 @@ pub(super) fn not_raw(cx: &Ctxt, ident: &Ident, what: &str) -> bool {
         format!("a raw identifier cannot name a {what}, since the generated code builds other names from it; rename `{bare}`"),
     );
     false
+}
+
+/// " (made by the URDF's link `x`)" when a URDF made the name: a clash
+/// with a name the model declares says where the other one comes from.
+pub(super) fn urdf_note(ast: &ModelAst, name: &str) -> String {
+    ast.urdf_names
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, what)| format!(" (one of them made by {what}; rename the model's own)"))
+        .unwrap_or_default()
+}
+
+/// An error for each body named like one before it.
+pub(super) fn duplicate_bodies(cx: &Ctxt, ast: &ModelAst) {
+    for (k, b) in ast.bodies.iter().enumerate() {
+        if ast.bodies[..k].iter().any(|o| o.name == b.name) {
+            let note = urdf_note(ast, &b.name.to_string());
+            cx.error_spanned_by(&b.name, format!("duplicate body `{}`{note}", b.name));
+        }
+    }
 }
 
 /// "; did you mean `x`?" when `name` is close to a candidate.

@@ -10,7 +10,7 @@ use super::options::{Promotion, Spec};
 use super::read::Read;
 use super::tree::Tree;
 use crate::ast::*;
-use crate::ctxt::{did_you_mean, Ctxt};
+use crate::ctxt::{did_you_mean, suggest, Ctxt};
 use crate::parse::joints::{
     add, in_frame, is_zero, rpy_rotations, times, JointAxis, JointDef, JointKind,
 };
@@ -171,13 +171,13 @@ fn promote(cx: &Ctxt, tree: &Tree, p: &Promotion, joints: &mut [JointNumbers], l
         Some(slot) => *slot = p.value.clone(),
         None => {
             let hint = did_you_mean(&field, fields.iter().copied())
-                .map(|s| format!("; did you mean `{s}`?"))
+                .map(|s| format!(" (did you mean `{s}`?)"))
                 .unwrap_or_default();
             let kind = if joint.is_some() { "joint" } else { "link" };
             cx.error_spanned_by(
                 &p.field[0],
                 format!(
-                    "a {kind} has no number `{field}`{hint}; a {kind}'s are {}",
+                    "a {kind} has no number `{field}`{hint}; a {kind}'s numbers are {}",
                     fields.join(", ")
                 ),
             );
@@ -429,10 +429,11 @@ fn record_names(ast: &mut ModelAst, robot: &urdf_rs::Robot, tree: &Tree) {
     }
 }
 
-/// "; did you mean `x`?" when `name` is close to a candidate.
+/// "; did you mean `x`?" when `name` is close to a candidate, or a name
+/// it is the start of (`elbow` for `elbow_joint`).
 fn hint(name: &str, candidates: impl IntoIterator<Item = String>) -> String {
     let all: Vec<String> = candidates.into_iter().collect();
-    did_you_mean(name, all.iter().map(|s| s.as_str()))
+    suggest(name, all.iter().map(|s| s.as_str()))
         .map(|s| format!("; did you mean `{s}`?"))
         .unwrap_or_default()
 }

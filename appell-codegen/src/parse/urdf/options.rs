@@ -94,7 +94,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
             }
             other => {
                 let hint = did_you_mean(other, OPTIONS.iter().copied())
-                    .map(|s| format!("; did you mean `{s}`?"))
+                    .map(|s| format!(" (did you mean `{s}`?)"))
                     .unwrap_or_default();
                 return Err(syn::Error::new(
                     key.span(),

@@ -5,7 +5,7 @@ use proc_macro2::Span;
 use syn::Ident;
 
 use super::read::Lines;
-use crate::ctxt::did_you_mean;
+
 
 /// The links and joints under their model names, and the order to declare
 /// them in.
@@ -53,7 +53,7 @@ impl Tree {
         let find = |name: &str, joint: &urdf_rs::Joint, role: &str, errors: &mut Vec<String>| {
             let found = link_names.iter().position(|l| *l == name);
             if found.is_none() {
-                let hint = did_you_mean(name, link_names.iter().copied())
+                let hint = crate::ctxt::suggest(name, link_names.iter().copied())
                     .map(|s| format!("; did you mean `{s}`?"))
                     .unwrap_or_default();
                 errors.push(format!(
