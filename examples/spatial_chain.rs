@@ -32,9 +32,7 @@ fn main() -> ExitCode {
         match args.get(i + 1).and_then(|s| s.parse().ok()) {
             Some(v) if SIZES.contains(&v) => n = v,
             _ => {
-                eprintln!(
-                    "--n takes one of {SIZES:?} (32 needs `--features large-models`)"
-                );
+                eprintln!("--n takes one of {SIZES:?} (32 needs `--features large-models`)");
                 return ExitCode::from(2);
             }
         }

@@ -20,6 +20,8 @@ mod spatial_chain;
 #[path = "../examples/models/ur5.rs"]
 mod ur5;
 
+use std::f64::consts::PI;
+
 use appell::{Appell, Model};
 use common::Rng;
 use serde_json::Value;
@@ -138,14 +140,17 @@ fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
         forcing: 0.0,
     };
     for s in &r.states {
-        let pick = |at: &[usize], from: &[f64]| -> Vec<f64> { at.iter().map(|&i| from[i]).collect() };
+        let pick =
+            |at: &[usize], from: &[f64]| -> Vec<f64> { at.iter().map(|&i| from[i]).collect() };
         let (q, u, inputs) = (pick(&q_at, &s.q), pick(&u_at, &s.v), pick(&in_at, &s.tau));
         let mut state = pick(&kept, &s.q);
         state.extend(&u);
         let mut d = vec![0.0; state.len()];
         model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
         assert_eq!(&d[..kept.len()], &pick(&kept, &s.v)[..], "q̇ = u");
-        worst.ddq = worst.ddq.max(relative(&d[kept.len()..], &pick(&u_at, &s.ddq)));
+        worst.ddq = worst
+            .ddq
+            .max(relative(&d[kept.len()..], &pick(&u_at, &s.ddq)));
         let (mut m, mut f) = (vec![0.0; l * l], vec![0.0; l]);
         model
             .mass_matrix_and_forcing(0.0, &q, &u, &inputs, &mut m, &mut f)
@@ -171,8 +176,16 @@ fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
 fn assert_agrees<M: Model>(model: &M, robot: &str) {
     let w = agreement(model, robot);
     assert!(w.ddq <= 1e-10, "{robot}: ddq differs by {:.2e}", w.ddq);
-    assert!(w.mass_matrix <= 1e-10, "{robot}: M differs by {:.2e}", w.mass_matrix);
-    assert!(w.forcing <= 1e-10, "{robot}: f differs by {:.2e}", w.forcing);
+    assert!(
+        w.mass_matrix <= 1e-10,
+        "{robot}: M differs by {:.2e}",
+        w.mass_matrix
+    );
+    assert!(
+        w.forcing <= 1e-10,
+        "{robot}: f differs by {:.2e}",
+        w.forcing
+    );
 }
 
 #[test]
@@ -204,7 +217,7 @@ fn oracle_agreement<M: Model>(model: &M, seed: u64) -> f64 {
     let mut rng = Rng(seed);
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
-        let q: Vec<f64> = (0..n).map(|_| rng.uniform(-3.14, 3.14)).collect();
+        let q: Vec<f64> = (0..n).map(|_| rng.uniform(-PI, PI)).collect();
         let u: Vec<f64> = (0..l).map(|_| rng.uniform(-2.0, 2.0)).collect();
         let inputs: Vec<f64> = (0..k).map(|_| rng.uniform(-20.0, 20.0)).collect();
         let mut state: Vec<f64> = info
@@ -254,7 +267,13 @@ fn the_chain_read_from_its_urdf_is_the_chain_written_with_joints() {
     let mut worst: f64 = 0.0;
     for _ in 0..1000 {
         let s: Vec<f64> = (0..urdf.state_len())
-            .map(|k| if k < urdf.retained.len() { rng.uniform(-3.14, 3.14) } else { rng.uniform(-2.0, 2.0) })
+            .map(|k| {
+                if k < urdf.retained.len() {
+                    rng.uniform(-PI, PI)
+                } else {
+                    rng.uniform(-2.0, 2.0)
+                }
+            })
             .collect();
         let inputs: Vec<f64> = (0..4).map(|_| rng.uniform(-20.0, 20.0)).collect();
         let (mut da, mut db) = (vec![0.0; s.len()], vec![0.0; s.len()]);

@@ -6,7 +6,7 @@ mod common;
 #[path = "../examples/models/ur5.rs"]
 mod ur5;
 
-use std::f64::consts::FRAC_PI_2;
+use std::f64::consts::{FRAC_PI_2, PI};
 
 use appell::{Appell, Model};
 use common::Rng;
@@ -58,7 +58,13 @@ fn largest_difference<A: Model, B: Model>(a: &A, b: &B, states: usize, seed: u64
     let mut worst: f64 = 0.0;
     for _ in 0..states {
         let s: Vec<f64> = (0..ia.state_len())
-            .map(|k| if k < ia.retained.len() { rng.uniform(-3.14, 3.14) } else { rng.uniform(-2.0, 2.0) })
+            .map(|k| {
+                if k < ia.retained.len() {
+                    rng.uniform(-PI, PI)
+                } else {
+                    rng.uniform(-2.0, 2.0)
+                }
+            })
             .collect();
         let inputs: Vec<f64> = ia.inputs.iter().map(|_| rng.uniform(-20.0, 20.0)).collect();
         let (mut da, mut db) = (vec![0.0; s.len()], vec![0.0; s.len()]);
@@ -71,19 +77,27 @@ fn largest_difference<A: Model, B: Model>(a: &A, b: &B, states: usize, seed: u64
     worst
 }
 
+/// π/2 as the UR5's file writes it.
+// Not FRAC_PI_2 on purpose: the file's rounded value.
+#[allow(clippy::approx_constant)]
+const ROUNDED_RIGHT_ANGLE: f64 = 1.57079632679;
+
 /// The UR5's file writes π/2 as 1.57079632679 (4.9e-12 below it); the
 /// accelerations with exact right angles differ by about 2e-10 relative
 /// (printed; the docs quote the figure).
 #[test]
 fn the_ur5s_rounded_right_angles_measured() {
     let rounded = Ur5Pitches {
-        lift_pitch: 1.57079632679,
-        wrist_pitch: 1.57079632679,
+        lift_pitch: ROUNDED_RIGHT_ANGLE,
+        wrist_pitch: ROUNDED_RIGHT_ANGLE,
     };
     let same = largest_difference(&rounded, &ur5::Ur5, 200, 12);
     // Constants folded at compile time against the same numbers as
     // parameters: rounding apart.
-    assert!(same <= 1e-13, "the parameters as the file's numbers: {same:.2e}");
+    assert!(
+        same <= 1e-13,
+        "the parameters as the file's numbers: {same:.2e}"
+    );
     let exact = Ur5Pitches {
         lift_pitch: FRAC_PI_2,
         wrist_pitch: FRAC_PI_2,
@@ -117,12 +131,24 @@ fn numbers_of_the_file_become_parameters() {
     loaded.mass_properties(&mut masses, &mut inertias).unwrap();
     let at = |name: &str| bodies.iter().position(|b| *b == name).unwrap();
     assert_eq!(masses[at("wrist_3_link")], 2.5);
-    assert_eq!((masses[at("tool0")], inertias[at("tool0")]), (1.0, [0.0; 9]));
+    assert_eq!(
+        (masses[at("tool0")], inertias[at("tool0")]),
+        (1.0, [0.0; 9])
+    );
     assert!(largest_difference(&loaded, &ur5::Ur5, 20, 15) > 1e-3);
     // `positive(payload)` is checked.
-    let bad = Ur5Payload { payload: -1.0, ..loaded };
+    let bad = Ur5Payload {
+        payload: -1.0,
+        ..loaded
+    };
     let mut d = vec![0.0; info.state_len()];
-    let err = bad.rhs(&bad.prepare::<f64>(), 0.0, &vec![0.0; d.len()], &[0.0; 6], &mut d);
+    let err = bad.rhs(
+        &bad.prepare::<f64>(),
+        0.0,
+        &vec![0.0; d.len()],
+        &[0.0; 6],
+        &mut d,
+    );
     assert!(err.is_err());
 }
 
@@ -141,13 +167,25 @@ fn a_mimic_joint_is_a_dependent_coordinate_tied_by_a_constraint() {
     let mut rng = Rng(16);
     let mut worst: f64 = 0.0;
     for _ in 0..200 {
-        let mut q: Vec<f64> = info.coordinates.iter().map(|_| rng.uniform(-3.0, 3.0)).collect();
+        let mut q: Vec<f64> = info
+            .coordinates
+            .iter()
+            .map(|_| rng.uniform(-3.0, 3.0))
+            .collect();
         let finger = rng.uniform(0.0, 0.04);
         q[info.coordinate_index("panda_finger_joint1").unwrap()] = finger;
         q[info.coordinate_index("panda_finger_joint2").unwrap()] = finger;
         let u: Vec<f64> = info.speeds.iter().map(|_| rng.uniform(-2.0, 2.0)).collect();
-        let inputs: Vec<f64> = info.inputs.iter().map(|_| rng.uniform(-10.0, 10.0)).collect();
-        let mut s: Vec<f64> = info.retained.iter().map(|c| q[info.coordinate_index(c).unwrap()]).collect();
+        let inputs: Vec<f64> = info
+            .inputs
+            .iter()
+            .map(|_| rng.uniform(-10.0, 10.0))
+            .collect();
+        let mut s: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|c| q[info.coordinate_index(c).unwrap()])
+            .collect();
         s.extend(&u);
         let mut d = vec![0.0; s.len()];
         model.rhs(&prepared, 0.0, &s, &inputs, &mut d).unwrap();
@@ -177,6 +215,8 @@ fn eval_takes_the_joint_names() {
     let inputs = [0.0, 0.0, 2.0, 0.0, 0.0, 0.0];
     let mut d = vec![0.0; s.len()];
     let model = ur5::Ur5;
-    model.rhs(&model.prepare::<f64>(), 0.0, &s, &inputs, &mut d).unwrap();
+    model
+        .rhs(&model.prepare::<f64>(), 0.0, &s, &inputs, &mut d)
+        .unwrap();
     assert_eq!(v["udot"]["elbow_joint"].as_f64(), Some(d[5 + 2]), "{v}");
 }

@@ -108,8 +108,7 @@ fn manifest_dir(rel: &Path) -> PathBuf {
 /// Whether a model is compiled only with a cargo feature.
 fn behind_a_feature(item: &syn::ItemStruct) -> bool {
     item.attrs.iter().any(|a| {
-        a.path().is_ident("cfg")
-            && a.meta.to_token_stream().to_string().contains("feature")
+        a.path().is_ident("cfg") && a.meta.to_token_stream().to_string().contains("feature")
     })
 }
 

@@ -5,14 +5,16 @@ use std::path::{Path, PathBuf};
 use appell_codegen::expand_in;
 
 fn workspace() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).parent().expect("workspace").to_path_buf()
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace")
+        .to_path_buf()
 }
 
 fn expand_str(src: &str) -> String {
     let input: syn::DeriveInput = syn::parse_str(src).expect("valid Rust");
     expand_in(&input, Some(&workspace())).to_string()
 }
-
 
 /// Each struct of a model file (from the blank line before its derive to
 /// the next, so with its attributes), by name.
@@ -21,9 +23,17 @@ fn model_structs(src: &str) -> Vec<(String, String)> {
     let mut rest = src;
     while let Some(derive) = rest.find("#[derive(Appell") {
         let start = rest[..derive].rfind("\n\n").map_or(0, |b| b + 2);
-        let end = rest[derive..].find("\n\n").map_or(rest.len(), |e| derive + e);
+        let end = rest[derive..]
+            .find("\n\n")
+            .map_or(rest.len(), |e| derive + e);
         let item = &rest[start..end];
-        let name = item.split("pub struct ").nth(1).unwrap().split([';', ' ', '{']).next().unwrap();
+        let name = item
+            .split("pub struct ")
+            .nth(1)
+            .unwrap()
+            .split([';', ' ', '{'])
+            .next()
+            .unwrap();
         out.push((name.to_string(), item.to_string()));
         rest = &rest[end..];
     }
@@ -46,8 +56,16 @@ fn robots_expand_and_their_time_and_size() {
             }
             let t = std::time::Instant::now();
             let out = expand_str(&src);
-            println!("{name}: expansion {:.3} s, {} bytes", t.elapsed().as_secs_f64(), out.len());
-            assert!(!out.contains("compile_error"), "{}", &out[..out.len().min(3000)]);
+            println!(
+                "{name}: expansion {:.3} s, {} bytes",
+                t.elapsed().as_secs_f64(),
+                out.len()
+            );
+            assert!(
+                !out.contains("compile_error"),
+                "{}",
+                &out[..out.len().min(3000)]
+            );
             if let Some(dir) = std::env::var_os("APPELL_WRITE_EXPANSIONS") {
                 std::fs::write(Path::new(&dir).join(format!("{name}.rs")), &out).unwrap();
             }
@@ -82,8 +100,16 @@ fn a_robot_on_a_moving_base() {
         struct Mobile;
         "#,
     );
-    assert!(!out.contains("compile_error"), "{}", &out[..out.len().min(3000)]);
-    assert!(out.contains(r#"coordinates : & ["slide" , "shoulder_pan_joint""#), "{}", &out[..3000]);
+    assert!(
+        !out.contains("compile_error"),
+        "{}",
+        &out[..out.len().min(3000)]
+    );
+    assert!(
+        out.contains(r#"coordinates : & ["slide" , "shoulder_pan_joint""#),
+        "{}",
+        &out[..3000]
+    );
     // A frame not made by a joint has no origin: `at` is needed.
     let out = expand_str(
         r#"
@@ -101,15 +127,17 @@ fn a_robot_on_a_moving_base() {
         struct Turning;
         "#,
     );
-    assert!(!out.contains("compile_error"), "{}", &out[..out.len().min(3000)]);
+    assert!(
+        !out.contains("compile_error"),
+        "{}",
+        &out[..out.len().min(3000)]
+    );
 }
 
 #[test]
 fn without_a_manifest_directory_a_urdf_is_an_error() {
-    let input: syn::DeriveInput = syn::parse_str(
-        r#"#[appell(urdf("robot.urdf"))] struct R;"#,
-    )
-    .unwrap();
+    let input: syn::DeriveInput =
+        syn::parse_str(r#"#[appell(urdf("robot.urdf"))] struct R;"#).unwrap();
     let out = expand_in(&input, None).to_string();
     assert!(out.contains("CARGO_MANIFEST_DIR"), "{out}");
 }

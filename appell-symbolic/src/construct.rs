@@ -615,7 +615,11 @@ impl Graph {
             Func::Sin | Func::Cos if n.is_float() => quarter_turns(n.to_f64()).map(|k| {
                 // sin(kπ/2) and cos(kπ/2) for k mod 4 = 0, 1, 2, 3.
                 let sin = [0, 1, 0, -1][k];
-                Number::int(if f == Func::Sin { sin } else { [1, 0, -1, 0][k] })
+                Number::int(if f == Func::Sin {
+                    sin
+                } else {
+                    [1, 0, -1, 0][k]
+                })
             }),
             Func::Cos | Func::Exp if n.is_zero() => Some(Number::ONE),
             Func::Ln if n.is_one() && !n.is_float() => Some(Number::ZERO),

@@ -78,7 +78,11 @@ rule!(
     "cos(1.5707963267948966) + sin(-1.5707963267948966) + sin(3.141592653589793) + cos(3.141592653589793)*x",
     "-x - 1"
 );
-rule!(rounded_right_angle_stays, "cos(1.57079632679)", "4.8965888601467475e-12");
+rule!(
+    rounded_right_angle_stays,
+    "cos(1.57079632679)",
+    "4.8965888601467475e-12"
+);
 rule!(exp_zero, "exp(0)", "1");
 rule!(ln_one, "ln(1)", "0");
 rule!(exp_ln, "exp(ln(x))", "x");

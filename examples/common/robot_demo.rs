@@ -29,20 +29,42 @@ pub fn demonstrate<M: Model>(model: &M) -> Result<(), Box<dyn Error>> {
         let q: Vec<f64> = info
             .coordinates
             .iter()
-            .map(|c| info.retained.iter().position(|r| r == c).map_or(0.0, |k| state[k]))
+            .map(|c| {
+                info.retained
+                    .iter()
+                    .position(|r| r == c)
+                    .map_or(0.0, |k| state[k])
+            })
             .collect();
         let e = appell::energy::energies(model, 0.0, &q, &state[info.retained.len()..], &inputs)?;
         Ok(e.kinetic + e.potential)
     };
     let e0 = energy(&state)?;
     let h = 1e-4;
-    let (mut k1, mut k2, mut k3, mut k4) = (vec![0.0; len], vec![0.0; len], vec![0.0; len], vec![0.0; len]);
+    let (mut k1, mut k2, mut k3, mut k4) = (
+        vec![0.0; len],
+        vec![0.0; len],
+        vec![0.0; len],
+        vec![0.0; len],
+    );
     let start = std::time::Instant::now();
     for step in 0..20_000 {
         let t = step as f64 * h;
         model.rhs(&prepared, t, &state, &inputs, &mut k1)?;
-        model.rhs(&prepared, t + 0.5 * h, &ahead(&state, 0.5 * h, &k1), &inputs, &mut k2)?;
-        model.rhs(&prepared, t + 0.5 * h, &ahead(&state, 0.5 * h, &k2), &inputs, &mut k3)?;
+        model.rhs(
+            &prepared,
+            t + 0.5 * h,
+            &ahead(&state, 0.5 * h, &k1),
+            &inputs,
+            &mut k2,
+        )?;
+        model.rhs(
+            &prepared,
+            t + 0.5 * h,
+            &ahead(&state, 0.5 * h, &k2),
+            &inputs,
+            &mut k3,
+        )?;
         model.rhs(&prepared, t + h, &ahead(&state, h, &k3), &inputs, &mut k4)?;
         for i in 0..len {
             state[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);

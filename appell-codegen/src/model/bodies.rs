@@ -4,7 +4,7 @@ use appell_symbolic::{Id, SymbolicError};
 
 use crate::algebra::dot;
 
-use super::builder::{hint, Builder};
+use super::builder::Builder;
 use super::expr::Val;
 use super::{Body, Constraint, Load, Point, Rolling, Vec3};
 use crate::ast::*;

@@ -99,7 +99,9 @@ fn positive_definite(m: &[[f64; 3]; 3], tol: &dyn Fn(i32) -> f64) -> bool {
 /// Every principal minor is non-negative.
 fn semidefinite(m: &[[f64; 3]; 3], tol: &dyn Fn(i32) -> f64) -> bool {
     (0..3).all(|k| m[k][k] >= -tol(1))
-        && [(0, 1), (0, 2), (1, 2)].iter().all(|&(a, b)| minor(m, a, b) >= -tol(2))
+        && [(0, 1), (0, 2), (1, 2)]
+            .iter()
+            .all(|&(a, b)| minor(m, a, b) >= -tol(2))
         && det(m) >= -tol(3)
 }
 
@@ -121,10 +123,28 @@ mod tests {
     #[test]
     fn real_links_pass() {
         // The UR5's wrist (izz close to ixx + iyy) and a Panda link.
-        assert_eq!(check(1.219, &inertia(0.111172755531, 0.111172755531, 0.21942, 0.0, 0.0, 0.0)), Ok(Mass::Body));
-        assert_eq!(check(4.970684, &inertia(0.70337, 0.70661, 0.009117, -0.000139, 0.019169, 0.006772)), Ok(Mass::Body));
-        assert_eq!(check(0.0, &inertia(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)), Ok(Mass::None));
-        assert_eq!(check(2.0, &inertia(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)), Ok(Mass::Body));
+        assert_eq!(
+            check(
+                1.219,
+                &inertia(0.111172755531, 0.111172755531, 0.21942, 0.0, 0.0, 0.0)
+            ),
+            Ok(Mass::Body)
+        );
+        assert_eq!(
+            check(
+                4.970684,
+                &inertia(0.70337, 0.70661, 0.009117, -0.000139, 0.019169, 0.006772)
+            ),
+            Ok(Mass::Body)
+        );
+        assert_eq!(
+            check(0.0, &inertia(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
+            Ok(Mass::None)
+        );
+        assert_eq!(
+            check(2.0, &inertia(0.0, 0.0, 0.0, 0.0, 0.0, 0.0)),
+            Ok(Mass::Body)
+        );
     }
 
     #[test]

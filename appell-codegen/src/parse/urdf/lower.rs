@@ -33,10 +33,28 @@ struct LinkNumbers {
 }
 
 /// The fields `parameters(...)` may name, on a joint and on a link.
-const JOINT_FIELDS: &[&str] = &["xyz.x", "xyz.y", "xyz.z", "rpy.roll", "rpy.pitch", "rpy.yaw"];
+const JOINT_FIELDS: &[&str] = &[
+    "xyz.x",
+    "xyz.y",
+    "xyz.z",
+    "rpy.roll",
+    "rpy.pitch",
+    "rpy.yaw",
+];
 const LINK_FIELDS: &[&str] = &[
-    "mass", "ixx", "iyy", "izz", "ixy", "iyz", "ixz", "xyz.x", "xyz.y", "xyz.z", "rpy.roll",
-    "rpy.pitch", "rpy.yaw",
+    "mass",
+    "ixx",
+    "iyy",
+    "izz",
+    "ixy",
+    "iyz",
+    "ixz",
+    "xyz.x",
+    "xyz.y",
+    "xyz.z",
+    "rpy.roll",
+    "rpy.pitch",
+    "rpy.yaw",
 ];
 
 fn slot<'a>(xyz: &'a mut [Expr; 3], rpy: &'a mut [Expr; 3], field: &str) -> Option<&'a mut Expr> {
@@ -71,7 +89,13 @@ fn floats(v: &[f64; 3], span: Span) -> [Expr; 3] {
 
 /// Writes the robot into `ast`. Errors about elements go to `cx` (all of
 /// them); the result's error is one that stops the lowering.
-pub(super) fn lower(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec) -> syn::Result<()> {
+pub(super) fn lower(
+    cx: &Ctxt,
+    ast: &mut ModelAst,
+    read: &Read,
+    tree: &Tree,
+    spec: &Spec,
+) -> syn::Result<()> {
     let span = spec.path.span();
     let robot = &read.robot;
     let mut joints: Vec<JointNumbers> = robot
@@ -140,7 +164,13 @@ pub(super) fn lower(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spe
 }
 
 /// Replaces a number by the expression `parameters(...)` gives for it.
-fn promote(cx: &Ctxt, tree: &Tree, p: &Promotion, joints: &mut [JointNumbers], links: &mut [LinkNumbers]) {
+fn promote(
+    cx: &Ctxt,
+    tree: &Tree,
+    p: &Promotion,
+    joints: &mut [JointNumbers],
+    links: &mut [LinkNumbers],
+) {
     let field = p.field_text();
     let joint = tree.joints.iter().position(|j| *j == p.element);
     let link = tree.links.iter().position(|l| *l == p.element);
@@ -154,7 +184,10 @@ fn promote(cx: &Ctxt, tree: &Tree, p: &Promotion, joints: &mut [JointNumbers], l
             (links[l].slot(&field), LINK_FIELDS)
         }
         (Some(_), Some(_)) => {
-            cx.error_spanned_by(&p.element, format!("`{}` is both a link and a joint of the URDF", p.element));
+            cx.error_spanned_by(
+                &p.element,
+                format!("`{}` is both a link and a joint of the URDF", p.element),
+            );
             return;
         }
         (None, None) => {
@@ -192,7 +225,10 @@ fn welds(cx: &Ctxt, robot: &urdf_rs::Robot, tree: &Tree, names: &[Ident]) -> Vec
     for name in names {
         match tree.joints.iter().position(|j| j == name) {
             Some(j) if robot.joints[j].joint_type == urdf_rs::JointType::Fixed => {
-                cx.error_spanned_by(name, format!("joint `{name}` is fixed already; `weld` is for movable joints"));
+                cx.error_spanned_by(
+                    name,
+                    format!("joint `{name}` is fixed already; `weld` is for movable joints"),
+                );
             }
             Some(j) => welded[j] = true,
             None => {
@@ -227,7 +263,11 @@ fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, St
     let mass_promoted = promoted.iter().any(|f| f == "mass");
     let inertia_promoted = promoted.iter().any(|f| f.starts_with('i'));
     let (mass, i) = (inertial.mass.value, &inertial.inertia);
-    let matrix = [[i.ixx, i.ixy, i.ixz], [i.ixy, i.iyy, i.iyz], [i.ixz, i.iyz, i.izz]];
+    let matrix = [
+        [i.ixx, i.ixy, i.ixz],
+        [i.ixy, i.iyy, i.iyz],
+        [i.ixz, i.iyz, i.izz],
+    ];
     if mass_promoted || mass > 0.0 {
         if !inertia_promoted {
             if mass_promoted {
@@ -250,11 +290,18 @@ fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, St
 fn kinds(cx: &Ctxt, read: &Read, welded: &[bool], span: Span) -> Vec<Option<JointKind>> {
     let mut out = Vec::new();
     for (j, weld) in read.robot.joints.iter().zip(welded) {
-        let kind = if *weld { Ok(JointKind::Weld) } else { kind(j, span) };
+        let kind = if *weld {
+            Ok(JointKind::Weld)
+        } else {
+            kind(j, span)
+        };
         out.push(match kind {
             Ok(k) => Some(k),
             Err(e) => {
-                cx.error_at(span, format!("URDF {}: {e}", read.lines.describe("joint", &j.name)));
+                cx.error_at(
+                    span,
+                    format!("URDF {}: {e}", read.lines.describe("joint", &j.name)),
+                );
                 None
             }
         })
@@ -381,13 +428,25 @@ fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, 
         }
         let at = read.lines.describe("joint", &urdf.name);
         let Some(other) = read.robot.joints.iter().position(|o| o.name == mimic.joint) else {
-            let hint = hint(&mimic.joint, read.robot.joints.iter().map(|o| o.name.clone()));
-            cx.error_at(span, format!("URDF {at}: it mimics `{}`, which is not a joint of the file{hint}", mimic.joint));
+            let hint = hint(
+                &mimic.joint,
+                read.robot.joints.iter().map(|o| o.name.clone()),
+            );
+            cx.error_at(
+                span,
+                format!(
+                    "URDF {at}: it mimics `{}`, which is not a joint of the file{hint}",
+                    mimic.joint
+                ),
+            );
             continue;
         };
         let single = |k: usize| {
             use urdf_rs::JointType as T;
-            matches!(read.robot.joints[k].joint_type, T::Revolute | T::Continuous | T::Prismatic)
+            matches!(
+                read.robot.joints[k].joint_type,
+                T::Revolute | T::Continuous | T::Prismatic
+            )
         };
         if !single(j) || !single(other) {
             cx.error_at(span, format!("URDF {at}: a mimic joint and the joint it mimics must be revolute, continuous or prismatic"));
@@ -401,7 +460,11 @@ fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, 
                 Expr::Float(mimic.multiplier.unwrap_or(1.0), span),
                 Expr::Name(tree.joints[other].clone()),
             );
-            if is_zero(&offset) { scaled } else { add(scaled, offset) }
+            if is_zero(&offset) {
+                scaled
+            } else {
+                add(scaled, offset)
+            }
         };
         ast.holonomic.push(ConstraintDef {
             lhs: Expr::Name(tree.joints[j].clone()),
@@ -418,13 +481,17 @@ fn record_names(ast: &mut ModelAst, robot: &urdf_rs::Robot, tree: &Tree) {
     for (l, name) in robot.links.iter().zip(&tree.links) {
         let what = format!("the URDF's link `{}`", l.name);
         for suffix in ["", "_origin", "_center", "_inertial"] {
-            ast.urdf_names.push((format!("{name}{suffix}"), what.clone()));
+            ast.urdf_names
+                .push((format!("{name}{suffix}"), what.clone()));
         }
     }
     for (j, name) in robot.joints.iter().zip(&tree.joints) {
         let what = format!("the URDF's joint `{}`", j.name);
-        for form in ["{}", "tau_{}", "{}_frame", "{}_at", "{}_x", "{}_y", "{}_angle"] {
-            ast.urdf_names.push((form.replace("{}", &name.to_string()), what.clone()));
+        for form in [
+            "{}", "tau_{}", "{}_frame", "{}_at", "{}_x", "{}_y", "{}_angle",
+        ] {
+            ast.urdf_names
+                .push((form.replace("{}", &name.to_string()), what.clone()));
         }
     }
 }

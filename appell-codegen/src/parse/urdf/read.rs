@@ -125,10 +125,7 @@ fn walk(text: &str) -> Result<Lines, String> {
                 xml::Event::ElementEnd(tag) => match open.pop() {
                     Some(o) if o == tag.name => {}
                     Some(o) => {
-                        return Err(format!(
-                            "line {number}: `</{}>` closes `<{o}>`",
-                            tag.name
-                        ))
+                        return Err(format!("line {number}: `</{}>` closes `<{o}>`", tag.name))
                     }
                     None => return Err(format!("line {number}: `</{}>` closes nothing", tag.name)),
                 },
@@ -210,7 +207,10 @@ mod tests {
     fn dot_dot_is_taken_out_by_name() {
         let p = resolve(Path::new("/a/b/target/x"), "../../c/./d.urdf");
         assert_eq!(p, Path::new("/a/b/c/d.urdf"));
-        assert_eq!(resolve(Path::new("/a"), "/e/f.urdf"), Path::new("/e/f.urdf"));
+        assert_eq!(
+            resolve(Path::new("/a"), "/e/f.urdf"),
+            Path::new("/e/f.urdf")
+        );
     }
 
     #[test]
@@ -225,7 +225,8 @@ mod tests {
 
     #[test]
     fn elements_are_found_by_line() {
-        let lines = walk("<robot>\n  <link name=\"a\"/>\n  <joint name=\"j\">\n</joint></robot>").unwrap();
+        let lines =
+            walk("<robot>\n  <link name=\"a\"/>\n  <joint name=\"j\">\n</joint></robot>").unwrap();
         assert_eq!(lines.describe("joint", "j"), "joint `j` (line 3)");
         assert_eq!(lines.describe("link", "a"), "link `a` (line 2)");
         assert_eq!(lines.describe("link", "b"), "link `b`");

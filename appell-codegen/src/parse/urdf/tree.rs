@@ -6,7 +6,6 @@ use syn::Ident;
 
 use super::read::Lines;
 
-
 /// The links and joints under their model names, and the order to declare
 /// them in.
 pub(super) struct Tree {
@@ -30,7 +29,13 @@ pub(super) struct Tree {
 pub(super) fn model_name(urdf: &str) -> String {
     let mut s: String = urdf
         .chars()
-        .map(|c| if c.is_ascii_alphanumeric() || c == '_' { c } else { '_' })
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     if s.is_empty() || s.starts_with(|c: char| c.is_ascii_digit()) {
         s.insert(0, '_');
@@ -45,10 +50,26 @@ impl Tree {
     /// The tree of `robot`, or what is wrong with it: repeated names, a
     /// joint whose parent or child link is unknown, a link that is the
     /// child of two joints, no root or several, a loop.
-    pub(super) fn new(robot: &urdf_rs::Robot, lines: &Lines, span: Span) -> Result<Tree, Vec<String>> {
+    pub(super) fn new(
+        robot: &urdf_rs::Robot,
+        lines: &Lines,
+        span: Span,
+    ) -> Result<Tree, Vec<String>> {
         let mut errors = Vec::new();
-        let links = names(robot.links.iter().map(|l| l.name.as_str()), "link", lines, span, &mut errors);
-        let joints = names(robot.joints.iter().map(|j| j.name.as_str()), "joint", lines, span, &mut errors);
+        let links = names(
+            robot.links.iter().map(|l| l.name.as_str()),
+            "link",
+            lines,
+            span,
+            &mut errors,
+        );
+        let joints = names(
+            robot.joints.iter().map(|j| j.name.as_str()),
+            "joint",
+            lines,
+            span,
+            &mut errors,
+        );
         let link_names: Vec<&str> = robot.links.iter().map(|l| l.name.as_str()).collect();
         let find = |name: &str, joint: &urdf_rs::Joint, role: &str, errors: &mut Vec<String>| {
             let found = link_names.iter().position(|l| *l == name);
@@ -85,12 +106,21 @@ impl Tree {
         if !errors.is_empty() {
             return Err(errors);
         }
-        let roots: Vec<usize> = (0..links.len()).filter(|&l| parent_joint[l].is_none()).collect();
+        let roots: Vec<usize> = (0..links.len())
+            .filter(|&l| parent_joint[l].is_none())
+            .collect();
         let root = match roots[..] {
             [root] => root,
-            [] => return Err(vec!["the URDF has no root link: its joints make a loop".into()]),
+            [] => {
+                return Err(vec![
+                    "the URDF has no root link: its joints make a loop".into()
+                ])
+            }
             _ => {
-                let names: Vec<String> = roots.iter().map(|&l| format!("`{}`", robot.links[l].name)).collect();
+                let names: Vec<String> = roots
+                    .iter()
+                    .map(|&l| format!("`{}`", robot.links[l].name))
+                    .collect();
                 return Err(vec![format!(
                     "the URDF has several root links ({}): join them with joints so that one link is the root",
                     names.join(", ")
@@ -99,7 +129,9 @@ impl Tree {
         };
         let order = depth_first(root, &ends);
         if order.len() != ends.len() {
-            return Err(vec!["the URDF's joints make a loop: some links cannot be reached from the root".into()]);
+            return Err(vec![
+                "the URDF's joints make a loop: some links cannot be reached from the root".into(),
+            ]);
         }
         Ok(Tree {
             links,
@@ -158,7 +190,10 @@ mod tests {
 
     #[test]
     fn urdf_names_become_rust_names() {
-        assert_eq!(model_name("base_link-base_fixed_joint"), "base_link_base_fixed_joint");
+        assert_eq!(
+            model_name("base_link-base_fixed_joint"),
+            "base_link_base_fixed_joint"
+        );
         assert_eq!(model_name("type"), "type_");
         assert_eq!(model_name("2nd"), "_2nd");
         assert_eq!(model_name("panda_joint1"), "panda_joint1");
