@@ -232,3 +232,29 @@ fn a_zero_quaternion_is_a_typed_error_not_a_nan() {
         .unwrap_err();
     assert!(err.to_string().contains("quaternion of frame `B`"), "{err}");
 }
+
+/// The same body from a URDF whose joint is `floating`.
+#[derive(appell::Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/data/floating_base.urdf"))]
+struct FloatingUrdf;
+
+#[test]
+fn a_urdf_floating_joint_is_the_free_joint() {
+    assert_eq!(
+        FloatingUrdf::info().coordinates,
+        FreeBody::info().coordinates
+    );
+    assert_eq!(FloatingUrdf::info().speeds, FreeBody::info().speeds);
+    let (a, b) = (FloatingUrdf, FreeBody::default());
+    let mut rng = Rng(12);
+    for _ in 0..100 {
+        let mut x: Vec<f64> = random_unit_quaternion(&mut rng).to_vec();
+        x.extend((0..6).map(|_| rng.uniform(-2.0, 2.0)));
+        let (mut da, mut db) = ([0.0; 10], [0.0; 10]);
+        a.rhs(&a.prepare::<f64>(), 0.0, &x, &[], &mut da).unwrap();
+        b.rhs(&b.prepare::<f64>(), 0.0, &x, &[], &mut db).unwrap();
+        for (p, q) in da.iter().zip(&db) {
+            assert!((p - q).abs() < 1e-14 * (1.0 + q.abs()), "{da:?} {db:?}");
+        }
+    }
+}

@@ -232,4 +232,13 @@ pub struct ModelAst {
     pub joint_speeds: Vec<Ident>,
     /// The struct's visibility (scene types get the same).
     pub vis: syn::Visibility,
+    /// Files the model was read from (`urdf(...)`), absolute: the output
+    /// includes each, so cargo builds the model again when one changes.
+    pub files: Vec<String>,
+    /// Names a URDF made, with the element that made each (`the URDF's
+    /// link `forearm_link``), for errors about them.
+    pub urdf_names: Vec<(String, String)>,
+    /// URDF links without mass: frames, but not bodies (for the error of a
+    /// `rolls(...)` that names one).
+    pub massless_links: Vec<String>,
 }

@@ -88,6 +88,24 @@ pub fn did_you_mean<'a>(
     best.map(|(_, c)| c)
 }
 
+/// [`did_you_mean`], or else the only candidate that begins or ends with
+/// `wanted` and an underscore (`elbow` for `elbow_joint`, `forearm` for
+/// `forearm_link`): URDF names carry such suffixes.
+pub fn suggest<'a>(wanted: &str, candidates: impl IntoIterator<Item = &'a str>) -> Option<&'a str> {
+    let all: Vec<&str> = candidates.into_iter().collect();
+    if let Some(close) = did_you_mean(wanted, all.iter().copied()) {
+        return Some(close);
+    }
+    let (head, tail) = (format!("{wanted}_"), format!("_{wanted}"));
+    let mut extending = all
+        .iter()
+        .filter(|c| c.starts_with(&head) || c.ends_with(&tail));
+    match (extending.next(), extending.next()) {
+        (Some(only), None) => Some(only),
+        _ => None,
+    }
+}
+
 /// Edit distance counting an adjacent transposition as one edit (optimal
 /// string alignment), so `theat` is one edit from `theta`.
 fn levenshtein(a: &str, b: &str) -> usize {
@@ -126,6 +144,12 @@ mod tests {
     #[test]
     fn transposition_is_one_edit() {
         assert_eq!(did_you_mean("theat", ["theta", "l", "m"]), Some("theta"));
+    }
+    #[test]
+    fn suggests_the_one_name_a_suffix_extends() {
+        let links = ["base_link", "forearm_link", "upper_arm_link"];
+        assert_eq!(suggest("forearm", links), Some("forearm_link"));
+        assert_eq!(suggest("link", links), None);
     }
     #[test]
     fn no_suggestion_for_a_distant_name() {

@@ -54,8 +54,16 @@ use proc_macro2::TokenStream;
 /// assert!(out.contains("did you mean `q`?"), "{out}");
 /// ```
 pub fn expand(input: &syn::DeriveInput) -> TokenStream {
+    let dir = std::env::var_os("CARGO_MANIFEST_DIR").map(std::path::PathBuf::from);
+    expand_in(input, dir.as_deref())
+}
+
+/// [`expand`], reading the files a model names (`urdf(...)`) relative to
+/// `manifest_dir` instead of the environment's `CARGO_MANIFEST_DIR` (tools
+/// that expand models of several crates, such as the snapshot test).
+pub fn expand_in(input: &syn::DeriveInput, manifest_dir: Option<&std::path::Path>) -> TokenStream {
     let cx = ctxt::Ctxt::new();
-    let ast = parse::parse(&cx, input);
+    let ast = parse::parse_in(&cx, input, manifest_dir);
     let model = if cx.has_errors() {
         None
     } else {

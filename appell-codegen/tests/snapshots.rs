@@ -8,13 +8,19 @@
 //! error) and benches. A struct written inside a `macro_rules!` body (the
 //! gyroscopes of `tests/composite_bodies.rs`) is not seen.
 //!
-//! The expansion is compared as formatted Rust (see [`expansion_text`]).
+//! The expansion is compared as formatted Rust (see [`expansion_text`]),
+//! with the workspace's directory written `$WORKSPACE` (a URDF model
+//! includes its file by absolute path). Each model reads its files (URDF)
+//! from the directory its crate is compiled in ([`manifest_dir`]). Models
+//! behind a cargo feature (`#[cfg(feature = ...)]`: the 32-link spatial
+//! chain) are expanded only with `APPELL_LARGE_MODELS=1`.
 //!
 //! `APPELL_BLESS=1 cargo test -p appell-codegen --test snapshots` writes the
 //! snapshots anew; review the diff before committing it.
 
 use std::path::{Path, PathBuf};
 
+use quote::ToTokens;
 use syn::visit::Visit;
 
 /// Folders searched for models, relative to the workspace root.
@@ -75,11 +81,35 @@ impl<'ast> Visit<'ast> for Models {
 /// statement a line so a change reads as a diff. Formatting the syntax tree
 /// leaves out what only the token stream carries (spans, and whether two
 /// punctuation marks were written together), which is no change of code.
-fn expansion_text(item: &syn::ItemStruct) -> String {
+fn expansion_text(item: &syn::ItemStruct, manifest_dir: &Path) -> String {
     let input = syn::DeriveInput::from(item.clone());
-    let tokens = appell_codegen::expand(&input);
+    let tokens = appell_codegen::expand_in(&input, Some(manifest_dir));
     let file: syn::File = syn::parse2(tokens).expect("the expansion parses as Rust items");
-    prettyplease::unparse(&file)
+    let root = workspace_root().to_string_lossy().into_owned();
+    prettyplease::unparse(&file).replace(&root, "$WORKSPACE")
+}
+
+/// The directory cargo compiles `file`'s crate in, which paths in its
+/// models start from: the workspace's for the root crate, a member's own,
+/// and for a UI case the project trybuild writes under the target
+/// directory (`target/tests/trybuild/appell`, which need not exist: the
+/// derive takes `..` out of a path by name).
+fn manifest_dir(rel: &Path) -> PathBuf {
+    let root = workspace_root();
+    if rel.starts_with("tests/ui") {
+        root.join("target/tests/trybuild/appell")
+    } else if rel.starts_with("appell-nostd-check") {
+        root.join("appell-nostd-check")
+    } else {
+        root
+    }
+}
+
+/// Whether a model is compiled only with a cargo feature.
+fn behind_a_feature(item: &syn::ItemStruct) -> bool {
+    item.attrs.iter().any(|a| {
+        a.path().is_ident("cfg") && a.meta.to_token_stream().to_string().contains("feature")
+    })
 }
 
 /// Every model: (snapshot name, expansion).
@@ -102,8 +132,13 @@ fn expansions() -> Vec<(String, String)> {
             .with_extension("")
             .to_string_lossy()
             .replace(['/', '\\'], "__");
+        let large = std::env::var_os("APPELL_LARGE_MODELS").is_some();
         for item in &models.0 {
-            out.push((format!("{stem}__{}.txt", item.ident), expansion_text(item)));
+            if behind_a_feature(item) && !large {
+                continue;
+            }
+            let text = expansion_text(item, &manifest_dir(rel));
+            out.push((format!("{stem}__{}.txt", item.ident), text));
         }
     }
     out

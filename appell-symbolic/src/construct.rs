@@ -13,6 +13,7 @@
 //! | sums as factors are primitive, leading term positive | `(4y − 2x)/z → −2(x − 2y)/z` |
 //! | square roots and absolute values of powers | `√x² → x` (as `√x·√x`), `|x|² → x²` |
 //! | parity | `sin(−x) → −sin x`, `cos(−x) → cos x`, `|−x| → |x|` |
+//! | right angles as doubles | `cos(1.5707963267948966) → 0`, `sin(-1.5707963267948966) → -1` |
 //! | inverse pairs | `exp(ln x) → x`, `ln(exp x) → x` |
 //! | Pythagoras inside a sum | `c·R·sin²x + c·R·cos²x → c·R`, `c·R − c·R·sin²x → c·R·cos²x` |
 //!
@@ -25,6 +26,22 @@ use std::collections::BTreeMap;
 use crate::error::{Result, SymbolicError};
 use crate::graph::{Func, Graph, Id, Node, Symbol};
 use crate::number::Number;
+
+/// k mod 4 when `x` is the double nearest to kπ/2 (0 < |k| ≤ 8): such an
+/// angle stands for the right angle it rounds (a URDF's
+/// `1.5707963267948966`), so its sine and cosine fold to the exact 0 and
+/// ±1. The float values differ from them by less than half an ulp of 1
+/// (cos(fl(π/2)) = 6.1e-17), below the rounding of a direction cosine, and
+/// an exact zero keeps a rotation by a right angle a permutation instead of
+/// filling every entry of the frames below it with tiny products.
+fn quarter_turns(x: f64) -> Option<usize> {
+    let k = (x / std::f64::consts::FRAC_PI_2).round();
+    if k == 0.0 || k.abs() > 8.0 {
+        return None;
+    }
+    let nearest = k * std::f64::consts::FRAC_PI_2;
+    ((nearest - x).abs() <= f64::EPSILON * x.abs()).then(|| (k as i64).rem_euclid(4) as usize)
+}
 
 /// What a coefficient-1 product of factors canonically is.
 enum UnitProduct {
@@ -595,6 +612,15 @@ impl Graph {
     fn fold(&mut self, f: Func, n: Number) -> Result<Option<Id>> {
         let exact = match f {
             Func::Sin | Func::Tan if n.is_zero() => Some(Number::ZERO),
+            Func::Sin | Func::Cos if n.is_float() => quarter_turns(n.to_f64()).map(|k| {
+                // sin(kπ/2) and cos(kπ/2) for k mod 4 = 0, 1, 2, 3.
+                let sin = [0, 1, 0, -1][k];
+                Number::int(if f == Func::Sin {
+                    sin
+                } else {
+                    [1, 0, -1, 0][k]
+                })
+            }),
             Func::Cos | Func::Exp if n.is_zero() => Some(Number::ONE),
             Func::Ln if n.is_one() && !n.is_float() => Some(Number::ZERO),
             Func::Abs => Some(n.abs()),

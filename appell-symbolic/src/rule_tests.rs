@@ -73,6 +73,16 @@ rule!(cos_even, "cos(-2*x)", "cos(2*x)");
 rule!(tan_odd, "tan(-x)", "-tan(x)");
 rule!(sin_zero, "sin(0)", "0");
 rule!(cos_zero, "cos(0)", "1");
+rule!(
+    right_angle_as_double,
+    "cos(1.5707963267948966) + sin(-1.5707963267948966) + sin(3.141592653589793) + cos(3.141592653589793)*x",
+    "-x - 1"
+);
+rule!(
+    rounded_right_angle_stays,
+    "cos(1.57079632679)",
+    "4.8965888601467475e-12"
+);
 rule!(exp_zero, "exp(0)", "1");
 rule!(ln_one, "ln(1)", "0");
 rule!(exp_ln, "exp(ln(x))", "x");

@@ -9,18 +9,27 @@ use appell_symbolic::Id;
 use super::{Derivation, Elimination};
 use crate::model::Model;
 
+/// The longest expression written out in full, in characters (a spatial
+/// chain's mass matrix entries reach megabytes otherwise).
+const MAX_TEXT: usize = 8192;
+
 /// The readable form of the derived equations.
 pub fn equations_text(model: &Model, d: &Derivation) -> String {
     let g = &model.g;
     let name = |i: usize| model.coords[i].0.to_string();
+    // A small graph can still print as a long tree (its shared parts
+    // written out each time they occur): an expression whose text passes
+    // MAX_TEXT characters is named by its size too.
     let show = |e: Id| -> String {
-        if g.dag_size(&[e]) > 400 {
-            format!(
-                "<expression of {} nodes; see the generated code>",
-                g.dag_size(&[e])
-            )
-        } else {
-            g.display(e).to_string()
+        let nodes = g.dag_size(&[e]);
+        let text = (nodes <= 400).then(|| g.display(e).to_string());
+        match text {
+            Some(text) if text.len() <= MAX_TEXT => text,
+            Some(text) => format!(
+                "<expression of {nodes} nodes, {} characters written out; see the generated code>",
+                text.len()
+            ),
+            None => format!("<expression of {nodes} nodes; see the generated code>"),
         }
     };
     let mut s = String::new();

@@ -228,6 +228,10 @@ pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
         }
         .implementation(),
     );
+    // The files the model was read from: cargo tracks what a crate
+    // includes, so a changed URDF builds the model again.
+    let files = &model.files;
+    body.extend(quote!(#(const _: &[u8] = ::core::include_bytes!(#files);)*));
     let mut decls = TokenStream::new();
     for (scene, d) in scenes {
         let name = &scene.name;

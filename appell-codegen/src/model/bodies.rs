@@ -4,7 +4,7 @@ use appell_symbolic::{Id, SymbolicError};
 
 use crate::algebra::dot;
 
-use super::builder::{hint, Builder};
+use super::builder::Builder;
 use super::expr::Val;
 use super::{Body, Constraint, Load, Point, Rolling, Vec3};
 use crate::ast::*;
@@ -255,7 +255,17 @@ impl Builder<'_> {
         for r in &ast.rolls {
             let name = r.body.to_string();
             let Some(bi) = bodies.iter().position(|x| x.name == name) else {
-                let h = hint(&name, bodies.iter().map(|x| x.name.clone()));
+                if ast.massless_links.contains(&name) {
+                    self.cx.error_spanned_by(&r.body, format!("`{name}` is a link of the URDF without mass, so no body rolls as it; name a link with mass, or give this one a mass with `parameters({name}.mass = m)`"));
+                    continue;
+                }
+                let names: Vec<&str> = bodies.iter().map(|x| x.name.as_str()).collect();
+                let h = crate::ctxt::suggest(&name, names.iter().copied())
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_else(|| match names.len() {
+                        1..=16 => format!("; the bodies are `{}`", names.join("`, `")),
+                        _ => String::new(),
+                    });
                 self.cx
                     .error_spanned_by(&r.body, format!("unknown body `{name}`{h}"));
                 continue;

@@ -36,6 +36,9 @@ pub(super) struct Builder<'a> {
     /// Every declared frame and point, built or not yet: a name used
     /// before its declaration is reported as such.
     pub(super) declared: Vec<Ident>,
+    /// Frames made by joints (and URDF roots) with their origin points,
+    /// for `origin(F)`.
+    pub(super) origins: Vec<(Ident, Ident)>,
 }
 
 pub(super) fn engine_error(cx: &Ctxt, span: proc_macro2::Span, e: SymbolicError) {
@@ -74,8 +77,12 @@ pub(super) fn build_in(
             .map(|f| f.name.clone())
             .chain(ast.points.iter().map(|p| p.name.clone()))
             .collect(),
+        origins: ast.origins.clone(),
     };
     b.declare_symbols(ast);
+    if b.cut_from.is_none() {
+        duplicate_bodies(cx, ast);
+    }
     b.frames_and_points(ast)?;
     let bodies: Vec<super::Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
     let holonomic = ast.holonomic.iter().flat_map(|c| b.constraint(c)).collect();
@@ -122,6 +129,7 @@ pub(super) fn build_in(
         norms: b.norms,
         quaternions: b.quaternions,
         joint_speeds: ast.joint_speeds.iter().map(|q| q.to_string()).collect(),
+        files: ast.files.clone(),
     };
     Some((model, b.cuts))
 }
@@ -191,10 +199,11 @@ impl Builder<'_> {
                 return false;
             }
             if let Some((_, other)) = seen.iter().find(|(n, _)| *n == name) {
+                let note = urdf_note(ast, &name);
                 if *other == what {
-                    cx.error_spanned_by(ident, format!("duplicate {what} `{name}`"));
+                    cx.error_spanned_by(ident, format!("duplicate {what} `{name}`{note}"));
                 } else {
-                    cx.error_spanned_by(ident, format!("`{name}` is already a {other}"));
+                    cx.error_spanned_by(ident, format!("`{name}` is already a {other}{note}"));
                 }
                 return false;
             }
@@ -386,6 +395,26 @@ pub(super) fn not_raw(cx: &Ctxt, ident: &Ident, what: &str) -> bool {
         format!("a raw identifier cannot name a {what}, since the generated code builds other names from it; rename `{bare}`"),
     );
     false
+}
+
+/// " (made by the URDF's link `x`)" when a URDF made the name: a clash
+/// with a name the model declares says where the other one comes from.
+pub(super) fn urdf_note(ast: &ModelAst, name: &str) -> String {
+    ast.urdf_names
+        .iter()
+        .find(|(n, _)| n == name)
+        .map(|(_, what)| format!(" (one of them made by {what}; rename the model's own)"))
+        .unwrap_or_default()
+}
+
+/// An error for each body named like one before it.
+pub(super) fn duplicate_bodies(cx: &Ctxt, ast: &ModelAst) {
+    for (k, b) in ast.bodies.iter().enumerate() {
+        if ast.bodies[..k].iter().any(|o| o.name == b.name) {
+            let note = urdf_note(ast, &b.name.to_string());
+            cx.error_spanned_by(&b.name, format!("duplicate body `{}`{note}", b.name));
+        }
+    }
 }
 
 /// "; did you mean `x`?" when `name` is close to a candidate.

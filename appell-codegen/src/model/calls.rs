@@ -1,7 +1,8 @@
 //! Function calls in expressions: `dt`, the elementary functions, `atan2`,
-//! `powi`, `dot`, `cross`, `norm`, `unit`, `omega` and `velocity`. Norms
-//! of vectors made of frame axes are taken by Lagrange's identity and the
-//! vector triple product, which keep their square roots short.
+//! `powi`, `dot`, `cross`, `norm`, `unit`, `omega`, `velocity` and
+//! `origin`. Norms of vectors made of frame axes are taken by Lagrange's
+//! identity and the vector triple product, which keep their square roots
+//! short.
 
 use proc_macro2::Span;
 use syn::Ident;
@@ -187,6 +188,7 @@ impl Builder<'_> {
             }
             "powi" => self.call_powi(args),
             "omega" | "velocity" => self.call_motion(&name, &args[0]),
+            "origin" => Ok(self.call_origin(&args[0])),
             "dot" | "cross" => self.call_product(&name, args),
             "norm" | "unit" => self.call_norm(&name, &args[0], span),
             _ => {
@@ -267,6 +269,36 @@ impl Builder<'_> {
         Ok(Some(Val::Vector(v)))
     }
 
+    /// `origin(F)`: the origin point of a frame a joint made (`F_origin`),
+    /// O for N.
+    fn call_origin(&mut self, arg: &Expr) -> Option<Val> {
+        let Expr::Name(frame) = arg else {
+            self.cx
+                .error_at(arg.span(), "`origin` takes the name of a frame");
+            return None;
+        };
+        if frame == "N" {
+            return Some(Val::Point(self.points[0].pos));
+        }
+        let point = self
+            .origins
+            .iter()
+            .find(|(f, _)| f == frame)
+            .map(|(_, p)| p.clone());
+        match point {
+            Some(p) => self.point_named(&p).map(Val::Point),
+            None => {
+                if self.frame_named(frame).is_some() {
+                    self.cx.error_spanned_by(
+                        frame,
+                        format!("frame `{frame}` was not made by a joint, so it has no origin; name a point instead"),
+                    );
+                }
+                None
+            }
+        }
+    }
+
     /// `dot(a, b)` or `cross(a, b)`; a cross product of a cross product
     /// by the triple product rule.
     fn call_product(&mut self, name: &str, args: &[Expr]) -> Result<Option<Val>, SymbolicError> {
@@ -339,6 +371,7 @@ const FUNCTIONS: &[(&str, usize)] = &[
     ("unit", 1),
     ("omega", 1),
     ("velocity", 1),
+    ("origin", 1),
 ];
 
 /// An elementary function of one argument.

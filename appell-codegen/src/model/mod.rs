@@ -230,6 +230,9 @@ pub struct Model {
     /// The coordinates whose rates joints made privileged speeds, for
     /// errors that count speeds.
     pub joint_speeds: Vec<String>,
+    /// Files the model was read from (absolute paths): the output includes
+    /// them, so cargo builds the model again when one changes.
+    pub files: Vec<String>,
 }
 
 impl Model {

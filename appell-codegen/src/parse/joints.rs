@@ -288,14 +288,7 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         holonomic: Vec::new(),
     };
     // The joint frame: the parent's axes turned by rpy, when it turns them.
-    let rpy: Vec<(RotationAxis, Expr)> = match &j.rpy {
-        Some([r, p, y]) => [(2, y), (1, p), (0, r)]
-            .into_iter()
-            .filter(|(_, a)| !is_zero(a))
-            .map(|(k, a)| (RotationAxis::Parent(k), a.clone()))
-            .collect(),
-        None => Vec::new(),
-    };
+    let rpy = j.rpy.as_ref().map(rpy_rotations).unwrap_or_default();
     let joint_frame = if rpy.is_empty() {
         j.parent.clone()
     } else {
@@ -465,6 +458,17 @@ fn actuate(j: &JointDef, out: &mut Lowered, child_origin: &Ident, joint_origin: 
     }
 }
 
+/// The rotations of fixed-axis roll, pitch, yaw (R = Rz(yaw) Ry(pitch)
+/// Rx(roll)) as a frame chain: yaw, then pitch and roll about the new
+/// axes; literal zero angles are left out.
+pub(super) fn rpy_rotations([r, p, y]: &[Expr; 3]) -> Vec<(RotationAxis, Expr)> {
+    [(2, y), (1, p), (0, r)]
+        .into_iter()
+        .filter(|(_, a)| !is_zero(a))
+        .map(|(k, a)| (RotationAxis::Parent(k), a.clone()))
+        .collect()
+}
+
 /// The rotation of a joint about its axis by `angle`.
 fn turn(axis: &JointAxis, joint_frame: &Ident, angle: Expr) -> (RotationAxis, Expr) {
     match axis {
@@ -496,7 +500,7 @@ fn unit_vector(axis: &JointAxis, frame: &Ident) -> Expr {
 }
 
 /// c0 F.x + c1 F.y + c2 F.z, leaving out literal zero components.
-fn in_frame(frame: &Ident, c: &[Expr; 3]) -> Expr {
+pub(super) fn in_frame(frame: &Ident, c: &[Expr; 3]) -> Expr {
     let span = frame.span();
     let terms: Vec<Expr> = c
         .iter()
@@ -510,7 +514,7 @@ fn in_frame(frame: &Ident, c: &[Expr; 3]) -> Expr {
         .unwrap_or_else(|| times(Expr::Int(0, span), Expr::Axis(frame.clone(), 0, span)))
 }
 
-fn is_zero(e: &Expr) -> bool {
+pub(super) fn is_zero(e: &Expr) -> bool {
     match e {
         Expr::Int(0, _) => true,
         Expr::Float(x, _) => *x == 0.0,
@@ -526,12 +530,12 @@ fn plus(point: Expr, offset: Option<Expr>) -> Expr {
     }
 }
 
-fn add(a: Expr, b: Expr) -> Expr {
+pub(super) fn add(a: Expr, b: Expr) -> Expr {
     let span = a.span();
     Expr::Binary(BinOp::Add, Box::new(a), Box::new(b), span)
 }
 
-fn times(a: Expr, b: Expr) -> Expr {
+pub(super) fn times(a: Expr, b: Expr) -> Expr {
     let span = a.span();
     Expr::Binary(BinOp::Mul, Box::new(a), Box::new(b), span)
 }

@@ -13,12 +13,26 @@ mod expr;
 mod items;
 pub mod joints;
 mod repeat;
+pub mod urdf;
 
 pub use expr::convert;
 use items::*;
 
-/// Parses the derive input; errors go to `cx`.
+/// Parses the derive input; errors go to `cx`. Files a model reads
+/// (`urdf(...)`) are found relative to the directory in the environment's
+/// `CARGO_MANIFEST_DIR`, the crate being compiled.
 pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
+    let dir = std::env::var_os("CARGO_MANIFEST_DIR").map(std::path::PathBuf::from);
+    parse_in(cx, input, dir.as_deref())
+}
+
+/// [`parse`], with files read relative to `manifest_dir` (None: a model
+/// that reads a file is an error).
+pub fn parse_in(
+    cx: &Ctxt,
+    input: &syn::DeriveInput,
+    manifest_dir: Option<&std::path::Path>,
+) -> ModelAst {
     let mut ast = ModelAst {
         name: input.ident.clone(),
         fields: Vec::new(),
@@ -39,6 +53,9 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
         origins: Vec::new(),
         joint_speeds: Vec::new(),
         vis: input.vis.clone(),
+        files: Vec::new(),
+        urdf_names: Vec::new(),
+        massless_links: Vec::new(),
     };
     match &input.data {
         syn::Data::Struct(s) => match &s.fields {
@@ -95,7 +112,7 @@ pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
         match expanded.and_then(|tokens| Parser::parse2(parser, tokens)) {
             Ok(items) => {
                 for item in items {
-                    add_item(cx, &mut ast, item);
+                    add_item(cx, &mut ast, item, manifest_dir);
                 }
             }
             Err(e) => cx.syn_error(e),
@@ -125,7 +142,7 @@ fn add_joint_speeds(ast: &mut ModelAst) {
 }
 
 /// Adds a joint's frames, points, coordinates, speeds, inputs and loads.
-fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
+pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
     let parent_origin = if joint.parent == "N" {
         Some(Ident::new("O", joint.parent.span()))
     } else {
@@ -184,6 +201,20 @@ pub(super) struct Item {
 impl syn::parse::Parse for Item {
     fn parse(input: ParseStream) -> syn::Result<Item> {
         let name: Ident = input.parse()?;
+        if input.peek(Token![=]) && name == "urdf" {
+            // `urdf = "path"`: the same as `urdf("path")`.
+            input.parse::<Token![=]>()?;
+            let path: syn::LitStr = input.parse()?;
+            let content = quote::quote!(#path);
+            let all = quote::quote!(#name = #path);
+            let span = name.span();
+            return Ok(Item {
+                name,
+                content,
+                all,
+                span,
+            });
+        }
         let content;
         let paren = syn::parenthesized!(content in input);
         let content: proc_macro2::TokenStream = content.parse()?;
@@ -220,9 +251,10 @@ const ITEMS: &[&str] = &[
     "scene",
     "joint",
     "repeat",
+    "urdf",
 ];
 
-fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
+fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, manifest_dir: Option<&std::path::Path>) {
     let name = item.name.to_string();
     let tokens = item.content.clone();
     let result: syn::Result<()> = (|| {
@@ -271,6 +303,7 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item) {
                     Parser::parse2(move |s: ParseStream| joints::parse_joint(s, span), tokens)?;
                 add_joint(ast, &joint)?
             }
+            "urdf" => urdf::add(cx, ast, &item, manifest_dir)?,
             "holonomic" | "nonholonomic" => {
                 let at = item.content.clone();
                 let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, at), tokens)?;

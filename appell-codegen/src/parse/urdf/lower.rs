@@ -1,0 +1,504 @@
+//! The robot as model items: the root link's frame and origin, a
+//! `joint(...)` per URDF joint, a `body(...)` per link with mass, and a
+//! holonomic constraint per mimic joint.
+
+use proc_macro2::Span;
+use syn::Ident;
+
+use super::inertia::{self, Mass};
+use super::options::{Promotion, Spec};
+use super::read::Read;
+use super::tree::Tree;
+use crate::ast::*;
+use crate::ctxt::{did_you_mean, suggest, Ctxt};
+use crate::parse::joints::{
+    add, in_frame, is_zero, rpy_rotations, times, JointAxis, JointDef, JointKind,
+};
+
+/// A joint's numbers the model uses: its origin.
+struct JointNumbers {
+    xyz: [Expr; 3],
+    rpy: [Expr; 3],
+}
+
+/// A link's numbers: its inertial. `inertia` is ixx, iyy, izz, ixy, iyz,
+/// ixz.
+struct LinkNumbers {
+    mass: Expr,
+    xyz: [Expr; 3],
+    rpy: [Expr; 3],
+    inertia: [Expr; 6],
+    /// The fields `parameters(...)` replaced.
+    promoted: Vec<String>,
+}
+
+/// The fields `parameters(...)` may name, on a joint and on a link.
+const JOINT_FIELDS: &[&str] = &[
+    "xyz.x",
+    "xyz.y",
+    "xyz.z",
+    "rpy.roll",
+    "rpy.pitch",
+    "rpy.yaw",
+];
+const LINK_FIELDS: &[&str] = &[
+    "mass",
+    "ixx",
+    "iyy",
+    "izz",
+    "ixy",
+    "iyz",
+    "ixz",
+    "xyz.x",
+    "xyz.y",
+    "xyz.z",
+    "rpy.roll",
+    "rpy.pitch",
+    "rpy.yaw",
+];
+
+fn slot<'a>(xyz: &'a mut [Expr; 3], rpy: &'a mut [Expr; 3], field: &str) -> Option<&'a mut Expr> {
+    Some(match field {
+        "xyz.x" => &mut xyz[0],
+        "xyz.y" => &mut xyz[1],
+        "xyz.z" => &mut xyz[2],
+        "rpy.roll" => &mut rpy[0],
+        "rpy.pitch" => &mut rpy[1],
+        "rpy.yaw" => &mut rpy[2],
+        _ => return None,
+    })
+}
+
+impl LinkNumbers {
+    fn slot(&mut self, field: &str) -> Option<&mut Expr> {
+        let inertia = ["ixx", "iyy", "izz", "ixy", "iyz", "ixz"];
+        if field == "mass" {
+            return Some(&mut self.mass);
+        }
+        match inertia.iter().position(|f| *f == field) {
+            Some(k) => Some(&mut self.inertia[k]),
+            None => slot(&mut self.xyz, &mut self.rpy, field),
+        }
+    }
+}
+
+/// Three numbers of the file as float constants.
+fn floats(v: &[f64; 3], span: Span) -> [Expr; 3] {
+    v.map(|x| Expr::Float(x, span))
+}
+
+/// Writes the robot into `ast`. Errors about elements go to `cx` (all of
+/// them); the result's error is one that stops the lowering.
+pub(super) fn lower(
+    cx: &Ctxt,
+    ast: &mut ModelAst,
+    read: &Read,
+    tree: &Tree,
+    spec: &Spec,
+) -> syn::Result<()> {
+    let span = spec.path.span();
+    let robot = &read.robot;
+    let mut joints: Vec<JointNumbers> = robot
+        .joints
+        .iter()
+        .map(|j| JointNumbers {
+            xyz: floats(&j.origin.xyz.0, span),
+            rpy: floats(&j.origin.rpy.0, span),
+        })
+        .collect();
+    let mut links: Vec<LinkNumbers> = robot
+        .links
+        .iter()
+        .map(|l| {
+            let (i, o) = (&l.inertial.inertia, &l.inertial.origin);
+            LinkNumbers {
+                mass: Expr::Float(l.inertial.mass.value, span),
+                xyz: floats(&o.xyz.0, span),
+                rpy: floats(&o.rpy.0, span),
+                inertia: [i.ixx, i.iyy, i.izz, i.ixy, i.iyz, i.ixz].map(|x| Expr::Float(x, span)),
+                promoted: Vec::new(),
+            }
+        })
+        .collect();
+    for p in &spec.parameters {
+        promote(cx, tree, p, &mut joints, &mut links);
+    }
+    let welded = welds(cx, robot, tree, &spec.welds);
+    let bodies = masses(cx, read, &links, span);
+    let kinds = kinds(cx, read, &welded, span);
+    if cx.has_errors() {
+        return Ok(());
+    }
+    root(ast, tree, spec)?;
+    let body_of = |ast: &mut ModelAst, l: usize| {
+        if bodies[l] {
+            body(ast, &tree.links[l], &links[l], span);
+        } else {
+            ast.massless_links.push(tree.links[l].to_string());
+        }
+    };
+    body_of(ast, tree.root);
+    for &j in &tree.order {
+        let urdf = &robot.joints[j];
+        let (parent, child) = tree.ends[j];
+        let kind = kinds[j].clone().expect("checked");
+        let mimic = urdf.mimic.is_some() && !welded[j];
+        let joint = JointDef {
+            name: tree.joints[j].clone(),
+            actuated: matches!(kind, JointKind::Revolute(_) | JointKind::Prismatic(_)) && !mimic,
+            kind,
+            parent: tree.links[parent].clone(),
+            child: tree.links[child].clone(),
+            at: None,
+            xyz: Some(joints[j].xyz.clone()),
+            rpy: Some(joints[j].rpy.clone()),
+            dependent: mimic,
+            span,
+        };
+        crate::parse::add_joint(ast, &joint)?;
+        body_of(ast, child);
+    }
+    mimics(cx, ast, read, tree, spec, &welded);
+    record_names(ast, robot, tree);
+    Ok(())
+}
+
+/// Replaces a number by the expression `parameters(...)` gives for it.
+fn promote(
+    cx: &Ctxt,
+    tree: &Tree,
+    p: &Promotion,
+    joints: &mut [JointNumbers],
+    links: &mut [LinkNumbers],
+) {
+    let field = p.field_text();
+    let joint = tree.joints.iter().position(|j| *j == p.element);
+    let link = tree.links.iter().position(|l| *l == p.element);
+    let (target, fields) = match (joint, link) {
+        (Some(j), None) => {
+            let n = &mut joints[j];
+            (slot(&mut n.xyz, &mut n.rpy, &field), JOINT_FIELDS)
+        }
+        (None, Some(l)) => {
+            links[l].promoted.push(field.clone());
+            (links[l].slot(&field), LINK_FIELDS)
+        }
+        (Some(_), Some(_)) => {
+            cx.error_spanned_by(
+                &p.element,
+                format!("`{}` is both a link and a joint of the URDF", p.element),
+            );
+            return;
+        }
+        (None, None) => {
+            let all = tree.joints.iter().chain(&tree.links).map(|i| i.to_string());
+            let hint = hint(&p.element.to_string(), all);
+            cx.error_spanned_by(
+                &p.element,
+                format!("`{}` is not a link or joint of the URDF{hint}", p.element),
+            );
+            return;
+        }
+    };
+    match target {
+        Some(slot) => *slot = p.value.clone(),
+        None => {
+            let hint = did_you_mean(&field, fields.iter().copied())
+                .map(|s| format!(" (did you mean `{s}`?)"))
+                .unwrap_or_default();
+            let kind = if joint.is_some() { "joint" } else { "link" };
+            cx.error_spanned_by(
+                &p.field[0],
+                format!(
+                    "a {kind} has no number `{field}`{hint}; a {kind}'s numbers are {}",
+                    fields.join(", ")
+                ),
+            );
+        }
+    }
+}
+
+/// Which joints `weld(...)` names; an error for a name that is no joint or
+/// a joint that is already fixed.
+fn welds(cx: &Ctxt, robot: &urdf_rs::Robot, tree: &Tree, names: &[Ident]) -> Vec<bool> {
+    let mut welded = vec![false; tree.joints.len()];
+    for name in names {
+        match tree.joints.iter().position(|j| j == name) {
+            Some(j) if robot.joints[j].joint_type == urdf_rs::JointType::Fixed => {
+                cx.error_spanned_by(
+                    name,
+                    format!("joint `{name}` is fixed already; `weld` is for movable joints"),
+                );
+            }
+            Some(j) => welded[j] = true,
+            None => {
+                let hint = hint(&name.to_string(), tree.joints.iter().map(|j| j.to_string()));
+                cx.error_spanned_by(name, format!("`{name}` is not a joint of the URDF{hint}"));
+            }
+        }
+    }
+    welded
+}
+
+/// Which links are bodies: those with a positive mass, or whose mass is a
+/// parameter; an error for each link whose inertial cannot be a body's.
+fn masses(cx: &Ctxt, read: &Read, links: &[LinkNumbers], span: Span) -> Vec<bool> {
+    let mut out = Vec::new();
+    for (l, n) in read.robot.links.iter().zip(links) {
+        let at = read.lines.describe("link", &l.name);
+        match is_body(&l.inertial, &n.promoted) {
+            Ok(body) => out.push(body),
+            Err(e) => {
+                cx.error_at(span, format!("URDF {at}: {e}"));
+                out.push(false)
+            }
+        }
+    }
+    out
+}
+
+/// Whether an inertial is a body's, its numbers checked where they are the
+/// file's (a parameter is checked by nobody at compile time).
+fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, String> {
+    let mass_promoted = promoted.iter().any(|f| f == "mass");
+    let inertia_promoted = promoted.iter().any(|f| f.starts_with('i'));
+    let (mass, i) = (inertial.mass.value, &inertial.inertia);
+    let matrix = [
+        [i.ixx, i.ixy, i.ixz],
+        [i.ixy, i.iyy, i.iyz],
+        [i.ixz, i.iyz, i.izz],
+    ];
+    if mass_promoted || mass > 0.0 {
+        if !inertia_promoted {
+            if mass_promoted {
+                inertia::check_matrix(&matrix)?;
+            } else {
+                inertia::check(mass, i)?;
+            }
+        }
+        return Ok(true);
+    }
+    if let (Some(f), true) = (promoted.first(), mass == 0.0) {
+        return Err(format!(
+            "it has no mass, so it is no body and its `{f}` cannot be a parameter; make its `mass` one too"
+        ));
+    }
+    Ok(inertia::check(mass, i)? == Mass::Body)
+}
+
+/// Each joint's kind in the model (`None` where it has none, reported).
+fn kinds(cx: &Ctxt, read: &Read, welded: &[bool], span: Span) -> Vec<Option<JointKind>> {
+    let mut out = Vec::new();
+    for (j, weld) in read.robot.joints.iter().zip(welded) {
+        let kind = if *weld {
+            Ok(JointKind::Weld)
+        } else {
+            kind(j, span)
+        };
+        out.push(match kind {
+            Ok(k) => Some(k),
+            Err(e) => {
+                cx.error_at(
+                    span,
+                    format!("URDF {}: {e}", read.lines.describe("joint", &j.name)),
+                );
+                None
+            }
+        })
+    }
+    out
+}
+
+fn kind(j: &urdf_rs::Joint, span: Span) -> Result<JointKind, String> {
+    use urdf_rs::JointType as T;
+    Ok(match j.joint_type {
+        T::Revolute | T::Continuous => JointKind::Revolute(axis(j, span)?),
+        T::Prismatic => JointKind::Prismatic(axis(j, span)?),
+        T::Fixed => JointKind::Weld,
+        T::Planar => match axis(j, span)? {
+            JointAxis::Unit(k, false) => JointKind::Planar(k),
+            _ => return Err(format!(
+                "a planar joint's axis (its plane's normal) must be x, y or z of its frame, not {:?}; turn the joint frame with `rpy` instead",
+                j.axis.xyz.0
+            )),
+        },
+        T::Floating => JointKind::Free,
+        T::Spherical => JointKind::Spherical,
+    })
+}
+
+/// The joint's axis: `Unit` when it is exactly ±x, ±y or ±z, else its
+/// components (normalized by the joint).
+fn axis(j: &urdf_rs::Joint, span: Span) -> Result<JointAxis, String> {
+    let a = j.axis.xyz.0;
+    if a.iter().any(|x| !x.is_finite()) || a.iter().all(|x| *x == 0.0) {
+        return Err(format!("its axis {a:?} is not a direction"));
+    }
+    let nonzero: Vec<usize> = (0..3).filter(|&k| a[k] != 0.0).collect();
+    Ok(match nonzero[..] {
+        [k] if a[k].abs() == 1.0 => JointAxis::Unit(k, a[k] < 0.0),
+        _ => JointAxis::Components(floats(&a, span)),
+    })
+}
+
+/// The root link: a frame with the parent's axes (N's unless `parent = A`)
+/// and its origin point at `at` (the parent's origin unless given).
+fn root(ast: &mut ModelAst, tree: &Tree, spec: &Spec) -> syn::Result<()> {
+    let span = spec.path.span();
+    let name = tree.links[tree.root].clone();
+    let parent = spec.parent.clone().unwrap_or_else(|| Ident::new("N", span));
+    let at = match &spec.at {
+        Some(p) => p.clone(),
+        None if parent == "N" => Ident::new("O", span),
+        None => match ast.origins.iter().find(|(f, _)| *f == parent) {
+            Some((_, p)) => p.clone(),
+            None => {
+                return Err(syn::Error::new(
+                    parent.span(),
+                    format!("frame `{parent}` was not made by a joint, so it has no origin: give `at = P`, a point fixed in it, for the URDF's root link"),
+                ))
+            }
+        },
+    };
+    let origin = Ident::new(&format!("{name}_origin"), span);
+    ast.frames.push(FrameDef {
+        name: name.clone(),
+        parent,
+        rotations: Vec::new(),
+        quaternion: None,
+    });
+    ast.points.push(PointDef {
+        name: origin.clone(),
+        location: Expr::Name(at),
+    });
+    ast.origins.push((name, origin));
+    Ok(())
+}
+
+/// A link's body: its centre `{link}_center` at the inertial origin
+/// (the link's origin when that is zero), its frame `{link}_inertial`
+/// turned by the inertial's rpy (the link's frame when zero).
+fn body(ast: &mut ModelAst, link: &Ident, n: &LinkNumbers, span: Span) {
+    let named = |suffix: &str| Ident::new(&format!("{link}{suffix}"), span);
+    let origin = named("_origin");
+    let frame = if n.rpy.iter().all(is_zero) {
+        link.clone()
+    } else {
+        let f = named("_inertial");
+        ast.frames.push(FrameDef {
+            name: f.clone(),
+            parent: link.clone(),
+            rotations: rpy_rotations(&n.rpy),
+            quaternion: None,
+        });
+        f
+    };
+    let center = if n.xyz.iter().all(is_zero) {
+        origin
+    } else {
+        let c = named("_center");
+        ast.points.push(PointDef {
+            name: c.clone(),
+            location: add(Expr::Name(origin), in_frame(link, &n.xyz)),
+        });
+        c
+    };
+    let [ixx, iyy, izz, ixy, iyz, ixz] = n.inertia.clone();
+    ast.bodies.push(BodyDef {
+        name: link.clone(),
+        center,
+        frame: Some(frame),
+        mass: n.mass.clone(),
+        inertia: Some(Inertia::Matrix([ixx, iyy, izz, ixy, iyz, ixz])),
+        span,
+    });
+}
+
+/// `holonomic(joint == multiplier * other + offset)` for each mimic joint
+/// not welded (the other's term left out when it is welded at 0).
+fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, welded: &[bool]) {
+    let span = spec.path.span();
+    let path = &spec.path;
+    for (j, urdf) in read.robot.joints.iter().enumerate() {
+        let Some(mimic) = &urdf.mimic else { continue };
+        if welded[j] {
+            continue;
+        }
+        let at = read.lines.describe("joint", &urdf.name);
+        let Some(other) = read.robot.joints.iter().position(|o| o.name == mimic.joint) else {
+            let hint = hint(
+                &mimic.joint,
+                read.robot.joints.iter().map(|o| o.name.clone()),
+            );
+            cx.error_at(
+                span,
+                format!(
+                    "URDF {at}: it mimics `{}`, which is not a joint of the file{hint}",
+                    mimic.joint
+                ),
+            );
+            continue;
+        };
+        let single = |k: usize| {
+            use urdf_rs::JointType as T;
+            matches!(
+                read.robot.joints[k].joint_type,
+                T::Revolute | T::Continuous | T::Prismatic
+            )
+        };
+        if !single(j) || !single(other) {
+            cx.error_at(span, format!("URDF {at}: a mimic joint and the joint it mimics must be revolute, continuous or prismatic"));
+            continue;
+        }
+        let offset = Expr::Float(mimic.offset.unwrap_or(0.0), span);
+        let rhs = if welded[other] {
+            offset
+        } else {
+            let scaled = times(
+                Expr::Float(mimic.multiplier.unwrap_or(1.0), span),
+                Expr::Name(tree.joints[other].clone()),
+            );
+            if is_zero(&offset) {
+                scaled
+            } else {
+                add(scaled, offset)
+            }
+        };
+        ast.holonomic.push(ConstraintDef {
+            lhs: Expr::Name(tree.joints[j].clone()),
+            rhs,
+            along: None,
+            at: quote::quote!(#path),
+        });
+    }
+}
+
+/// The names the robot made, with the element that made each, for errors
+/// about clashes with the model's own names.
+fn record_names(ast: &mut ModelAst, robot: &urdf_rs::Robot, tree: &Tree) {
+    for (l, name) in robot.links.iter().zip(&tree.links) {
+        let what = format!("the URDF's link `{}`", l.name);
+        for suffix in ["", "_origin", "_center", "_inertial"] {
+            ast.urdf_names
+                .push((format!("{name}{suffix}"), what.clone()));
+        }
+    }
+    for (j, name) in robot.joints.iter().zip(&tree.joints) {
+        let what = format!("the URDF's joint `{}`", j.name);
+        for form in [
+            "{}", "tau_{}", "{}_frame", "{}_at", "{}_x", "{}_y", "{}_angle",
+        ] {
+            ast.urdf_names
+                .push((form.replace("{}", &name.to_string()), what.clone()));
+        }
+    }
+}
+
+/// "; did you mean `x`?" when `name` is close to a candidate, or a name
+/// it is the start of (`elbow` for `elbow_joint`).
+fn hint(name: &str, candidates: impl IntoIterator<Item = String>) -> String {
+    let all: Vec<String> = candidates.into_iter().collect();
+    suggest(name, all.iter().map(|s| s.as_str()))
+        .map(|s| format!("; did you mean `{s}`?"))
+        .unwrap_or_default()
+}

@@ -1,0 +1,138 @@
+//! What `urdf(...)` says beside the path: `weld(...)`, `parameters(...)`,
+//! `parent = A` and `at = P`.
+
+use syn::parse::ParseStream;
+use syn::punctuated::Punctuated;
+use syn::spanned::Spanned;
+use syn::{Ident, LitStr, Token};
+
+use crate::ast::Expr;
+use crate::ctxt::did_you_mean;
+use crate::parse::convert;
+
+/// The options of `urdf(...)`.
+const OPTIONS: &[&str] = &["weld", "parameters", "parent", "at"];
+
+/// `urdf("path", options...)` as written.
+pub(super) struct Spec {
+    /// The file, as written.
+    pub path: LitStr,
+    /// Movable joints welded at 0.
+    pub welds: Vec<Ident>,
+    /// Numbers of the file replaced by expressions of the model.
+    pub parameters: Vec<Promotion>,
+    /// The frame the root link is fixed in (N when absent).
+    pub parent: Option<Ident>,
+    /// The point the root link's origin is at (the parent's origin when
+    /// absent).
+    pub at: Option<Ident>,
+}
+
+/// `element.field = expression` or `element.field.component = expression`
+/// in `parameters(...)`.
+pub(super) struct Promotion {
+    /// The link or joint, by its model name.
+    pub element: Ident,
+    /// The field and, for `xyz` and `rpy`, the component.
+    pub field: Vec<Ident>,
+    /// What stands for the number.
+    pub value: Expr,
+}
+
+impl Promotion {
+    /// `xyz.z`: the field as written after the element.
+    pub(super) fn field_text(&self) -> String {
+        let parts: Vec<String> = self.field.iter().map(|f| f.to_string()).collect();
+        parts.join(".")
+    }
+}
+
+/// The contents of `urdf(...)`, or of `urdf = "path"`.
+pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
+    let path: LitStr = s.parse().map_err(|e| {
+        syn::Error::new(
+            e.span(),
+            "`urdf` starts with the file's path, relative to the crate's directory: `urdf(\"robots/arm.urdf\")`",
+        )
+    })?;
+    let mut spec = Spec {
+        path,
+        welds: Vec::new(),
+        parameters: Vec::new(),
+        parent: None,
+        at: None,
+    };
+    while !s.is_empty() {
+        s.parse::<Token![,]>()?;
+        if s.is_empty() {
+            break;
+        }
+        let key: Ident = s.parse()?;
+        match key.to_string().as_str() {
+            "weld" => {
+                let content;
+                syn::parenthesized!(content in s);
+                let list = Punctuated::<Ident, Token![,]>::parse_terminated(&content)?;
+                spec.welds.extend(list);
+            }
+            "parameters" => {
+                let content;
+                syn::parenthesized!(content in s);
+                let list = Punctuated::<syn::Expr, Token![,]>::parse_terminated(&content)?;
+                for e in &list {
+                    spec.parameters.push(promotion(e)?);
+                }
+            }
+            "parent" | "at" => {
+                s.parse::<Token![=]>()?;
+                let value: Ident = s.parse()?;
+                if key == "parent" {
+                    spec.parent = Some(value);
+                } else {
+                    spec.at = Some(value);
+                }
+            }
+            other => {
+                let hint = did_you_mean(other, OPTIONS.iter().copied())
+                    .map(|s| format!(" (did you mean `{s}`?)"))
+                    .unwrap_or_default();
+                return Err(syn::Error::new(
+                    key.span(),
+                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A` and `at = P`"),
+                ));
+            }
+        }
+    }
+    Ok(spec)
+}
+
+/// `wrist_3_link.mass = payload`.
+fn promotion(e: &syn::Expr) -> syn::Result<Promotion> {
+    let form = "expected `element.field = parameter`, such as `wrist_3_link.mass = payload` or `elbow_joint.xyz.z = forearm`";
+    let syn::Expr::Assign(assign) = e else {
+        return Err(syn::Error::new(e.span(), form));
+    };
+    let mut field = Vec::new();
+    let mut at = &*assign.left;
+    let element = loop {
+        match at {
+            syn::Expr::Field(f) => {
+                let syn::Member::Named(name) = &f.member else {
+                    return Err(syn::Error::new(f.member.span(), form));
+                };
+                field.insert(0, name.clone());
+                at = &f.base;
+            }
+            syn::Expr::Path(p) if !field.is_empty() => match p.path.get_ident() {
+                Some(id) => break id.clone(),
+                None => return Err(syn::Error::new(p.span(), form)),
+            },
+            other => return Err(syn::Error::new(other.span(), form)),
+        }
+    };
+    Ok(Promotion {
+        element,
+        field,
+        value: convert(&assign.right)?,
+    })
+}

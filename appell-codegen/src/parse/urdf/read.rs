@@ -1,0 +1,234 @@
+//! Finding, reading and checking a URDF file, with errors that name the
+//! element at fault and its line.
+//!
+//! The file is read by `urdf-rs`. Its errors carry no position (it writes
+//! the document anew before deserializing it), so the XML is first walked
+//! here with the parser `urdf-rs` builds on (RustyXML): a syntax error gets
+//! its line and column, and an element `urdf-rs` rejects is found by reading
+//! each top-level element alone, so every bad element is reported, each by
+//! its tag, name and line.
+
+use std::path::{Component, Path, PathBuf};
+
+/// The URDF joint types, as the file spells them.
+pub(super) const JOINT_TYPES: &[&str] = &[
+    "revolute",
+    "continuous",
+    "prismatic",
+    "fixed",
+    "floating",
+    "planar",
+];
+
+/// Where each top-level element of the file starts.
+#[derive(Debug, Default)]
+pub(super) struct Lines(Vec<(String, String, u32)>);
+
+impl Lines {
+    /// `joint `elbow` (line 42)`: an element by its tag and name attribute.
+    pub(super) fn describe(&self, tag: &str, name: &str) -> String {
+        match self.0.iter().find(|(t, n, _)| t == tag && n == name) {
+            Some((_, _, line)) => format!("{tag} `{name}` (line {line})"),
+            None => format!("{tag} `{name}`"),
+        }
+    }
+}
+
+/// The file read: the robot and where its elements are.
+pub(super) struct Read {
+    /// The robot, as `urdf-rs` reads it.
+    pub robot: urdf_rs::Robot,
+    /// The lines of its links and joints.
+    pub lines: Lines,
+}
+
+/// `manifest_dir` joined with the path as written, with `.` and `..` taken
+/// out by the names alone (so the path need not pass through directories
+/// that exist). An absolute path is kept as it is.
+pub(super) fn resolve(manifest_dir: &Path, written: &str) -> PathBuf {
+    let mut out = PathBuf::new();
+    for part in manifest_dir.join(written).components() {
+        match part {
+            Component::CurDir => {}
+            Component::ParentDir => {
+                if !out.pop() {
+                    out.push("..");
+                }
+            }
+            other => out.push(other),
+        }
+    }
+    out
+}
+
+/// The robot in the file at `path`, or the messages of everything wrong
+/// with the file.
+pub(super) fn read(path: &Path) -> Result<Read, Vec<String>> {
+    let text = std::fs::read_to_string(path).map_err(|e| {
+        vec![format!(
+            "cannot read the URDF file `{}`: {e} (a relative path is taken from the directory of the crate's Cargo.toml)",
+            path.display()
+        )]
+    })?;
+    let lines = walk(&text).map_err(|e| vec![format!("the URDF is not well-formed XML: {e}")])?;
+    let root: xml::Element = text
+        .parse()
+        .map_err(|e| vec![format!("the URDF is not well-formed XML: {e}")])?;
+    if root.name != "robot" {
+        return Err(vec![format!(
+            "the URDF's root element is `<{}>`; a URDF is a `<robot>`",
+            root.name
+        )]);
+    }
+    let mut errors = joint_types(&root, &lines);
+    if errors.is_empty() {
+        match urdf_rs::read_from_string(&text) {
+            Ok(robot) => return Ok(Read { robot, lines }),
+            Err(whole) => errors = element_errors(&root, &lines, &whole.to_string()),
+        }
+    }
+    Err(errors)
+}
+
+/// Walks the XML: checks that it is well-formed and records the line of
+/// each element directly under the root.
+fn walk(text: &str) -> Result<Lines, String> {
+    let mut parser = xml::Parser::new();
+    let mut open: Vec<String> = Vec::new();
+    let mut lines = Lines::default();
+    let mut seen_root = false;
+    // Fed a line at a time, so each event is known to come from the line
+    // just fed.
+    for (k, line) in text.split_inclusive('\n').enumerate() {
+        let number = k as u32 + 1;
+        parser.feed_str(line);
+        for event in &mut parser {
+            match event.map_err(|e| format!("line {}, column {}: {}", e.line, e.col, e.msg))? {
+                xml::Event::ElementStart(tag) => {
+                    if open.is_empty() && seen_root {
+                        return Err(format!(
+                            "line {number}: `<{}>` after the root element has closed",
+                            tag.name
+                        ));
+                    }
+                    if open.len() == 1 {
+                        let name = tag
+                            .attributes
+                            .get(&("name".to_string(), None))
+                            .cloned()
+                            .unwrap_or_default();
+                        lines.0.push((tag.name.clone(), name, number));
+                    }
+                    seen_root = true;
+                    open.push(tag.name);
+                }
+                xml::Event::ElementEnd(tag) => match open.pop() {
+                    Some(o) if o == tag.name => {}
+                    Some(o) => {
+                        return Err(format!("line {number}: `</{}>` closes `<{o}>`", tag.name))
+                    }
+                    None => return Err(format!("line {number}: `</{}>` closes nothing", tag.name)),
+                },
+                _ => {}
+            }
+        }
+    }
+    match open.last() {
+        Some(o) => Err(format!("`<{o}>` is never closed")),
+        None if !seen_root => Err("the file holds no element".into()),
+        None => Ok(lines),
+    }
+}
+
+/// An error for each joint whose type is missing or not a URDF type.
+fn joint_types(root: &xml::Element, lines: &Lines) -> Vec<String> {
+    let mut errors = Vec::new();
+    for joint in root.get_children("joint", None) {
+        let name = joint.get_attribute("name", None).unwrap_or_default();
+        let at = lines.describe("joint", name);
+        match joint.get_attribute("type", None) {
+            Some(t) if JOINT_TYPES.contains(&t) => {}
+            Some(t) => {
+                let hint = crate::ctxt::did_you_mean(t, JOINT_TYPES.iter().copied())
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_default();
+                errors.push(format!(
+                    "URDF {at}: unknown joint type `{t}`; the types are {}{hint}",
+                    JOINT_TYPES.join(", ")
+                ));
+            }
+            None => errors.push(format!(
+                "URDF {at}: no `type`; the types are {}",
+                JOINT_TYPES.join(", ")
+            )),
+        }
+    }
+    errors
+}
+
+/// When `urdf-rs` rejects the file: each top-level element read alone, and
+/// an error for each one it rejects; the whole file's error when none is
+/// rejected alone.
+fn element_errors(root: &xml::Element, lines: &Lines, whole: &str) -> Vec<String> {
+    let mut errors = Vec::new();
+    for node in &root.children {
+        let xml::Xml::ElementNode(e) = node else {
+            continue;
+        };
+        if !matches!(e.name.as_str(), "link" | "joint" | "material") {
+            continue;
+        }
+        let alone = format!("<robot name=\"alone\">{e}</robot>");
+        if let Err(err) = urdf_rs::read_from_string(&alone) {
+            let name = e.get_attribute("name", None).unwrap_or_default();
+            errors.push(format!(
+                "URDF {}: {}",
+                lines.describe(&e.name, name),
+                plain(&err.to_string())
+            ));
+        }
+    }
+    if errors.is_empty() {
+        errors.push(format!("the URDF cannot be read: {}", plain(whole)));
+    }
+    errors
+}
+
+/// An error of `urdf-rs` without the prefix its deserializer adds.
+fn plain(message: &str) -> &str {
+    message.strip_prefix("custom: ").unwrap_or(message)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn dot_dot_is_taken_out_by_name() {
+        let p = resolve(Path::new("/a/b/target/x"), "../../c/./d.urdf");
+        assert_eq!(p, Path::new("/a/b/c/d.urdf"));
+        assert_eq!(
+            resolve(Path::new("/a"), "/e/f.urdf"),
+            Path::new("/e/f.urdf")
+        );
+    }
+
+    #[test]
+    fn a_syntax_error_has_its_line() {
+        let e = walk("<robot>\n<link name=\"a\">\n</joint>\n</robot>").unwrap_err();
+        assert_eq!(e, "line 3: `</joint>` closes `<link>`");
+        let e = walk("<robot>\n<link name=a/>\n</robot>").unwrap_err();
+        assert!(e.starts_with("line 2, column"), "{e}");
+        let e = walk("<robot>\n<link name=\"a\">\n").unwrap_err();
+        assert_eq!(e, "`<link>` is never closed");
+    }
+
+    #[test]
+    fn elements_are_found_by_line() {
+        let lines =
+            walk("<robot>\n  <link name=\"a\"/>\n  <joint name=\"j\">\n</joint></robot>").unwrap();
+        assert_eq!(lines.describe("joint", "j"), "joint `j` (line 3)");
+        assert_eq!(lines.describe("link", "a"), "link `a` (line 2)");
+        assert_eq!(lines.describe("link", "b"), "link `b`");
+    }
+}

@@ -1,0 +1,288 @@
+//! The URDF robots (`examples/models/ur5.rs`, `panda.rs`) and the spatial
+//! chains written with joints (`spatial_chain.rs`) against an independent
+//! implementation: Pinocchio 4.1.0's ABA, CRBA and nonlinear effects at 20
+//! random states per robot (`tests/reference/pinocchio/`, computed offline;
+//! read here with serde_json), and against the multiplier oracle at 1,000
+//! random states each.
+//!
+//! Pinocchio's vectors follow its joint order (`joints` in each file); the
+//! model's are matched by name: coordinates and speeds are the joints',
+//! inputs `tau_<joint>`. The reduced state leaves out the coordinates the
+//! equations do not depend on (`info().retained`: the first joint, about
+//! the vertical, of each arm), which the full-coordinate functions take at
+//! any value.
+
+mod common;
+#[path = "../examples/models/panda.rs"]
+mod panda;
+#[path = "../examples/models/spatial_chain.rs"]
+mod spatial_chain;
+#[path = "../examples/models/ur5.rs"]
+mod ur5;
+
+use std::f64::consts::PI;
+
+use appell::{Appell, Model};
+use common::Rng;
+use serde_json::Value;
+
+/// The 4-link chain read from `make_urdf.py`'s file.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("examples/robots/spatial_chain/spatial_chain_4.urdf"))]
+#[appell(gravity(-9.81 * N.z))]
+struct UrdfChain4;
+
+/// One state of a reference file, in Pinocchio's joint order.
+struct State {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    tau: Vec<f64>,
+    ddq: Vec<f64>,
+    mass_matrix: Vec<Vec<f64>>,
+    nle: Vec<f64>,
+}
+
+/// A reference file: Pinocchio's joint names and the states.
+struct Reference {
+    joints: Vec<String>,
+    states: Vec<State>,
+}
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .expect("a list")
+        .iter()
+        .map(|x| x.as_f64().expect("a number"))
+        .collect()
+}
+
+fn reference(robot: &str) -> Reference {
+    let path = format!(
+        "{}/tests/reference/pinocchio/{robot}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).expect("reference file");
+    let data: Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(data["gravity"], serde_json::json!([0.0, 0.0, -9.81]));
+    let joints = data["joints"]
+        .as_array()
+        .expect("joints")
+        .iter()
+        .map(|j| j.as_str().expect("name").to_string())
+        .collect();
+    let states = data["states"]
+        .as_array()
+        .expect("states")
+        .iter()
+        .map(|s| State {
+            q: numbers(&s["q"]),
+            v: numbers(&s["v"]),
+            tau: numbers(&s["tau"]),
+            ddq: numbers(&s["ddq"]),
+            mass_matrix: s["mass_matrix"]
+                .as_array()
+                .expect("rows")
+                .iter()
+                .map(numbers)
+                .collect(),
+            nle: numbers(&s["nle"]),
+        })
+        .collect();
+    Reference { joints, states }
+}
+
+/// The index in Pinocchio's order of each of `names`, with `prefix` taken
+/// off (`tau_`).
+fn order(joints: &[String], names: &[&str], prefix: &str) -> Vec<usize> {
+    names
+        .iter()
+        .map(|n| {
+            let joint = n.strip_prefix(prefix).unwrap_or(n);
+            joints
+                .iter()
+                .position(|j| j == joint)
+                .unwrap_or_else(|| panic!("`{n}` is not a joint of the reference"))
+        })
+        .collect()
+}
+
+/// |a − b| / (1 + max |b|): the difference relative to the reference's
+/// magnitude.
+fn relative(a: &[f64], b: &[f64]) -> f64 {
+    let scale = 1.0 + b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    a.iter()
+        .zip(b)
+        .fold(0.0f64, |m, (a, b)| m.max((a - b).abs() / scale))
+}
+
+/// The worst relative differences over the reference's states: the rhs's
+/// accelerations against ABA's ddq, M against CRBA's, and the forcing f
+/// against τ − nle.
+struct Agreement {
+    ddq: f64,
+    mass_matrix: f64,
+    forcing: f64,
+}
+
+fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
+    let info = M::info();
+    let r = reference(robot);
+    let q_at = order(&r.joints, info.coordinates, "");
+    let u_at = order(&r.joints, info.speeds, "");
+    let in_at = order(&r.joints, info.inputs, "tau_");
+    let kept = order(&r.joints, info.retained, "");
+    assert_eq!(info.speeds.len(), r.joints.len(), "one speed per joint");
+    let prepared = model.prepare::<f64>();
+    let l = info.speeds.len();
+    let mut worst = Agreement {
+        ddq: 0.0,
+        mass_matrix: 0.0,
+        forcing: 0.0,
+    };
+    for s in &r.states {
+        let pick =
+            |at: &[usize], from: &[f64]| -> Vec<f64> { at.iter().map(|&i| from[i]).collect() };
+        let (q, u, inputs) = (pick(&q_at, &s.q), pick(&u_at, &s.v), pick(&in_at, &s.tau));
+        let mut state = pick(&kept, &s.q);
+        state.extend(&u);
+        let mut d = vec![0.0; state.len()];
+        model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
+        assert_eq!(&d[..kept.len()], &pick(&kept, &s.v)[..], "q̇ = u");
+        worst.ddq = worst
+            .ddq
+            .max(relative(&d[kept.len()..], &pick(&u_at, &s.ddq)));
+        let (mut m, mut f) = (vec![0.0; l * l], vec![0.0; l]);
+        model
+            .mass_matrix_and_forcing(0.0, &q, &u, &inputs, &mut m, &mut f)
+            .unwrap();
+        let crba: Vec<f64> = (0..l * l)
+            .map(|k| s.mass_matrix[u_at[k / l]][u_at[k % l]])
+            .collect();
+        worst.mass_matrix = worst.mass_matrix.max(relative(&m, &crba));
+        let tau_minus_nle: Vec<f64> = u_at.iter().map(|&i| s.tau[i] - s.nle[i]).collect();
+        worst.forcing = worst.forcing.max(relative(&f, &tau_minus_nle));
+    }
+    println!(
+        "{robot} ({}): worst relative difference to Pinocchio over {} states: ddq {:.1e}, M {:.1e}, f = τ − nle {:.1e}",
+        info.name,
+        r.states.len(),
+        worst.ddq,
+        worst.mass_matrix,
+        worst.forcing
+    );
+    worst
+}
+
+fn assert_agrees<M: Model>(model: &M, robot: &str) {
+    let w = agreement(model, robot);
+    assert!(w.ddq <= 1e-10, "{robot}: ddq differs by {:.2e}", w.ddq);
+    assert!(
+        w.mass_matrix <= 1e-10,
+        "{robot}: M differs by {:.2e}",
+        w.mass_matrix
+    );
+    assert!(
+        w.forcing <= 1e-10,
+        "{robot}: f differs by {:.2e}",
+        w.forcing
+    );
+}
+
+#[test]
+fn the_ur5_from_its_urdf_agrees_with_pinocchio() {
+    assert_agrees(&ur5::Ur5, "ur5");
+}
+
+#[test]
+fn the_panda_from_its_urdf_agrees_with_pinocchio() {
+    assert_agrees(&panda::Panda, "panda");
+}
+
+#[test]
+fn the_spatial_chains_written_with_joints_agree_with_pinocchio() {
+    use spatial_chain::*;
+    assert_agrees(&SpatialChain2, "spatial_chain_2");
+    assert_agrees(&SpatialChain4, "spatial_chain_4");
+    assert_agrees(&SpatialChain8, "spatial_chain_8");
+    assert_agrees(&SpatialChain16, "spatial_chain_16");
+}
+
+/// The largest relative difference between the rhs and the multiplier
+/// oracle (eqs. 69-70) over 1,000 random states: q in [−π, π], u in
+/// [−2, 2], torques in [−20, 20].
+fn oracle_agreement<M: Model>(model: &M, seed: u64) -> f64 {
+    let info = M::info();
+    let (n, l, k) = (info.coordinates.len(), info.speeds.len(), info.inputs.len());
+    let prepared = model.prepare::<f64>();
+    let mut rng = Rng(seed);
+    let mut worst: f64 = 0.0;
+    for _ in 0..1000 {
+        let q: Vec<f64> = (0..n).map(|_| rng.uniform(-PI, PI)).collect();
+        let u: Vec<f64> = (0..l).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let inputs: Vec<f64> = (0..k).map(|_| rng.uniform(-20.0, 20.0)).collect();
+        let mut state: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|c| q[info.coordinate_index(c).unwrap()])
+            .collect();
+        state.extend(&u);
+        let mut d = vec![0.0; state.len()];
+        model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
+        let o = appell::oracle::reduced_rhs(model, 0.0, &q, &u, &inputs).unwrap();
+        for (a, b) in d.iter().zip(&o) {
+            worst = worst.max((a - b).abs() / (1.0 + a.abs().max(b.abs())));
+        }
+    }
+    println!(
+        "{}: largest relative difference to the oracle over 1,000 states {worst:.2e}",
+        info.name
+    );
+    worst
+}
+
+#[test]
+fn the_robots_agree_with_the_oracle() {
+    use spatial_chain::*;
+    assert!(oracle_agreement(&ur5::Ur5, 1) < 1e-9);
+    assert!(oracle_agreement(&panda::Panda, 2) < 1e-9);
+    assert!(oracle_agreement(&SpatialChain2, 3) < 1e-9);
+    assert!(oracle_agreement(&SpatialChain4, 4) < 1e-9);
+    assert!(oracle_agreement(&SpatialChain8, 5) < 1e-9);
+    assert!(oracle_agreement(&SpatialChain16, 6) < 1e-9);
+}
+
+#[test]
+fn the_chain_read_from_its_urdf_is_the_chain_written_with_joints() {
+    use spatial_chain::SpatialChain4;
+    let (urdf, joints) = (UrdfChain4::info(), SpatialChain4::info());
+    assert_eq!(urdf.coordinates, joints.coordinates);
+    assert_eq!(urdf.retained, joints.retained);
+    assert_eq!(urdf.speeds, joints.speeds);
+    assert_eq!(urdf.inputs, joints.inputs);
+    let names: Vec<&str> = urdf.bodies.iter().map(|b| b.name).collect();
+    assert_eq!(names, ["link_1", "link_2", "link_3", "link_4"]);
+    let (a, b) = (UrdfChain4, SpatialChain4);
+    let (pa, pb) = (a.prepare::<f64>(), b.prepare::<f64>());
+    let mut rng = Rng(11);
+    let mut worst: f64 = 0.0;
+    for _ in 0..1000 {
+        let s: Vec<f64> = (0..urdf.state_len())
+            .map(|k| {
+                if k < urdf.retained.len() {
+                    rng.uniform(-PI, PI)
+                } else {
+                    rng.uniform(-2.0, 2.0)
+                }
+            })
+            .collect();
+        let inputs: Vec<f64> = (0..4).map(|_| rng.uniform(-20.0, 20.0)).collect();
+        let (mut da, mut db) = (vec![0.0; s.len()], vec![0.0; s.len()]);
+        a.rhs(&pa, 0.0, &s, &inputs, &mut da).unwrap();
+        b.rhs(&pb, 0.0, &s, &inputs, &mut db).unwrap();
+        for (x, y) in da.iter().zip(&db) {
+            worst = worst.max((x - y).abs() / (1.0 + y.abs()));
+        }
+    }
+    println!("spatial chain 4, read from its URDF against written with joints: largest relative difference {worst:.1e} over 1,000 states");
+    assert!(worst <= 1e-12, "{worst:.2e}");
+}

@@ -1,0 +1,11 @@
+//! trybuild compiles this case in `target/tests/trybuild/appell`, the
+//! directory a relative path starts from: the path climbs back to the
+//! workspace.
+
+use appell::Appell;
+
+#[derive(Appell)]
+#[appell(urdf("../../../../tests/ui/urdf/bad_element.urdf"))]
+struct Robot;
+
+fn main() {}

@@ -1,0 +1,12 @@
+//! trybuild compiles this case in `target/tests/trybuild/appell`, the
+//! directory a relative path starts from: the path climbs back to the
+//! workspace.
+
+use appell::Appell;
+
+#[derive(Appell)]
+#[appell(urdf("../../../../examples/robots/ur5/ur5_robot.urdf"), gravity(-9.81 * N.z))]
+#[appell(coordinates(q), frame(forearm_link = N.rotate_z(q)), inputs(tau_elbow_joint))]
+struct Ur5;
+
+fn main() {}
