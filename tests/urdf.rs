@@ -45,6 +45,17 @@ struct Ur5Payload {
 #[appell(urdf("examples/robots/panda/panda.urdf"), gravity(-9.81 * N.z))]
 struct PandaWithFingers;
 
+/// A link whose inertial frame is turned (rpy 0.3, -0.2, 0.5), and the same
+/// link with the inertia written in the link frame (R I Rᵀ, computed
+/// offline); the elbow's axis is not a unit axis.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/fixtures/turned_inertial.urdf"), gravity(-9.81 * N.z))]
+struct TurnedInertial;
+
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/fixtures/turned_inertial_written.urdf"), gravity(-9.81 * N.z))]
+struct TurnedInertialWritten;
+
 /// The rhs of two models at the same random states (the first coordinate,
 /// ignorable in both, left out); the largest difference relative to
 /// 1 + |b|.
@@ -105,6 +116,15 @@ fn the_ur5s_rounded_right_angles_measured() {
     let d = largest_difference(&exact, &ur5::Ur5, 1000, 13);
     println!("UR5, exact right angles against the file's 1.57079632679: largest relative difference of the rhs {d:.2e} over 1,000 states");
     assert!((1e-11..1e-8).contains(&d), "{d:.2e}");
+}
+
+#[test]
+fn a_turned_inertial_frame_is_the_inertia_turned() {
+    let info = TurnedInertial::info();
+    assert_eq!(info.coordinates, ["shoulder", "elbow"]);
+    let d = largest_difference(&TurnedInertial, &TurnedInertialWritten, 500, 17);
+    println!("turned inertial frame against the turned inertia written out: {d:.1e}");
+    assert!(d <= 1e-13, "{d:.2e}");
 }
 
 #[test]

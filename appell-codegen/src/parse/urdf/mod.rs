@@ -29,7 +29,7 @@
 //! inertial's).
 //!
 //! Names of the file that cannot be Rust names are made so
-//! ([`tree::model_name`]: `base_link-base_fixed_joint` is
+//! (`tree::model_name`: `base_link-base_fixed_joint` is
 //! `base_link_base_fixed_joint`).
 //!
 //! | module | role |
