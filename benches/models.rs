@@ -13,10 +13,18 @@ mod chaplygin_sleigh;
 mod double_pendulum;
 #[path = "../examples/models/free_body.rs"]
 mod free_body;
+#[path = "../examples/models/mobile_manipulator.rs"]
+mod mobile_manipulator;
 #[path = "../examples/models/n_link_pendulum.rs"]
 mod n_link_pendulum;
+#[path = "../examples/models/panda.rs"]
+mod panda;
 #[path = "../examples/models/rolling_disc.rs"]
 mod rolling_disc;
+#[path = "../examples/models/spatial_chain.rs"]
+mod spatial_chain;
+#[path = "../examples/models/ur5.rs"]
+mod ur5;
 #[path = "../examples/models/wheel_axle.rs"]
 mod wheel_axle;
 #[path = "../examples/models/whipple_bicycle.rs"]
@@ -31,11 +39,18 @@ use criterion::{criterion_group, criterion_main, Criterion};
 
 /// The `#[derive(Appell)]` struct `name` of a model file, as a derive input.
 fn derive_input(source: &str, name: &str) -> syn::DeriveInput {
-    let at = source
-        .find(&format!("pub struct {name} {{"))
-        .expect("struct");
+    let unit = format!("pub struct {name};");
+    let (at, end) = match source.find(&format!("pub struct {name} {{")) {
+        Some(at) => (
+            at,
+            at + source[at..].find("\n}").expect("end of struct") + 2,
+        ),
+        None => {
+            let at = source.find(&unit).expect("struct");
+            (at, at + unit.len())
+        }
+    };
     let start = source[..at].rfind("#[derive(Appell").expect("derive");
-    let end = at + source[at..].find("\n}").expect("end of struct") + 2;
     syn::parse_str(&source[start..end]).expect("struct")
 }
 
@@ -247,6 +262,34 @@ fn bench(c: &mut Criterion) {
         &free_body::ChaplyginBall::default(),
         include_str!("../examples/models/free_body.rs"),
         "ChaplyginBall",
+    );
+    bench_model(
+        c,
+        "ur5",
+        &ur5::Ur5,
+        include_str!("../examples/models/ur5.rs"),
+        "Ur5",
+    );
+    bench_model(
+        c,
+        "panda",
+        &panda::Panda,
+        include_str!("../examples/models/panda.rs"),
+        "Panda",
+    );
+    bench_model(
+        c,
+        "spatial_chain_8",
+        &spatial_chain::SpatialChain8::default(),
+        include_str!("../examples/models/spatial_chain.rs"),
+        "SpatialChain8",
+    );
+    bench_model(
+        c,
+        "mobile_manipulator",
+        &mobile_manipulator::MobileManipulator::default(),
+        include_str!("../examples/models/mobile_manipulator.rs"),
+        "MobileManipulator",
     );
     bench_model(
         c,
