@@ -280,7 +280,7 @@ fn bench(c: &mut Criterion) {
     bench_model(
         c,
         "spatial_chain_8",
-        &spatial_chain::SpatialChain8::default(),
+        &spatial_chain::SpatialChain8,
         include_str!("../examples/models/spatial_chain.rs"),
         "SpatialChain8",
     );
