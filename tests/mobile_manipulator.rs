@@ -40,37 +40,7 @@ fn the_base_leaves_the_state_and_the_contacts_are_eliminated_in_closed_form() {
 
 #[test]
 fn it_agrees_with_the_oracle() {
-    let model = MobileManipulator::default();
-    let info = MobileManipulator::info();
-    let prepared = model.prepare::<f64>();
-    let mut rng = Rng(21);
-    let mut worst: f64 = 0.0;
-    for _ in 0..1000 {
-        let q: Vec<f64> = info
-            .coordinates
-            .iter()
-            .map(|_| rng.uniform(-3.0, 3.0))
-            .collect();
-        let u: Vec<f64> = info.speeds.iter().map(|_| rng.uniform(-2.0, 2.0)).collect();
-        let tau: Vec<f64> = info
-            .inputs
-            .iter()
-            .map(|_| rng.uniform(-20.0, 20.0))
-            .collect();
-        let mut state: Vec<f64> = info
-            .retained
-            .iter()
-            .map(|c| q[info.coordinate_index(c).unwrap()])
-            .collect();
-        state.extend(&u);
-        let mut d = vec![0.0; state.len()];
-        model.rhs(&prepared, 0.0, &state, &tau, &mut d).unwrap();
-        let o = appell::oracle::reduced_rhs(&model, 0.0, &q, &u, &tau).unwrap();
-        for (a, b) in d.iter().zip(&o) {
-            worst = worst.max((a - b).abs() / (1.0 + a.abs().max(b.abs())));
-        }
-    }
-    println!("mobile manipulator: largest relative difference to the oracle {worst:.2e}");
+    let worst = common::agree(&MobileManipulator::default(), &mut Rng(21), 1000, 3.0);
     assert!(worst < 1e-9, "{worst:e}");
 }
 

@@ -112,21 +112,19 @@ fn expand_repeat(group: &Group, scope: &mut Scope, out: &mut Vec<TokenStream>) -
             ),
         ));
     }
-    let bound = |e: &Option<Box<syn::Expr>>| -> syn::Result<i64> {
-        match e {
-            Some(e) => evaluate(e, scope, "the bounds of a repeat"),
-            None => Err(syn::Error::new(
-                range.span(),
-                "a repeat's range needs both bounds: `1..=8`",
-            )),
-        }
-    };
-    let (start, end) = (bound(&range.start)?, bound(&range.end)?);
-    let end = match range.limits {
-        syn::RangeLimits::HalfOpen(_) => end,
-        syn::RangeLimits::Closed(_) => end + 1,
-    };
-    for value in start..end {
+    let values = range_values(
+        &range,
+        scope,
+        "the bounds of a repeat",
+        "a repeat's range needs both bounds: `1..=8`",
+    )?;
+    if values.end.saturating_sub(values.start) > MAX_ITEMS as i64 {
+        return Err(syn::Error::new(
+            range.span(),
+            format!("a repeat of more than {MAX_ITEMS} steps"),
+        ));
+    }
+    for value in values {
         scope.push((name.clone(), value));
         let result = expand_items(body.clone(), scope, out);
         scope.pop();
@@ -216,21 +214,13 @@ fn index_values(group: &Group, scope: &Scope) -> syn::Result<Vec<i64>> {
         syn::Error::new(group.span(), "an index is an integer expression: `q[3]`, `L[i - 1]`, or a range in a list: `q[1..=8]`")
     })?;
     let values = match &e {
-        syn::Expr::Range(r) => {
-            let bound = |b: &Option<Box<syn::Expr>>| match b {
-                Some(b) => evaluate(b, scope, "an index range"),
-                None => Err(syn::Error::new(
-                    r.span(),
-                    "an index range needs both bounds: `q[1..=8]`",
-                )),
-            };
-            let (start, end) = (bound(&r.start)?, bound(&r.end)?);
-            let end = match r.limits {
-                syn::RangeLimits::HalfOpen(_) => end,
-                syn::RangeLimits::Closed(_) => end + 1,
-            };
-            (start..end).collect()
-        }
+        syn::Expr::Range(r) => range_values(
+            r,
+            scope,
+            "an index range",
+            "an index range needs both bounds: `q[1..=8]`",
+        )?
+        .collect(),
         e => vec![evaluate(e, scope, "an index")?],
     };
     if let Some(v) = values.iter().find(|v| **v < 0) {
@@ -243,6 +233,25 @@ fn index_values(group: &Group, scope: &Scope) -> syn::Result<Vec<i64>> {
         ));
     }
     Ok(values)
+}
+
+/// The integers of `a..b` or `a..=b`, its bounds evaluated as `what`;
+/// `open` is the error for a missing bound.
+fn range_values(
+    range: &syn::ExprRange,
+    scope: &Scope,
+    what: &str,
+    open: &str,
+) -> syn::Result<std::ops::Range<i64>> {
+    let bound = |b: &Option<Box<syn::Expr>>| match b {
+        Some(b) => evaluate(b, scope, what),
+        None => Err(syn::Error::new(range.span(), open)),
+    };
+    let (start, end) = (bound(&range.start)?, bound(&range.end)?);
+    Ok(match range.limits {
+        syn::RangeLimits::HalfOpen(_) => start..end,
+        syn::RangeLimits::Closed(_) => start..end + 1,
+    })
 }
 
 /// ` (i = 0, j = 2)`: the indices in scope, for errors.
