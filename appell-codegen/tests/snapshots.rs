@@ -84,9 +84,12 @@ impl<'ast> Visit<'ast> for Models {
 fn expansion_text(item: &syn::ItemStruct, manifest_dir: &Path) -> String {
     let input = syn::DeriveInput::from(item.clone());
     let tokens = appell_codegen::expand_in(&input, Some(manifest_dir));
-    let file: syn::File = syn::parse2(tokens).expect("the expansion parses as Rust items");
+    // The workspace's path is replaced before formatting: its length would
+    // otherwise decide where a long line breaks.
     let root = workspace_root().to_string_lossy().into_owned();
-    prettyplease::unparse(&file).replace(&root, "$WORKSPACE")
+    let text = tokens.to_string().replace(&root, "$WORKSPACE");
+    let file: syn::File = syn::parse_str(&text).expect("the expansion parses as Rust items");
+    prettyplease::unparse(&file)
 }
 
 /// The directory cargo compiles `file`'s crate in, which paths in its
