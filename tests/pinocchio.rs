@@ -211,33 +211,7 @@ fn the_spatial_chains_written_with_joints_agree_with_pinocchio() {
 /// oracle (eqs. 69-70) over 1,000 random states: q in [−π, π], u in
 /// [−2, 2], torques in [−20, 20].
 fn oracle_agreement<M: Model>(model: &M, seed: u64) -> f64 {
-    let info = M::info();
-    let (n, l, k) = (info.coordinates.len(), info.speeds.len(), info.inputs.len());
-    let prepared = model.prepare::<f64>();
-    let mut rng = Rng(seed);
-    let mut worst: f64 = 0.0;
-    for _ in 0..1000 {
-        let q: Vec<f64> = (0..n).map(|_| rng.uniform(-PI, PI)).collect();
-        let u: Vec<f64> = (0..l).map(|_| rng.uniform(-2.0, 2.0)).collect();
-        let inputs: Vec<f64> = (0..k).map(|_| rng.uniform(-20.0, 20.0)).collect();
-        let mut state: Vec<f64> = info
-            .retained
-            .iter()
-            .map(|c| q[info.coordinate_index(c).unwrap()])
-            .collect();
-        state.extend(&u);
-        let mut d = vec![0.0; state.len()];
-        model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
-        let o = appell::oracle::reduced_rhs(model, 0.0, &q, &u, &inputs).unwrap();
-        for (a, b) in d.iter().zip(&o) {
-            worst = worst.max((a - b).abs() / (1.0 + a.abs().max(b.abs())));
-        }
-    }
-    println!(
-        "{}: largest relative difference to the oracle over 1,000 states {worst:.2e}",
-        info.name
-    );
-    worst
+    common::agree_with_inputs(model, &mut Rng(seed), 1000, PI, 20.0)
 }
 
 #[test]

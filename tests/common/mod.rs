@@ -83,6 +83,17 @@ pub fn double_pendulum_accelerations(
 /// Compares generated and oracle reduced rhs at `count` random states;
 /// returns the largest relative difference seen.
 pub fn agree<M: Model>(model: &M, rng: &mut Rng, count: usize, q_range: f64) -> f64 {
+    agree_with_inputs(model, rng, count, q_range, 1.0)
+}
+
+/// [`agree`] with inputs drawn from [−input_range, input_range].
+pub fn agree_with_inputs<M: Model>(
+    model: &M,
+    rng: &mut Rng,
+    count: usize,
+    q_range: f64,
+    input_range: f64,
+) -> f64 {
     let info = M::info();
     let prepared = model.prepare::<f64>();
     let n = info.coordinates.len();
@@ -91,7 +102,11 @@ pub fn agree<M: Model>(model: &M, rng: &mut Rng, count: usize, q_range: f64) -> 
     for _ in 0..count {
         let q: Vec<f64> = (0..n).map(|_| rng.uniform(-q_range, q_range)).collect();
         let u: Vec<f64> = (0..l).map(|_| rng.uniform(-2.0, 2.0)).collect();
-        let inputs: Vec<f64> = info.inputs.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let inputs: Vec<f64> = info
+            .inputs
+            .iter()
+            .map(|_| rng.uniform(-input_range, input_range))
+            .collect();
         let mut state: Vec<f64> = info
             .retained
             .iter()
