@@ -226,6 +226,9 @@ pub struct ModelAst {
     pub scenes: Vec<SceneDef>,
     /// Frames made by joints, with their origin points (`B`, `B_origin`).
     pub origins: Vec<(Ident, Ident)>,
+    /// The joints as written (also lowered into frames, points,
+    /// coordinates and loads above), for the kinematic tree.
+    pub joints: Vec<crate::parse::joints::JointDef>,
     /// The coordinates whose rates joints make privileged speeds, added
     /// after those of `speeds(...)` that are not among them (when parsing
     /// ends; kept for error messages).

@@ -44,6 +44,7 @@ pub mod speed_map;
 pub mod speeds;
 pub mod structure;
 pub mod text;
+pub mod tree;
 
 use appell_symbolic::{Id, RateRules, Substitution, SymbolicError};
 

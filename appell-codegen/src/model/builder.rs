@@ -130,6 +130,7 @@ pub(super) fn build_in(
         quaternions: b.quaternions,
         joint_speeds: ast.joint_speeds.iter().map(|q| q.to_string()).collect(),
         files: ast.files.clone(),
+        tree: super::tree::tree_spec(ast),
     };
     Some((model, b.cuts))
 }

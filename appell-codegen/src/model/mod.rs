@@ -21,6 +21,7 @@ mod calls;
 mod expr;
 mod frames;
 mod scenes;
+pub mod tree;
 
 use syn::Ident;
 
@@ -233,6 +234,8 @@ pub struct Model {
     /// Files the model was read from (absolute paths): the output includes
     /// them, so cargo builds the model again when one changes.
     pub files: Vec<String>,
+    /// The kinematic tree, or why the model is not a plain tree of joints.
+    pub tree: Result<tree::TreeSpec, String>,
 }
 
 impl Model {

@@ -51,6 +51,7 @@ pub fn parse_in(
         rolls: Vec::new(),
         scenes: Vec::new(),
         origins: Vec::new(),
+        joints: Vec::new(),
         joint_speeds: Vec::new(),
         vis: input.vis.clone(),
         files: Vec::new(),
@@ -152,6 +153,7 @@ pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Re
             .map(|(_, p)| Ident::new(&p.to_string(), joint.parent.span()))
     };
     let lowered = joints::lower(joint, parent_origin)?;
+    ast.joints.push(joint.clone());
     ast.origins
         .push((joint.child.clone(), lowered.points[0].name.clone()));
     ast.frames.extend(lowered.frames);

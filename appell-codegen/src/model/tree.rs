@@ -1,0 +1,421 @@
+//! The kinematic tree of a model made of joints, as written: which link
+//! each joint moves, where its frame sits in the parent link, and the
+//! bodies each link carries, every number still an expression of the
+//! model language. The structured form of the equations
+//! ([`crate::derivation::tree`]) is built from it; a model that is not a
+//! plain tree (a loop, a rolling contact, a load other than gravity and
+//! joint actuation, ...) gets the reason instead, reported in `info()`.
+
+use std::collections::HashMap;
+
+use crate::ast::{BinOp, Expr, Inertia, ModelAst, RotationAxis};
+use crate::parse::joints::{JointAxis, JointDef, JointKind};
+
+/// Constant rotations from a link's axes to a frame fixed in it: each
+/// about the current frame's axis 0, 1 or 2 by the angle.
+pub type Turns = Vec<(usize, Expr)>;
+
+/// What a joint lets its child do, in the joint frame.
+#[derive(Clone, Debug)]
+pub enum Motion {
+    /// Turn about the axis.
+    Revolute(JointAxis),
+    /// Slide along the axis.
+    Prismatic(JointAxis),
+}
+
+/// One term of a vector fixed in a link: `coefficient · F.axis`, with `F`
+/// reached from the link's axes by `turns`.
+#[derive(Clone, Debug)]
+pub struct Term {
+    /// The scalar coefficient (parameters and numbers only).
+    pub coefficient: Expr,
+    /// The frame's rotations from the link.
+    pub turns: Turns,
+    /// Its axis, 0, 1 or 2.
+    pub axis: usize,
+    /// The link the frame is fixed in (None: the ground).
+    pub link: Option<usize>,
+}
+
+/// A body or particle carried by a link.
+#[derive(Clone, Debug)]
+pub struct MassSpec {
+    /// The body's name.
+    pub name: String,
+    /// Its mass.
+    pub mass: Expr,
+    /// Its mass centre from the link's origin.
+    pub center: Vec<Term>,
+    /// Its frame's rotations from the link and its central inertia in that
+    /// frame (none for a particle).
+    pub inertia: Option<(Turns, Inertia)>,
+}
+
+/// One link: the child of one joint.
+#[derive(Clone, Debug)]
+pub struct LinkSpec {
+    /// The joint's name (its coordinate's, for a moving joint).
+    pub joint: String,
+    /// The parent link; None for the ground N.
+    pub parent: Option<usize>,
+    /// The joint frame's origin in the parent link's axes (zero when None).
+    pub xyz: Option<[Expr; 3]>,
+    /// The joint frame's fixed-axis roll, pitch, yaw in the parent link.
+    pub rpy: Option<[Expr; 3]>,
+    /// The joint's motion; None for a weld.
+    pub motion: Option<Motion>,
+    /// Whether the joint carries the input `tau_{joint}`.
+    pub actuated: bool,
+    /// The bodies fixed in the link.
+    pub bodies: Vec<MassSpec>,
+}
+
+/// A model's kinematic tree.
+#[derive(Clone, Debug)]
+pub struct TreeSpec {
+    /// Links in declaration order: a parent comes before its children.
+    pub links: Vec<LinkSpec>,
+    /// The gravity acceleration as terms along N's axes.
+    pub gravity: Vec<Term>,
+}
+
+/// Where a frame or point sits: its link (None: the ground) and, for a
+/// frame, its rotations from the link, for a point, its offset.
+type FrameAt = (Option<usize>, Turns);
+type PointAt = (Option<usize>, Vec<Term>);
+
+/// The model's kinematic tree, or why it has none.
+///
+/// ```
+/// use appell_codegen::{ctxt::Ctxt, parse, model::tree};
+///
+/// let input: syn::DeriveInput = syn::parse_str(r#"
+///     #[appell(joint(j_1, revolute(z), parent = N, child = link_1, actuated))]
+///     #[appell(body(link_1, frame = link_1, mass = m, center = origin(link_1) + 0.5 * link_1.x,
+///                   inertia = principal(0.1, 0.2, 0.3)))]
+///     #[appell(gravity(-9.81 * N.z))]
+///     struct Arm { m: f64 }
+/// "#).unwrap();
+/// let cx = Ctxt::new();
+/// let ast = parse::parse(&cx, &input);
+/// cx.check().unwrap();
+/// let spec = tree::tree_spec(&ast).unwrap();
+/// assert_eq!(spec.links.len(), 1);
+/// assert_eq!(spec.links[0].bodies[0].center.len(), 1);
+/// ```
+pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
+    if ast.joints.is_empty() {
+        return Err("the model has no joints".into());
+    }
+    model_level_checks(ast)?;
+    let mut frames: HashMap<String, FrameAt> = HashMap::new();
+    let mut points: HashMap<String, PointAt> = HashMap::new();
+    frames.insert("N".into(), (None, Vec::new()));
+    points.insert("O".into(), (None, Vec::new()));
+    let mut links = Vec::new();
+    let mut skipped_frames = Vec::new();
+    let mut skipped_points = Vec::new();
+    for j in &ast.joints {
+        let link = link_of(j, &frames)?;
+        let index = links.len();
+        frames.insert(j.child.to_string(), (Some(index), Vec::new()));
+        points.insert(format!("{}_origin", j.child), (Some(index), Vec::new()));
+        skipped_frames.push(format!("{}_frame", j.name));
+        skipped_points.push(format!("{}_at", j.name));
+        links.push(link);
+    }
+    let coordinates = coordinate_names(ast);
+    for f in &ast.frames {
+        let name = f.name.to_string();
+        if frames.contains_key(&name) || skipped_frames.contains(&name) {
+            continue;
+        }
+        let (link, mut turns) = frames
+            .get(&f.parent.to_string())
+            .cloned()
+            .ok_or_else(|| format!("frame `{name}` is not fixed in a link"))?;
+        if f.quaternion.is_some() {
+            return Err(format!("frame `{name}` is turned by a quaternion"));
+        }
+        for (axis, angle) in &f.rotations {
+            match axis {
+                RotationAxis::Parent(k) if constant(angle, &coordinates) => {
+                    turns.push((*k, angle.clone()))
+                }
+                _ => return Err(format!("frame `{name}` is not fixed in a link")),
+            }
+        }
+        frames.insert(name, (link, turns));
+    }
+    for p in &ast.points {
+        let name = p.name.to_string();
+        if points.contains_key(&name) || skipped_points.contains(&name) {
+            continue;
+        }
+        let at = point_at(&p.location, &frames, &points, &coordinates)
+            .ok_or_else(|| format!("point `{name}` is not fixed in a link"))?;
+        points.insert(name, at);
+    }
+    for b in &ast.bodies {
+        let (link, mass) = mass_spec(b, &frames, &points)?;
+        if let Some(i) = link {
+            links[i].bodies.push(mass);
+        }
+    }
+    let gravity = match &ast.gravity {
+        Some(e) => {
+            let mut terms = Vec::new();
+            if !vector_terms(e, None, &frames, &coordinates, &mut terms)
+                || terms.iter().any(|t| !t.turns.is_empty())
+            {
+                return Err("gravity is not a constant vector along N's axes".into());
+            }
+            terms
+        }
+        None => Vec::new(),
+    };
+    Ok(TreeSpec { links, gravity })
+}
+
+/// What a tree may not have: constraints, rolling, scenes, inputs and
+/// loads other than the joints' own, speeds other than the joint rates.
+fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
+    if !ast.holonomic.is_empty() || !ast.nonholonomic.is_empty() {
+        return Err("the model has constraints".into());
+    }
+    if !ast.rolls.is_empty() {
+        return Err("the model has rolling contacts".into());
+    }
+    if !ast.scenes.is_empty() {
+        return Err("the model declares scenes".into());
+    }
+    let mut expected_loads = 0;
+    let mut inputs = Vec::new();
+    let mut coordinates = Vec::new();
+    for j in &ast.joints {
+        match j.kind {
+            JointKind::Revolute(_) | JointKind::Prismatic(_) => coordinates.push(j.name.to_string()),
+            JointKind::Weld => {}
+            _ => {
+                return Err(format!(
+                    "joint `{}` is not revolute, prismatic or fixed",
+                    j.name
+                ))
+            }
+        }
+        if j.dependent {
+            return Err(format!("joint `{}` is dependent", j.name));
+        }
+        if j.at.is_some() {
+            return Err(format!("joint `{}` is placed with `at`", j.name));
+        }
+        if j.actuated {
+            inputs.push(format!("tau_{}", j.name));
+            expected_loads += if j.parent == "N" { 1 } else { 2 };
+        }
+    }
+    let declared: Vec<String> = ast.coordinates.iter().map(|c| c.to_string()).collect();
+    if declared != coordinates {
+        return Err("the model has coordinates no joint makes".into());
+    }
+    let speeds_match = ast.speeds.as_ref().is_some_and(|(list, _)| {
+        list.len() == coordinates.len()
+            && list
+                .iter()
+                .zip(&coordinates)
+                .all(|(s, q)| s.definition.is_none() && s.name == q)
+    });
+    if !speeds_match && !coordinates.is_empty() {
+        return Err("the privileged speeds are not the joint rates in joint order".into());
+    }
+    let declared_inputs: Vec<String> = ast.inputs.iter().map(|i| i.to_string()).collect();
+    if declared_inputs != inputs {
+        return Err("the model has inputs other than the joints' torques".into());
+    }
+    let loads = ast.forces.iter().chain(&ast.torques);
+    if loads.clone().any(|l| l.effect != "actuation")
+        || loads.count() != expected_loads
+    {
+        return Err("the model has loads other than gravity and joint actuation".into());
+    }
+    Ok(())
+}
+
+/// The names that vary: coordinates, inputs and time.
+fn coordinate_names(ast: &ModelAst) -> Vec<String> {
+    let names = ast.coordinates.iter().chain(&ast.inputs);
+    names.map(|c| c.to_string()).chain(["t".to_string()]).collect()
+}
+
+/// The link a joint makes, placed in its parent.
+fn link_of(j: &JointDef, frames: &HashMap<String, FrameAt>) -> Result<LinkSpec, String> {
+    let parent = match frames.get(&j.parent.to_string()) {
+        Some((link, turns)) if turns.is_empty() => *link,
+        _ => {
+            return Err(format!(
+                "joint `{}`'s parent `{}` is not a joint's child frame or N",
+                j.name, j.parent
+            ))
+        }
+    };
+    let motion = match &j.kind {
+        JointKind::Revolute(a) => Some(Motion::Revolute(a.clone())),
+        JointKind::Prismatic(a) => Some(Motion::Prismatic(a.clone())),
+        _ => None,
+    };
+    Ok(LinkSpec {
+        joint: j.name.to_string(),
+        parent,
+        xyz: j.xyz.clone(),
+        rpy: j.rpy.clone(),
+        motion,
+        actuated: j.actuated,
+        bodies: Vec::new(),
+    })
+}
+
+/// The link a body is fixed in (None: the ground) and its mass spec.
+fn mass_spec(
+    b: &crate::ast::BodyDef,
+    frames: &HashMap<String, FrameAt>,
+    points: &HashMap<String, PointAt>,
+) -> Result<(Option<usize>, MassSpec), String> {
+    let not_fixed = || format!("body `{}` is not fixed in a link", b.name);
+    let (link, center) = points.get(&b.center.to_string()).cloned().ok_or_else(not_fixed)?;
+    let inertia = match (&b.frame, &b.inertia) {
+        (Some(f), Some(i)) => {
+            let (frame_link, turns) = frames.get(&f.to_string()).cloned().ok_or_else(not_fixed)?;
+            if frame_link != link {
+                return Err(not_fixed());
+            }
+            Some((turns, i.clone()))
+        }
+        (Some(f), None) => {
+            let (frame_link, _) = frames.get(&f.to_string()).ok_or_else(not_fixed)?;
+            if *frame_link != link {
+                return Err(not_fixed());
+            }
+            None
+        }
+        (None, _) => None,
+    };
+    Ok((
+        link,
+        MassSpec {
+            name: b.name.to_string(),
+            mass: b.mass.clone(),
+            center,
+            inertia,
+        },
+    ))
+}
+
+/// A point expression `P + Σ c F.axis` whose base and frames are fixed in
+/// one link.
+fn point_at(
+    e: &Expr,
+    frames: &HashMap<String, FrameAt>,
+    points: &HashMap<String, PointAt>,
+    coordinates: &[String],
+) -> Option<PointAt> {
+    match e {
+        Expr::Name(p) => points.get(&p.to_string()).cloned(),
+        Expr::Call(f, args, _) if f == "origin" && args.len() == 1 => match &args[0] {
+            Expr::Name(frame) => match frames.get(&frame.to_string()) {
+                Some((link, turns)) if turns.is_empty() => Some((*link, Vec::new())),
+                _ => None,
+            },
+            _ => None,
+        },
+        Expr::Binary(op @ (BinOp::Add | BinOp::Sub), a, b, span) => {
+            let (link, mut terms) = point_at(a, frames, points, coordinates)?;
+            let sign = (*op == BinOp::Sub).then(|| Expr::Int(-1, *span));
+            let mut more = Vec::new();
+            if !vector_terms(b, sign, frames, coordinates, &mut more) {
+                return None;
+            }
+            if more.iter().any(|t| t.link != link) {
+                return None;
+            }
+            terms.extend(more);
+            Some((link, terms))
+        }
+        _ => None,
+    }
+}
+
+/// Appends the terms of the vector expression `e` times `factor`; false
+/// when `e` is not a constant combination of frame axes fixed in links.
+fn vector_terms(
+    e: &Expr,
+    factor: Option<Expr>,
+    frames: &HashMap<String, FrameAt>,
+    coordinates: &[String],
+    out: &mut Vec<Term>,
+) -> bool {
+    let scaled = |k: &Expr| match &factor {
+        Some(f) => Expr::Binary(BinOp::Mul, Box::new(f.clone()), Box::new(k.clone()), k.span()),
+        None => k.clone(),
+    };
+    match e {
+        Expr::Axis(f, k, span) => match frames.get(&f.to_string()) {
+            Some((link, turns)) => {
+                out.push(Term {
+                    coefficient: factor.clone().unwrap_or(Expr::Int(1, *span)),
+                    turns: turns.clone(),
+                    axis: *k,
+                    link: *link,
+                });
+                true
+            }
+            None => false,
+        },
+        Expr::Neg(v, span) => vector_terms(v, Some(scaled(&Expr::Int(-1, *span))), frames, coordinates, out),
+        Expr::Binary(BinOp::Add, a, b, _) => {
+            vector_terms(a, factor.clone(), frames, coordinates, out)
+                && vector_terms(b, factor, frames, coordinates, out)
+        }
+        Expr::Binary(BinOp::Sub, a, b, span) => {
+            vector_terms(a, factor.clone(), frames, coordinates, out)
+                && vector_terms(b, Some(scaled(&Expr::Int(-1, *span))), frames, coordinates, out)
+        }
+        Expr::Binary(BinOp::Mul, a, b, _) => {
+            let (k, v) = if has_axis(b) { (a, b) } else { (b, a) };
+            !has_axis(k)
+                && constant(k, coordinates)
+                && vector_terms(v, Some(scaled(k)), frames, coordinates, out)
+        }
+        Expr::Binary(BinOp::Div, v, k, span) => {
+            let inverse = Expr::Binary(BinOp::Div, Box::new(Expr::Int(1, *span)), k.clone(), *span);
+            !has_axis(k)
+                && constant(k, coordinates)
+                && vector_terms(v, Some(scaled(&inverse)), frames, coordinates, out)
+        }
+        _ => false,
+    }
+}
+
+/// Whether `e` holds a frame axis.
+fn has_axis(e: &Expr) -> bool {
+    match e {
+        Expr::Axis(..) => true,
+        Expr::Int(..) | Expr::Float(..) | Expr::Name(_) => false,
+        Expr::Call(_, args, _) => args.iter().any(has_axis),
+        Expr::Binary(_, a, b, _) => has_axis(a) || has_axis(b),
+        Expr::Neg(a, _) => has_axis(a),
+    }
+}
+
+/// Whether `e` is a scalar of parameters and numbers: no coordinate, no
+/// input, no time, no `dt`.
+fn constant(e: &Expr, coordinates: &[String]) -> bool {
+    match e {
+        Expr::Int(..) | Expr::Float(..) => true,
+        Expr::Name(n) => !coordinates.contains(&n.to_string()),
+        Expr::Call(f, args, _) => f != "dt" && args.iter().all(|a| constant(a, coordinates)),
+        Expr::Binary(_, a, b, _) => constant(a, coordinates) && constant(b, coordinates),
+        Expr::Neg(a, _) => constant(a, coordinates),
+        Expr::Axis(..) => false,
+    }
+}
