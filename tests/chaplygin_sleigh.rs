@@ -63,3 +63,10 @@ fn turning_decays_to_straight_line_motion_at_constant_energy() {
         "all energy ends up in translation"
     );
 }
+
+#[test]
+fn controller_functions_agree_with_the_equations() {
+    let mut rng = Rng(47);
+    let worst = common::controller_agrees(&ChaplyginSleigh::default(), &mut rng, 50, 3.0);
+    assert!(worst < 1e-9, "{worst:.2e}"); // M is ill-conditioned at some states: ÿ carries cond(M) ε
+}

@@ -151,3 +151,14 @@ fn rolling_freely_it_keeps_its_energy() {
     );
     assert!(((e1 - e0) / e0.abs().max(1.0)).abs() < 1e-9);
 }
+
+/// Closed form with inputs on the wheels and the arm, and the arm's own
+/// structured controller functions.
+#[test]
+fn controller_functions_agree_with_the_equations() {
+    let mut rng = Rng(53);
+    let worst = common::controller_agrees(&MobileManipulator::default(), &mut rng, 50, 3.0);
+    assert!(worst < 1e-11, "{worst:.2e}");
+    let worst = common::controller_agrees(&Ur5, &mut rng, 50, 3.0);
+    assert!(worst < 1e-11, "{worst:.2e}");
+}

@@ -40,6 +40,10 @@ struct State {
     ddq: Vec<f64>,
     mass_matrix: Vec<Vec<f64>>,
     nle: Vec<f64>,
+    /// Accelerations and the joint torques RNEA gives for them.
+    a: Vec<f64>,
+    rnea: Vec<f64>,
+    gravity: Vec<f64>,
 }
 
 /// A reference file: Pinocchio's joint names and the states.
@@ -86,6 +90,9 @@ fn reference(robot: &str) -> Reference {
                 .map(numbers)
                 .collect(),
             nle: numbers(&s["nle"]),
+            a: numbers(&s["a"]),
+            rnea: numbers(&s["rnea"]),
+            gravity: numbers(&s["gravity_torque"]),
         })
         .collect();
     Reference { joints, states }
@@ -122,6 +129,10 @@ struct Agreement {
     ddq: f64,
     mass_matrix: f64,
     forcing: f64,
+    /// The controller functions against RNEA, CRBA, nle and
+    /// computeGeneralizedGravity, and inverse dynamics of the rhs's ÿ
+    /// against the inputs.
+    controller: f64,
 }
 
 fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
@@ -138,6 +149,7 @@ fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
         ddq: 0.0,
         mass_matrix: 0.0,
         forcing: 0.0,
+        controller: 0.0,
     };
     for s in &r.states {
         let pick =
@@ -161,7 +173,19 @@ fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
         worst.mass_matrix = worst.mass_matrix.max(relative(&m, &crba));
         let tau_minus_nle: Vec<f64> = u_at.iter().map(|&i| s.tau[i] - s.nle[i]).collect();
         worst.forcing = worst.forcing.max(relative(&f, &tau_minus_nle));
+        worst.controller = worst.controller.max(controller(
+            model,
+            s,
+            (&q, &u, &inputs),
+            &u_at,
+            &d[kept.len()..],
+        ));
     }
+    println!("{robot}: {}", info.form);
+    println!(
+        "{robot}: inverse dynamics, M, h and gravity against RNEA, CRBA, nle and computeGeneralizedGravity, inverse dynamics of the rhs: {:.1e}",
+        worst.controller
+    );
     println!(
         "{robot} ({}): worst relative difference to Pinocchio over {} states: ddq {:.1e}, M {:.1e}, f = τ − nle {:.1e}",
         info.name,
@@ -173,8 +197,43 @@ fn agreement<M: Model>(model: &M, robot: &str) -> Agreement {
     worst
 }
 
+/// The worst relative difference of the controller functions at one state.
+fn controller<M: Model>(
+    model: &M,
+    s: &State,
+    (q, u, inputs): (&[f64], &[f64], &[f64]),
+    u_at: &[usize],
+    ydd: &[f64],
+) -> f64 {
+    let l = u.len();
+    let pick = |from: &[f64]| -> Vec<f64> { u_at.iter().map(|&i| from[i]).collect() };
+    let mut out = vec![0.0; l];
+    let mut worst = 0.0f64;
+    model
+        .inverse_dynamics(0.0, q, u, &pick(&s.a), &mut out)
+        .unwrap();
+    worst = worst.max(relative(&out, &pick(&s.rnea)));
+    model.inverse_dynamics(0.0, q, u, ydd, &mut out).unwrap();
+    worst = worst.max(relative(&out, inputs));
+    model.bias_forces(0.0, q, u, &mut out).unwrap();
+    worst = worst.max(relative(&out, &pick(&s.nle)));
+    model.gravity_forces(0.0, q, &mut out).unwrap();
+    worst = worst.max(relative(&out, &pick(&s.gravity)));
+    let mut m = vec![0.0; l * l];
+    model.mass_matrix(0.0, q, &mut m).unwrap();
+    let crba: Vec<f64> = (0..l * l)
+        .map(|k| s.mass_matrix[u_at[k / l]][u_at[k % l]])
+        .collect();
+    worst.max(relative(&m, &crba))
+}
+
 fn assert_agrees<M: Model>(model: &M, robot: &str) {
     let w = agreement(model, robot);
+    assert!(
+        w.controller <= 1e-10,
+        "{robot}: the controller functions differ by {:.2e}",
+        w.controller
+    );
     assert!(w.ddq <= 1e-10, "{robot}: ddq differs by {:.2e}", w.ddq);
     assert!(
         w.mass_matrix <= 1e-10,

@@ -101,3 +101,10 @@ fn potential_energy_is_the_gravity_potential() {
     // V = m g z of the centre, z = r cos(lean) (N.z up, gravity −g N.z).
     assert!(close(v, p.m * p.g * p.r * q[1].cos(), 1e-15), "{v}");
 }
+
+#[test]
+fn controller_functions_agree_with_the_equations() {
+    let mut rng = Rng(43);
+    let worst = common::controller_agrees(&RollingDisc::default(), &mut rng, 50, 1.2);
+    assert!(worst < 1e-12, "{worst:.2e}");
+}

@@ -221,3 +221,10 @@ fn bad_calls_are_typed_errors() {
         })
     );
 }
+
+#[test]
+fn controller_functions_agree_with_the_equations() {
+    let mut rng = Rng(41);
+    let worst = common::controller_agrees(&WheelAxle::default(), &mut rng, 50, 3.0);
+    assert!(worst < 1e-12, "{worst:.2e}");
+}

@@ -62,6 +62,30 @@ pub fn expand(input: &syn::DeriveInput) -> TokenStream {
 /// `manifest_dir` instead of the environment's `CARGO_MANIFEST_DIR` (tools
 /// that expand models of several crates, such as the snapshot test).
 pub fn expand_in(input: &syn::DeriveInput, manifest_dir: Option<&std::path::Path>) -> TokenStream {
+    expand_with(input, manifest_dir, &derivation::Options::default())
+}
+
+/// [`expand_in`] with the derivation's cost-driven choices forced by
+/// `options` (tests that compare forms: a model written with joints is the
+/// model written with frames once the structured form is left out).
+///
+/// ```
+/// use appell_codegen::{derivation::Options, expand_with};
+///
+/// let input: syn::DeriveInput = syn::parse_str(r#"
+///     #[appell(joint(j, revolute(z), parent = N, child = A))]
+///     #[appell(body(a, frame = A, mass = 1, center = origin(A) + 0.2 * A.x, inertia = principal(1, 1, 1)))]
+///     struct Arm;
+/// "#).unwrap();
+/// let closed = Options { closed_form_only: true, ..Options::default() };
+/// let out = expand_with(&input, None, &closed).to_string();
+/// assert!(out.contains("form : \"closed form\""), "{out}");
+/// ```
+pub fn expand_with(
+    input: &syn::DeriveInput,
+    manifest_dir: Option<&std::path::Path>,
+    options: &derivation::Options,
+) -> TokenStream {
     let cx = ctxt::Ctxt::new();
     let ast = parse::parse_in(&cx, input, manifest_dir);
     let model = if cx.has_errors() {
@@ -71,7 +95,7 @@ pub fn expand_in(input: &syn::DeriveInput, manifest_dir: Option<&std::path::Path
     };
     // The full derivation, then each scene's from it (its effects' loads
     // only: kinematics, M and the elimination are shared).
-    let derived = model.and_then(|k| derivation::derive(&cx, k));
+    let derived = model.and_then(|k| derivation::derive_with(&cx, k, options));
     let tokens = derived.map(|d| emit::emit(&d, &ast.vis));
     match cx.check() {
         Ok(()) => tokens.expect("no errors means a derivation"),

@@ -27,6 +27,7 @@ fn equations_with(
     let options = Options {
         fold_always,
         rotor_form,
+        ..Options::default()
     };
     let derived = derive_with(&cx, kinematics, &options).expect("derivation");
     let (d, g) = (&derived.full, &derived.model.g);

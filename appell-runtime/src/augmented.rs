@@ -40,7 +40,7 @@
 //! #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
 //! #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 //! #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
-//! #     torques: 0, symbolic_elimination: false,
+//! #     torques: 0, form: "closed form", symbolic_elimination: false,
 //! #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
 //! # };
 //! # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -176,7 +176,7 @@ fn cholesky(a: DMatrix<f64>) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, O
 /// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
 /// #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
-/// #     torques: 0, symbolic_elimination: false,
+/// #     torques: 0, form: "closed form", symbolic_elimination: false,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -267,7 +267,7 @@ pub fn accelerations<M: Model>(
 /// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
 /// #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
-/// #     torques: 0, symbolic_elimination: false,
+/// #     torques: 0, form: "closed form", symbolic_elimination: false,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

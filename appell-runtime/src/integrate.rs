@@ -290,7 +290,7 @@ pub fn rk4_step<M: Model, T: Scalar, const S: usize>(
 /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
 /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
 /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
-/// #     torques: 0, symbolic_elimination: true, rhs_ops: OpCounts {
+/// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
 /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
 /// #     equations: "x'' = -w^2 x",
 /// # };

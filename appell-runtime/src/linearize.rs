@@ -32,7 +32,7 @@
 //! #     speeds: &["x"], dependent: &["y"], cyclic: &[], ignorable: &[],
 //! #     retained: &["x", "y"], inputs: &["f"], effects: &["gravity", "push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 //! #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
-//! #     force_points: 1, torques: 0, symbolic_elimination: true,
+//! #     force_points: 1, torques: 0, form: "closed form", symbolic_elimination: true,
 //! #     rhs_ops: OpCounts { add: 5, mul: 9, div: 3, calls: 0, total: 18 },
 //! #     equations: "x'' = f/m + x (g y - x f/m - x'^2 - y'^2) / (x^2 + y^2)",
 //! # };

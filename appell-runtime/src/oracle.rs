@@ -54,7 +54,7 @@
 //! #     speeds: &["theta"], dependent: &[], cyclic: &[], ignorable: &[],
 //! #     retained: &["theta"], inputs: &[], effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0,
 //! #     constraints: 0, bodies: &[BodyInfo { name: "P", rigid: false }],
-//! #     force_points: 1, torques: 0, symbolic_elimination: true,
+//! #     force_points: 1, torques: 0, form: "closed form", symbolic_elimination: true,
 //! #     rhs_ops: OpCounts { add: 0, mul: 1, div: 1, calls: 1, total: 4 },
 //! #     equations: "theta'' = -(g/l) sin(theta)",
 //! # };

@@ -35,6 +35,7 @@ const fn info(
         bodies: &[],
         force_points: 0,
         torques: 0,
+        form: "closed form",
         symbolic_elimination: true,
         rhs_ops: OpCounts {
             add: 0,

@@ -209,6 +209,7 @@ const BASE_INFO: ModelInfo = ModelInfo {
     }],
     force_points: 0,
     torques: 0,
+    form: "closed form",
     symbolic_elimination: true,
     rhs_ops: NO_OPS,
     equations: "",

@@ -127,3 +127,64 @@ pub fn agree_with_inputs<M: Model>(
     );
     worst
 }
+
+/// The controller functions against `mass_matrix_and_forcing` and the rhs
+/// at `count` random states: inverse dynamics of the rhs's ÿ gives the
+/// inputs' generalized forces f(q, u, inputs) − f(q, u, 0), M alone is
+/// M, the bias is −f(q, u, 0) and the gravity term −f(q, 0, 0). Returns
+/// the largest relative difference.
+pub fn controller_agrees<M: Model>(model: &M, rng: &mut Rng, count: usize, q_range: f64) -> f64 {
+    let info = M::info();
+    let prepared = model.prepare::<f64>();
+    let (n, l) = (info.coordinates.len(), info.speeds.len());
+    let mut worst: f64 = 0.0;
+    let mut compare = |a: &[f64], b: &[f64]| {
+        for (a, b) in a.iter().zip(b) {
+            worst = worst.max((a - b).abs() / (1.0 + a.abs().max(b.abs())));
+        }
+    };
+    for _ in 0..count {
+        let q: Vec<f64> = (0..n).map(|_| rng.uniform(-q_range, q_range)).collect();
+        let u: Vec<f64> = (0..l).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let inputs: Vec<f64> = info.inputs.iter().map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let zero_inputs = vec![0.0; inputs.len()];
+        let mut state: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|c| q[info.coordinate_index(c).unwrap()])
+            .collect();
+        let kept = state.len();
+        state.extend(&u);
+        let mut d = vec![0.0; state.len()];
+        model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
+        let (mut m, mut f, mut f0, mut fg) =
+            (vec![0.0; l * l], vec![0.0; l], vec![0.0; l], vec![0.0; l]);
+        model
+            .mass_matrix_and_forcing(0.0, &q, &u, &inputs, &mut m, &mut f)
+            .unwrap();
+        model
+            .mass_matrix_and_forcing(0.0, &q, &u, &zero_inputs, &mut m, &mut f0)
+            .unwrap();
+        model
+            .mass_matrix_and_forcing(0.0, &q, &vec![0.0; l], &zero_inputs, &mut m, &mut fg)
+            .unwrap();
+        let mut out = vec![0.0; l];
+        model
+            .inverse_dynamics(0.0, &q, &u, &d[kept..], &mut out)
+            .unwrap();
+        let applied: Vec<f64> = f.iter().zip(&f0).map(|(a, b)| a - b).collect();
+        compare(&out, &applied);
+        let mut mm = vec![0.0; l * l];
+        model.mass_matrix(0.0, &q, &mut mm).unwrap();
+        compare(&mm, &m);
+        model.bias_forces(0.0, &q, &u, &mut out).unwrap();
+        compare(&out, &f0.iter().map(|x| -x).collect::<Vec<_>>());
+        model.gravity_forces(0.0, &q, &mut out).unwrap();
+        compare(&out, &fg.iter().map(|x| -x).collect::<Vec<_>>());
+    }
+    println!(
+        "{}: controller functions, largest relative difference over {count} states: {worst:.2e}",
+        info.name
+    );
+    worst
+}

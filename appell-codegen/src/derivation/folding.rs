@@ -380,6 +380,7 @@ mod tests {
         let forced = Options {
             fold_always: true,
             rotor_form: None,
+            closed_form_only: false,
         };
         let mut plain = testing::run(GYROSCOPE);
         let a = plain.later(&Options::default());

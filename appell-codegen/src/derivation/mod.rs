@@ -74,6 +74,8 @@ pub struct Options {
     /// Write every rotor's terms whole (`Some(true)`) or split
     /// (`Some(false)`) instead of the cheaper.
     pub rotor_form: Option<bool>,
+    /// Leave out the structured form of a tree of joints.
+    pub closed_form_only: bool,
 }
 
 /// The derivatives every stage takes: d/dt under the coordinates' rules,
@@ -153,6 +155,8 @@ pub struct Derivation {
     pub folded: Vec<String>,
     /// Readable equations.
     pub text: String,
+    /// The structured form (a plain tree of joints), or why there is none.
+    pub structured: Result<tree::Structured, String>,
 }
 
 /// M and the elimination before stage 12 fixed the coordinates they do not
@@ -201,7 +205,15 @@ pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
 pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derived> {
     let Kinematics { mut model, twin } = kinematics;
     let full = match stages(cx, &mut model, Calculus::new(twin), options) {
-        Ok(Some(d)) => d.finish(&model),
+        Ok(Some(d)) => {
+            let mut d = d.finish(&model);
+            d.structured = if options.closed_form_only {
+                Err(String::new())
+            } else {
+                structured_form(&mut model, &d.reduction.ignorable)
+            };
+            d
+        }
         Ok(None) => return None,
         Err(e) => {
             cx.error_at(
@@ -222,6 +234,15 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
         full,
         scenes,
     })
+}
+
+/// The structured form of a plain tree of joints (stage 13), the
+/// `ignorable` coordinates fixed at zero in its accelerations; else why
+/// there is none.
+fn structured_form(model: &mut Model, ignorable: &[usize]) -> Result<tree::Structured, String> {
+    let spec = model.tree.clone()?;
+    tree::structured(model, &spec, ignorable)
+        .map_err(|e| format!("the structured form failed: {e}"))
 }
 
 /// The stage outputs before they are bound to the model.
@@ -255,6 +276,7 @@ impl Stages {
             unreduced: self.unreduced,
             folded: self.folded,
             text: String::new(),
+            structured: Err(String::new()),
         };
         d.text = text::equations_text(model, &d);
         d

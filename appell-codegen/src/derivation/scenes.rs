@@ -98,6 +98,7 @@ fn scene_derivation(
             inertial_terms: full.equations.inertial_terms.clone(),
             load_terms: Vec::new(),
         },
+        structured: Err("a scene uses the closed form".into()),
         energies: Energies {
             kinetic: full.energies.kinetic,
             potential,

@@ -78,6 +78,7 @@ impl Emitter<'_> {
         let equations = self.equations_functions(&common);
         let kinematics = self.kinematics_functions(&common);
         let loads = self.load_functions(&common);
+        let controller = self.controller_functions(&common);
         quote! {
             static #info_ident: #p::ModelInfo = #info;
             #[automatically_derived]
@@ -93,6 +94,7 @@ impl Emitter<'_> {
                 #equations
                 #kinematics
                 #loads
+                #controller
             }
         }
     }

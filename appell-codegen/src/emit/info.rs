@@ -13,7 +13,7 @@ use crate::derivation::{Elimination, RowSource};
 impl Emitter<'_> {
     /// The `ModelInfo` value; `extra_ops` are the rhs's operations outside
     /// the engine's program (the numeric solves and the LDLᵀ).
-    pub(super) fn info(&self, rhs_ops: OpCount, extra_ops: usize) -> TokenStream {
+    pub(super) fn info(&self, rhs_ops: OpCount, extra_ops: usize, form: &str) -> TokenStream {
         let p = p();
         let d = self.d;
         let model = self.model;
@@ -66,7 +66,7 @@ impl Emitter<'_> {
             int(rhs_ops.calls),
         );
         let total = int(rhs_ops.total() + extra_ops);
-        let text = &d.text;
+        let text = format!("rhs: {form}\n\n{}", d.text);
         quote! {
             #p::ModelInfo {
                 name: #name,
@@ -87,6 +87,7 @@ impl Emitter<'_> {
                 bodies: &[#(#bodies),*],
                 force_points: #nf,
                 torques: #nt,
+                form: #form,
                 symbolic_elimination: #symbolic,
                 rhs_ops: #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
                 equations: #text,

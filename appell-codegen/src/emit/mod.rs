@@ -11,6 +11,7 @@
 //! beside the scene newtypes (`scenes.rs`). On errors, [`stub`] stands in.
 
 mod code;
+mod controller;
 mod functions;
 mod info;
 mod ldlt;

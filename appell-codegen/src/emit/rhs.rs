@@ -8,7 +8,9 @@
 //! `non_finite_diagnosis`) without slowing the path that
 //! succeeds.
 
-use appell_symbolic::Id;
+use appell_symbolic::{Id, OpCount};
+
+use crate::derivation::Elimination;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
@@ -25,6 +27,24 @@ pub(super) struct RhsParts {
     pub rhs: TokenStream,
     /// The length of the `Prepared` array.
     pub hoisted: usize,
+    /// The program's operations per call.
+    pub ops: OpCount,
+    /// Operations per call besides the program's (solves).
+    pub extra: usize,
+}
+
+/// What `prepare` and `rhs` are made of, in either form.
+struct Pieces<'a> {
+    /// `prepare`'s statements.
+    prepare: TokenStream,
+    /// The names `rhs` reads from `Prepared`.
+    names: &'a [TokenStream],
+    /// The expressions `prepare` returns.
+    values: &'a [TokenStream],
+    /// The program's per-call statements.
+    body: TokenStream,
+    /// What follows them: the solve and the writes to `dstate`.
+    tail: TokenStream,
 }
 
 /// The factorization of M, where it runs and what it costs per call.
@@ -44,9 +64,37 @@ struct Factors {
 
 impl Emitter<'_> {
     /// `prepare`, `rhs` and the `ModelInfo` (which counts the rhs's
-    /// operations).
+    /// operations and names the form): the structured form where the model
+    /// has one and it costs fewer operations per call, else the closed form.
     pub(super) fn rhs(&self, common: &super::functions::Common) -> RhsParts {
-        let p = p();
+        let flat = self.flat_rhs(common);
+        let flat_total = flat.ops.total() + flat.extra;
+        let (chosen, form) = match &self.d.structured {
+            Ok(s) if matches!(self.d.elimination, Elimination::Symbolic) => {
+                let structured = self.structured_rhs(common, &s.accelerations);
+                let total = structured.ops.total();
+                if total < flat_total {
+                    let form = format!("structured: the articulated-body algorithm over the joint tree, {total} operations per call against the closed form's {flat_total}");
+                    (structured, form)
+                } else {
+                    let form = format!("closed form: {flat_total} operations per call against the structured form's {total}");
+                    (flat, form)
+                }
+            }
+            Ok(_) => (flat, "closed form".to_string()),
+            Err(reason) if reason.is_empty() => (flat, "closed form".to_string()),
+            Err(reason) => (
+                flat,
+                format!("closed form ({reason}, so no structured form)"),
+            ),
+        };
+        let info = self.info(chosen.ops, chosen.extra, &form);
+        RhsParts { info, ..chosen }
+    }
+
+    /// The closed form: M and f from Appell's equations, the numeric
+    /// elimination, M ÿ = f by LDLᵀ.
+    fn flat_rhs(&self, common: &super::functions::Common) -> RhsParts {
         let d = self.d;
         let (l, retained) = (d.l, &d.reduction.retained);
         let constant_mass = self.constant_mass();
@@ -67,7 +115,78 @@ impl Emitter<'_> {
         let tri = if constant_mass { 0 } else { l * (l + 1) / 2 };
         let factors = self.factors(&tri_roots, &rhs.outputs, &rhs.hoisted, constant_mass);
         let (solve, solve_ops) = self.ldlt_solve(&rhs.outputs[tri..tri + l]);
-        let info = self.info(rhs.ops, factors.ops + solve_ops + elim_ops);
+        let rates_out = (0..retained.len()).map(|k| {
+            let (value, k) = (&rhs.outputs[tri + l + k], int(k));
+            quote!(__dstate[#k] = #value;)
+        });
+        let accels_out = (0..l).map(|k| {
+            let (y, k) = (format_ident!("__y_{}", k), int(retained.len() + k));
+            quote!(__dstate[#k] = #y;)
+        });
+        let (factors_rhs, prepare_statements) = (&factors.rhs, &rhs.prepare);
+        let factors_prepare = &factors.prepare;
+        let pieces = Pieces {
+            prepare: quote!(#(#prepare_statements)* #factors_prepare),
+            names: &factors.names,
+            values: &factors.values,
+            body: rhs_body,
+            tail: quote!(#factors_rhs #solve #(#rates_out)* #(#accels_out)*),
+        };
+        let (prepare, rhs_fn) = self.rhs_functions(common, pieces);
+        RhsParts {
+            info: TokenStream::new(),
+            prepare,
+            rhs: rhs_fn,
+            hoisted: factors.names.len(),
+            ops: rhs.ops,
+            extra: factors.ops + solve_ops + elim_ops,
+        }
+    }
+
+    /// The structured form: ÿ straight from the recursions' expressions.
+    fn structured_rhs(&self, common: &super::functions::Common, accelerations: &[Id]) -> RhsParts {
+        let d = self.d;
+        let (l, retained) = (d.l, &d.reduction.retained);
+        let mut roots: Vec<Id> = accelerations.to_vec();
+        roots.extend(retained.iter().map(|&r| d.map.qdot[r]));
+        let mut c = code(&self.model.g, &roots, Target::Generic { hoist: true });
+        let rates_out = (0..retained.len()).map(|k| {
+            let (value, k) = (&c.outputs[l + k], int(k));
+            quote!(__dstate[#k] = #value;)
+        });
+        let accels_out = (0..l).map(|k| {
+            let (value, k) = (&c.outputs[k], int(retained.len() + k));
+            quote!(__dstate[#k] = #value;)
+        });
+        let tail = quote!(#(#rates_out)* #(#accels_out)*);
+        let body = std::mem::take(&mut c.body);
+        let prepare = std::mem::take(&mut c.prepare);
+        let pieces = Pieces {
+            prepare: quote!(#(#prepare)*),
+            names: &c.hoisted,
+            values: &c.hoisted,
+            body: quote!(#(#body)*),
+            tail,
+        };
+        let (prepare, rhs_fn) = self.rhs_functions(common, pieces);
+        RhsParts {
+            info: TokenStream::new(),
+            prepare,
+            rhs: rhs_fn,
+            hoisted: c.hoisted.len(),
+            ops: c.ops,
+            extra: 0,
+        }
+    }
+
+    /// `prepare` and `rhs` around the pieces of either form.
+    fn rhs_functions(
+        &self,
+        common: &super::functions::Common,
+        pieces: Pieces,
+    ) -> (TokenStream, TokenStream) {
+        let p = p();
+        let retained = &self.d.reduction.retained;
         let g = &self.model.g;
         let state_q = retained.iter().enumerate().map(|(k, &r)| {
             let (q, k) = (self.coord(r), int(k));
@@ -80,15 +199,7 @@ impl Emitter<'_> {
             );
             quote!(let #u = __state[#k];)
         });
-        let rates_out = (0..retained.len()).map(|k| {
-            let (value, k) = (&rhs.outputs[tri + l + k], int(k));
-            quote!(__dstate[#k] = #value;)
-        });
-        let accels_out = (0..l).map(|k| {
-            let (y, k) = (format_ident!("__y_{}", k), int(retained.len() + k));
-            quote!(__dstate[#k] = #y;)
-        });
-        let ns = retained.len() + l;
+        let ns = retained.len() + self.d.l;
         let finite = if ns == 0 {
             quote!(true)
         } else {
@@ -98,13 +209,11 @@ impl Emitter<'_> {
             });
             quote!(#(#each)&&*)
         };
-        let h = factors.names.len();
-        let hi = int(h);
+        let hi = int(pieces.names.len());
         let (params_t, pos, bind_inputs) =
             (&common.params_t, &common.positivity, &common.bind_inputs);
-        let prepare_statements = &rhs.prepare;
-        let (factors_prepare, factors_rhs) = (&factors.prepare, &factors.rhs);
-        let (names, values) = (&factors.names, &factors.values);
+        let (names, values, prepare_statements, tail) =
+            (pieces.names, pieces.values, &pieces.prepare, &pieces.tail);
         let checks = [
             self.check("__state", ns),
             self.check("__inputs", self.model.inputs.len()),
@@ -113,7 +222,7 @@ impl Emitter<'_> {
         let diagnose = self.non_finite_diagnosis();
         let prepare = quote! {
             fn prepare<__T: #p::Scalar>(&self) -> [__T; #hi] {
-                #params_t #(#prepare_statements)* #factors_prepare
+                #params_t #prepare_statements
                 [#(#values),*]
             }
         };
@@ -122,9 +231,9 @@ impl Emitter<'_> {
                 let [#(#names),*] = *__prepared;
                 #params_t #(#state_q)* #(#state_u)* #bind_inputs
             },
-            rhs_body,
+            pieces.body,
             quote! {
-                #factors_rhs #solve #(#rates_out)* #(#accels_out)*
+                #tail
                 if !(#finite) { return #p::Err(#p::ModelError::NonFinite { what: "the state derivative" }); }
                 #p::Ok(())
             },
@@ -142,12 +251,7 @@ impl Emitter<'_> {
                 }
             }
         };
-        RhsParts {
-            info,
-            prepare,
-            rhs: rhs_fn,
-            hoisted: h,
-        }
+        (prepare, rhs_fn)
     }
 
     /// M's factorization: in `prepare` when M is constant (its pivots still

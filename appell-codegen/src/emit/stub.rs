@@ -32,7 +32,7 @@ pub fn stub(name: &syn::Ident, scenes: &[syn::Ident], vis: &syn::Visibility) -> 
                 name: #name_str, parameters: &[], coordinates: &[], speeds: &[], dependent: &[], cyclic: &[],
                 ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], holonomic: 0, constraints: 0,
                 row_sources: &[], contacts: &[],
-                bodies: &[], force_points: 0, torques: 0, symbolic_elimination: true,
+                bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
                 rhs_ops: #p::OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
             };
             #[allow(unused_variables, clippy::all)]

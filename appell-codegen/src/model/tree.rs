@@ -59,9 +59,14 @@ pub struct LinkSpec {
     pub joint: String,
     /// The parent link; None for the ground N.
     pub parent: Option<usize>,
-    /// The joint frame's origin in the parent link's axes (zero when None).
+    /// The parent frame's rotations from the parent link.
+    pub parent_turns: Turns,
+    /// The parent frame's origin from the parent link's.
+    pub parent_origin: Vec<Term>,
+    /// The joint frame's origin in the parent frame's axes (zero when
+    /// None).
     pub xyz: Option<[Expr; 3]>,
-    /// The joint frame's fixed-axis roll, pitch, yaw in the parent link.
+    /// The joint frame's fixed-axis roll, pitch, yaw in the parent frame.
     pub rpy: Option<[Expr; 3]>,
     /// The joint's motion; None for a weld.
     pub motion: Option<Motion>,
@@ -106,7 +111,8 @@ type PointAt = (Option<usize>, Vec<Term>);
 /// ```
 pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
     if ast.joints.is_empty() {
-        return Err("the model has no joints".into());
+        // No reason to give: a model without joints is not a tree of them.
+        return Err(String::new());
     }
     model_level_checks(ast)?;
     let mut frames: HashMap<String, FrameAt> = HashMap::new();
@@ -114,48 +120,62 @@ pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
     frames.insert("N".into(), (None, Vec::new()));
     points.insert("O".into(), (None, Vec::new()));
     let mut links = Vec::new();
-    let mut skipped_frames = Vec::new();
-    let mut skipped_points = Vec::new();
-    for j in &ast.joints {
-        let link = link_of(j, &frames)?;
-        let index = links.len();
-        frames.insert(j.child.to_string(), (Some(index), Vec::new()));
-        points.insert(format!("{}_origin", j.child), (Some(index), Vec::new()));
-        skipped_frames.push(format!("{}_frame", j.name));
-        skipped_points.push(format!("{}_at", j.name));
-        links.push(link);
-    }
-    let coordinates = coordinate_names(ast);
-    for f in &ast.frames {
-        let name = f.name.to_string();
-        if frames.contains_key(&name) || skipped_frames.contains(&name) {
-            continue;
-        }
-        let (link, mut turns) = frames
-            .get(&f.parent.to_string())
-            .cloned()
-            .ok_or_else(|| format!("frame `{name}` is not fixed in a link"))?;
-        if f.quaternion.is_some() {
-            return Err(format!("frame `{name}` is turned by a quaternion"));
-        }
-        for (axis, angle) in &f.rotations {
-            match axis {
-                RotationAxis::Parent(k) if constant(angle, &coordinates) => {
-                    turns.push((*k, angle.clone()))
-                }
-                _ => return Err(format!("frame `{name}` is not fixed in a link")),
+    let variables = coordinate_names(ast);
+    // What joints declare themselves: child frames, joint frames, origins.
+    let joint_frames: Vec<String> = ast
+        .joints
+        .iter()
+        .flat_map(|j| [format!("{}_frame", j.name), j.child.to_string()])
+        .collect();
+    let joint_points: Vec<String> = ast
+        .joints
+        .iter()
+        .flat_map(|j| [format!("{}_at", j.name), format!("{}_origin", j.child)])
+        .collect();
+    let mut pending = ast.joints.iter().peekable();
+    // Frames and points are resolved as their parents are: a joint's
+    // parent may be a frame declared before it and fixed in a link.
+    loop {
+        let mut progress = false;
+        for f in &ast.frames {
+            let name = f.name.to_string();
+            if frames.contains_key(&name) || joint_frames.contains(&name) {
+                continue;
+            }
+            if let Some(at) = frame_at(f, &frames, &variables)? {
+                frames.insert(name, at);
+                progress = true;
             }
         }
-        frames.insert(name, (link, turns));
-    }
-    for p in &ast.points {
-        let name = p.name.to_string();
-        if points.contains_key(&name) || skipped_points.contains(&name) {
-            continue;
+        for p in &ast.points {
+            let name = p.name.to_string();
+            if points.contains_key(&name) || joint_points.contains(&name) {
+                continue;
+            }
+            if let Some(at) = point_at(&p.location, &frames, &points, &variables) {
+                points.insert(name, at);
+                progress = true;
+            }
         }
-        let at = point_at(&p.location, &frames, &points, &coordinates)
-            .ok_or_else(|| format!("point `{name}` is not fixed in a link"))?;
-        points.insert(name, at);
+        if let Some(j) = pending.peek() {
+            if let Some(link) = link_of(j, ast, &frames, &points)? {
+                let index = links.len();
+                frames.insert(j.child.to_string(), (Some(index), Vec::new()));
+                points.insert(format!("{}_origin", j.child), (Some(index), Vec::new()));
+                links.push(link);
+                pending.next();
+                progress = true;
+            }
+        }
+        if !progress {
+            break;
+        }
+    }
+    if let Some(j) = pending.next() {
+        return Err(format!(
+            "joint `{}`'s parent `{}` is not fixed in a link or in N",
+            j.name, j.parent
+        ));
     }
     for b in &ast.bodies {
         let (link, mass) = mass_spec(b, &frames, &points)?;
@@ -166,7 +186,7 @@ pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
     let gravity = match &ast.gravity {
         Some(e) => {
             let mut terms = Vec::new();
-            if !vector_terms(e, None, &frames, &coordinates, &mut terms)
+            if !vector_terms(e, None, &frames, &variables, &mut terms)
                 || terms.iter().any(|t| !t.turns.is_empty())
             {
                 return Err("gravity is not a constant vector along N's axes".into());
@@ -195,7 +215,9 @@ fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
     let mut coordinates = Vec::new();
     for j in &ast.joints {
         match j.kind {
-            JointKind::Revolute(_) | JointKind::Prismatic(_) => coordinates.push(j.name.to_string()),
+            JointKind::Revolute(_) | JointKind::Prismatic(_) => {
+                coordinates.push(j.name.to_string())
+            }
             JointKind::Weld => {}
             _ => {
                 return Err(format!(
@@ -234,9 +256,7 @@ fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
         return Err("the model has inputs other than the joints' torques".into());
     }
     let loads = ast.forces.iter().chain(&ast.torques);
-    if loads.clone().any(|l| l.effect != "actuation")
-        || loads.count() != expected_loads
-    {
+    if loads.clone().any(|l| l.effect != "actuation") || loads.count() != expected_loads {
         return Err("the model has loads other than gravity and joint actuation".into());
     }
     Ok(())
@@ -245,34 +265,85 @@ fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
 /// The names that vary: coordinates, inputs and time.
 fn coordinate_names(ast: &ModelAst) -> Vec<String> {
     let names = ast.coordinates.iter().chain(&ast.inputs);
-    names.map(|c| c.to_string()).chain(["t".to_string()]).collect()
+    names
+        .map(|c| c.to_string())
+        .chain(["t".to_string()])
+        .collect()
 }
 
-/// The link a joint makes, placed in its parent.
-fn link_of(j: &JointDef, frames: &HashMap<String, FrameAt>) -> Result<LinkSpec, String> {
-    let parent = match frames.get(&j.parent.to_string()) {
-        Some((link, turns)) if turns.is_empty() => *link,
-        _ => {
-            return Err(format!(
-                "joint `{}`'s parent `{}` is not a joint's child frame or N",
-                j.name, j.parent
-            ))
+/// A frame fixed in a link by constant rotations from a resolved parent;
+/// None while the parent is not resolved.
+fn frame_at(
+    f: &crate::ast::FrameDef,
+    frames: &HashMap<String, FrameAt>,
+    variables: &[String],
+) -> Result<Option<FrameAt>, String> {
+    let name = &f.name;
+    let Some((link, mut turns)) = frames.get(&f.parent.to_string()).cloned() else {
+        return Ok(None);
+    };
+    if f.quaternion.is_some() {
+        return Err(format!("frame `{name}` is turned by a quaternion"));
+    }
+    for (axis, angle) in &f.rotations {
+        match axis {
+            RotationAxis::Parent(k) if constant(angle, variables) => {
+                turns.push((*k, angle.clone()))
+            }
+            _ => {
+                return Err(format!(
+                    "frame `{name}` turns with a coordinate but not by a joint"
+                ))
+            }
+        }
+    }
+    Ok(Some((link, turns)))
+}
+
+/// The link a joint makes, placed in its parent frame; None while the
+/// parent frame or its origin is not resolved.
+fn link_of(
+    j: &JointDef,
+    ast: &ModelAst,
+    frames: &HashMap<String, FrameAt>,
+    points: &HashMap<String, PointAt>,
+) -> Result<Option<LinkSpec>, String> {
+    let Some((parent, parent_turns)) = frames.get(&j.parent.to_string()).cloned() else {
+        return Ok(None);
+    };
+    let origin = if j.parent == "N" {
+        "O".to_string()
+    } else {
+        match ast.origins.iter().find(|(f, _)| *f == j.parent) {
+            Some((_, p)) => p.to_string(),
+            None => return Ok(None),
         }
     };
+    let Some((origin_link, parent_origin)) = points.get(&origin).cloned() else {
+        return Ok(None);
+    };
+    if origin_link != parent {
+        return Err(format!(
+            "joint `{}`'s origin is not fixed in its parent",
+            j.name
+        ));
+    }
     let motion = match &j.kind {
         JointKind::Revolute(a) => Some(Motion::Revolute(a.clone())),
         JointKind::Prismatic(a) => Some(Motion::Prismatic(a.clone())),
         _ => None,
     };
-    Ok(LinkSpec {
+    Ok(Some(LinkSpec {
         joint: j.name.to_string(),
         parent,
+        parent_turns,
+        parent_origin,
         xyz: j.xyz.clone(),
         rpy: j.rpy.clone(),
         motion,
         actuated: j.actuated,
         bodies: Vec::new(),
-    })
+    }))
 }
 
 /// The link a body is fixed in (None: the ground) and its mass spec.
@@ -282,7 +353,10 @@ fn mass_spec(
     points: &HashMap<String, PointAt>,
 ) -> Result<(Option<usize>, MassSpec), String> {
     let not_fixed = || format!("body `{}` is not fixed in a link", b.name);
-    let (link, center) = points.get(&b.center.to_string()).cloned().ok_or_else(not_fixed)?;
+    let (link, center) = points
+        .get(&b.center.to_string())
+        .cloned()
+        .ok_or_else(not_fixed)?;
     let inertia = match (&b.frame, &b.inertia) {
         (Some(f), Some(i)) => {
             let (frame_link, turns) = frames.get(&f.to_string()).cloned().ok_or_else(not_fixed)?;
@@ -330,7 +404,7 @@ fn point_at(
         },
         Expr::Binary(op @ (BinOp::Add | BinOp::Sub), a, b, span) => {
             let (link, mut terms) = point_at(a, frames, points, coordinates)?;
-            let sign = (*op == BinOp::Sub).then(|| Expr::Int(-1, *span));
+            let sign = (*op == BinOp::Sub).then_some(Expr::Int(-1, *span));
             let mut more = Vec::new();
             if !vector_terms(b, sign, frames, coordinates, &mut more) {
                 return None;
@@ -355,7 +429,12 @@ fn vector_terms(
     out: &mut Vec<Term>,
 ) -> bool {
     let scaled = |k: &Expr| match &factor {
-        Some(f) => Expr::Binary(BinOp::Mul, Box::new(f.clone()), Box::new(k.clone()), k.span()),
+        Some(f) => Expr::Binary(
+            BinOp::Mul,
+            Box::new(f.clone()),
+            Box::new(k.clone()),
+            k.span(),
+        ),
         None => k.clone(),
     };
     match e {
@@ -371,14 +450,26 @@ fn vector_terms(
             }
             None => false,
         },
-        Expr::Neg(v, span) => vector_terms(v, Some(scaled(&Expr::Int(-1, *span))), frames, coordinates, out),
+        Expr::Neg(v, span) => vector_terms(
+            v,
+            Some(scaled(&Expr::Int(-1, *span))),
+            frames,
+            coordinates,
+            out,
+        ),
         Expr::Binary(BinOp::Add, a, b, _) => {
             vector_terms(a, factor.clone(), frames, coordinates, out)
                 && vector_terms(b, factor, frames, coordinates, out)
         }
         Expr::Binary(BinOp::Sub, a, b, span) => {
             vector_terms(a, factor.clone(), frames, coordinates, out)
-                && vector_terms(b, Some(scaled(&Expr::Int(-1, *span))), frames, coordinates, out)
+                && vector_terms(
+                    b,
+                    Some(scaled(&Expr::Int(-1, *span))),
+                    frames,
+                    coordinates,
+                    out,
+                )
         }
         Expr::Binary(BinOp::Mul, a, b, _) => {
             let (k, v) = if has_axis(b) { (a, b) } else { (b, a) };

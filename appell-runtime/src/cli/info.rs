@@ -14,7 +14,7 @@ use serde_json::{json, Value};
 /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["phi"], inputs: &["tau"],
 /// #     effects: &["motor"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
 /// #     bodies: &[BodyInfo { name: "B", rigid: true }], force_points: 0, torques: 1,
-/// #     symbolic_elimination: true,
+/// #     form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
 /// #     equations: "phi'' = tau/i",
 /// # };
@@ -108,6 +108,7 @@ pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
             .collect::<Vec<_>>(),
         "force_points": info.force_points,
         "torques": info.torques,
+        "form": info.form,
         "symbolic_elimination": info.symbolic_elimination,
         "rhs_ops": {
             "add": ops.add,

@@ -20,7 +20,7 @@ use std::process::ExitCode;
 /// #     name: "Pendulum", parameters: &[], coordinates: &[], speeds: &[], dependent: &[],
 /// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[],
 /// #     holonomic: 0, constraints: 0, bodies: &[], force_points: 0, torques: 0,
-/// #     symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
+/// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
 /// # };
 /// let text = appell_runtime::cli::usage("pendulum", &info);
 /// assert!(text.starts_with("usage: pendulum [eval|contacts|info|equations|bench|accuracy|help]"));
@@ -99,7 +99,7 @@ pub fn run<M: Model>(
 /// #     name: "Free", parameters: &["m"], coordinates: &["x"], speeds: &["x"],
 /// #     dependent: &[], cyclic: &[], ignorable: &["x"], retained: &[], inputs: &["f"],
 /// #     effects: &["push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
-/// #     torques: 0, symbolic_elimination: true,
+/// #     torques: 0, form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
 /// #     equations: "x'' = f/m",
 /// # };

@@ -239,7 +239,7 @@ pub fn holonomic_unknowns<M: Model>(
 /// #     speeds: &["x"], dependent: &["y"], cyclic: &[], ignorable: &[],
 /// #     retained: &["x", "y"], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
-/// #     force_points: 0, torques: 0, symbolic_elimination: true,
+/// #     force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -334,7 +334,7 @@ pub fn project_holonomic<M: Model>(
 /// #     name: "Ring", parameters: &["l"], coordinates: &["x", "y"], speeds: &["x"],
 /// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
 /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1, constraints: 1, bodies: &[], force_points: 0,
-/// #     torques: 0, symbolic_elimination: false,
+/// #     torques: 0, form: "closed form", symbolic_elimination: false,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

@@ -70,6 +70,7 @@ pub static PENDULUM_INFO: ModelInfo = ModelInfo {
     }],
     force_points: 1,
     torques: 0,
+    form: "closed form",
     symbolic_elimination: true,
     rhs_ops: OpCounts {
         add: 0,
@@ -302,6 +303,7 @@ pub static ROD_INFO: ModelInfo = ModelInfo {
     }],
     force_points: 1,
     torques: 1,
+    form: "closed form",
     symbolic_elimination: true,
     rhs_ops: OpCounts {
         add: 3,
@@ -562,6 +564,7 @@ pub static KNIFE_INFO: ModelInfo = ModelInfo {
     }],
     force_points: 1,
     torques: 1,
+    form: "closed form",
     symbolic_elimination: true,
     rhs_ops: OpCounts {
         add: 2,
@@ -851,6 +854,7 @@ pub static CARTESIAN_INFO: ModelInfo = ModelInfo {
     }],
     force_points: 1,
     torques: 0,
+    form: "closed form",
     symbolic_elimination: false,
     rhs_ops: OpCounts {
         add: 6,
@@ -1216,6 +1220,7 @@ pub static GYRO_INFO: ModelInfo = ModelInfo {
     }],
     force_points: 1,
     torques: 1,
+    form: "closed form",
     symbolic_elimination: true,
     rhs_ops: OpCounts {
         add: 100,

@@ -87,7 +87,12 @@ pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> 
     let mut places: Vec<Place> = Vec::with_capacity(spec.links.len());
     let mut out: Vec<Link> = Vec::new();
     for link in &spec.links {
-        let placement = placement(&mut a, link.xyz.as_ref(), link.rpy.as_ref())?;
+        let parent_frame = Transform {
+            rot: turned(&mut a, &link.parent_turns)?,
+            pos: terms_vector(&mut a, &link.parent_origin)?,
+        };
+        let local = placement(&mut a, link.xyz.as_ref(), link.rpy.as_ref())?;
+        let placement = compose(&mut a, &parent_frame, &local)?;
         let (moving, before) = match link.parent {
             Some(p) => (places[p].moving, places[p].from),
             None => (None, identity(&mut a)?),
@@ -97,8 +102,7 @@ pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> 
         let Some(motion) = &link.motion else {
             // A weld: the link is part of `moving`.
             if let Some(m) = moving {
-                let x = a.motion_matrix(&joint_frame)?;
-                let moved = a.congruence(&x, &inertia)?;
+                let moved = a.congruence(&joint_frame, &inertia)?;
                 out[m].inertia = add6(&mut a, &out[m].inertia, &moved)?;
             }
             places.push(Place {
@@ -114,7 +118,11 @@ pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> 
             parts.coordinates[k]
         };
         let (transform, subspace) = joint(&mut a, &joint_frame, motion, q)?;
-        let input = match parts.inputs.iter().find(|(n, _)| *n == format!("tau_{}", link.joint)) {
+        let input = match parts
+            .inputs
+            .iter()
+            .find(|(n, _)| *n == format!("tau_{}", link.joint))
+        {
             Some((_, id)) if link.actuated => *id,
             _ => a.zero(),
         };
@@ -148,7 +156,13 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: Id) -> R<(Trans
             let turn = rotation_about(a, axis, u, q)?;
             let rot = a.mat_mul(&frame.rot, &turn)?;
             let s = [u[0], u[1], u[2], zero, zero, zero];
-            Ok((Transform { rot, pos: frame.pos }, s))
+            Ok((
+                Transform {
+                    rot,
+                    pos: frame.pos,
+                },
+                s,
+            ))
         }
         Motion::Prismatic(axis) => {
             let u = unit_axis(a, axis)?;
@@ -156,7 +170,13 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: Id) -> R<(Trans
             let slide = a.scale(along, q)?;
             let pos = a.add(frame.pos, slide)?;
             let s = [zero, zero, zero, u[0], u[1], u[2]];
-            Ok((Transform { rot: frame.rot, pos }, s))
+            Ok((
+                Transform {
+                    rot: frame.rot,
+                    pos,
+                },
+                s,
+            ))
         }
     }
 }

@@ -53,7 +53,6 @@ pub fn structured(
     let bias = r.newton_euler(&parts.speeds, None, true)?;
     let gravity_term = r.newton_euler(&parts.speeds, None, false)?;
     let mass = r.composite_rigid_body()?;
-    drop(r);
     let reduced = links::links(&mut model.g, spec, &parts, fixed)?;
     let mut r = recursions::Recursions::new(&mut model.g, &reduced, gravity)?;
     let accelerations = r.articulated_body(&parts.speeds)?;

@@ -23,7 +23,11 @@ impl<'g, 'l> Recursions<'g, 'l> {
     pub fn new(g: &'g mut Graph, links: &'l [Link], gravity: V3) -> R<Recursions<'g, 'l>> {
         let a = Algebra::new(g)?;
         let zero = a.zero();
-        let up = [a.g.neg(gravity[0])?, a.g.neg(gravity[1])?, a.g.neg(gravity[2])?];
+        let up = [
+            a.g.neg(gravity[0])?,
+            a.g.neg(gravity[1])?,
+            a.g.neg(gravity[2])?,
+        ];
         Ok(Recursions {
             a,
             links,
@@ -67,7 +71,12 @@ impl<'g, 'l> Recursions<'g, 'l> {
     /// The generalized forces M ÿ + h by recursive Newton–Euler, at
     /// accelerations `accels` (zero when None), with the velocity terms
     /// when `moving` (else at zero speeds: the gravity term).
-    pub fn newton_euler(&mut self, speeds: &[Id], accels: Option<&[Id]>, moving: bool) -> R<Vec<Id>> {
+    pub fn newton_euler(
+        &mut self,
+        speeds: &[Id],
+        accels: Option<&[Id]>,
+        moving: bool,
+    ) -> R<Vec<Id>> {
         let n = self.links.len();
         let zero = self.a.zero();
         let rest = vec![zero; n];
@@ -95,7 +104,9 @@ impl<'g, 'l> Recursions<'g, 'l> {
         for i in (0..n).rev() {
             tau[i] = self.project(i, forces[i])?;
             if let Some(p) = self.links[i].parent {
-                let moved = self.a.force_to_parent(&self.links[i].transform, forces[i])?;
+                let moved = self
+                    .a
+                    .force_to_parent(&self.links[i].transform, forces[i])?;
                 forces[p] = self.a.add(forces[p], moved)?;
             }
         }
@@ -108,8 +119,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
         let mut composite: Vec<M6> = self.links.iter().map(|l| l.inertia).collect();
         for i in (0..n).rev() {
             if let Some(p) = self.links[i].parent {
-                let x = self.a.motion_matrix(&self.links[i].transform)?;
-                let moved = self.a.congruence(&x, &composite[i])?;
+                let moved = self.a.congruence(&self.links[i].transform, &composite[i])?;
                 composite[p] = add6(&mut self.a, &composite[p], &moved)?;
             }
         }
@@ -165,8 +175,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
             let uu = self.a.scale(ud, u[i])?;
             let pa = self.a.add(bias[i], ic)?;
             let pa = self.a.add(pa, uu)?;
-            let x = self.a.motion_matrix(&self.links[i].transform)?;
-            let moved = self.a.congruence(&x, &ia)?;
+            let moved = self.a.congruence(&self.links[i].transform, &ia)?;
             inertia[p] = add6(&mut self.a, &inertia[p], &moved)?;
             let pushed = self.a.force_to_parent(&self.links[i].transform, pa)?;
             bias[p] = self.a.add(bias[p], pushed)?;

@@ -179,32 +179,40 @@ impl<'g> Algebra<'g> {
         Ok(out)
     }
 
-    /// The 6×6 matrix of the motion transform parent → child:
-    /// [[Rᵀ, 0], [−Rᵀ p̃, Rᵀ]].
-    pub fn motion_matrix(&mut self, x: &Transform) -> R<M6> {
-        let mut out = [[self.zero; 6]; 6];
+    /// Xᵀ I X for a symmetric I and the motion transform X of `x`: an
+    /// inertia of the child in the parent's axes about the parent's
+    /// origin. X = [Rᵀ 0; 0 Rᵀ] [1 0; −p̃ 1], so the blocks are turned
+    /// first (R A Rᵀ, R B Rᵀ, R C Rᵀ) and then moved by the constant p,
+    /// each step a product with a sparse factor.
+    pub fn congruence(&mut self, x: &Transform, inertia: &M6) -> R<M6> {
+        let zero = self.zero;
+        let mut turn = [[zero; 6]; 6];
         for i in 0..3 {
             for j in 0..3 {
-                out[i][j] = x.rot[j][i];
-                out[i + 3][j + 3] = x.rot[j][i];
+                turn[i][j] = x.rot[j][i];
+                turn[i + 3][j + 3] = x.rot[j][i];
             }
         }
-        // −Rᵀ p̃: column j is −Rᵀ (p × e_j).
+        let turned = self.symmetric_congruence(&turn, inertia)?;
+        let mut shift = [[zero; 6]; 6];
+        let one = self.g.int(1)?;
+        for (i, row) in shift.iter_mut().enumerate() {
+            row[i] = one;
+        }
+        // −p̃ in the lower left: (−p̃)[i][j] = −ε_ikj p_k.
         for j in 0..3 {
-            let mut e = [self.zero; 3];
-            e[j] = self.g.int(1)?;
+            let mut e = [zero; 3];
+            e[j] = one;
             let pe = self.cross(x.pos, e)?;
-            let col = self.mat_t_vec(&x.rot, pe)?;
             for i in 0..3 {
-                out[i + 3][j] = self.g.neg(col[i])?;
+                shift[i + 3][j] = self.g.neg(pe[i])?;
             }
         }
-        Ok(out)
+        self.symmetric_congruence(&shift, &turned)
     }
 
-    /// Xᵀ I X for a symmetric I (only what the symmetry needs is formed):
-    /// an inertia of the child in the parent's axes.
-    pub fn congruence(&mut self, x: &M6, inertia: &M6) -> R<M6> {
+    /// Xᵀ I X for a symmetric I, only the upper triangle formed.
+    fn symmetric_congruence(&mut self, x: &M6, inertia: &M6) -> R<M6> {
         let mut ix = [[self.zero; 6]; 6];
         for i in 0..6 {
             for j in 0..6 {
@@ -251,7 +259,11 @@ impl<'g> Algebra<'g> {
         for (i, row) in tilde.iter().enumerate() {
             for (j, entry) in row.iter().enumerate() {
                 if let Some((k, sign)) = entry {
-                    let v = if *sign > 0 { mc[*k] } else { self.g.neg(mc[*k])? };
+                    let v = if *sign > 0 {
+                        mc[*k]
+                    } else {
+                        self.g.neg(mc[*k])?
+                    };
                     out[i][j + 3] = v;
                     out[j + 3][i] = v;
                 }

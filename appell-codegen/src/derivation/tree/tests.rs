@@ -66,7 +66,10 @@ fn structured_form_agrees_with_the_closed_form() {
     let s = structured(&mut d.model, &spec, &[]).expect("structured");
     let l = d.full.l;
     assert_eq!(l, 4);
-    let (mass, forcing) = (d.full.equations.mass.clone(), d.full.equations.forcing.clone());
+    let (mass, forcing) = (
+        d.full.equations.mass.clone(),
+        d.full.equations.forcing.clone(),
+    );
     for seed in 1..6 {
         let values = state(&d, seed * 7919);
         let at: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
@@ -74,7 +77,13 @@ fn structured_form_agrees_with_the_closed_form() {
         let value = |e| g.eval_named(e, &at).expect("evaluates");
         let zero_inputs: Vec<(&str, f64)> = at
             .iter()
-            .map(|&(n, v)| if n.starts_with("tau_") { (n, 0.0) } else { (n, v) })
+            .map(|&(n, v)| {
+                if n.starts_with("tau_") {
+                    (n, 0.0)
+                } else {
+                    (n, v)
+                }
+            })
             .collect();
         let value0 = |e| g.eval_named(e, &zero_inputs).expect("evaluates");
         let accel: Vec<f64> = (0..l)
@@ -90,21 +99,45 @@ fn structured_form_agrees_with_the_closed_form() {
             assert!((h + f0).abs() < 1e-11, "bias {i}: {h} vs {}", -f0);
             let ma: f64 = (0..l).map(|j| value(mass[i * l + j]) * accel[j]).sum();
             let tau = value(s.inverse[i]);
-            assert!((tau - (ma - f0)).abs() < 1e-11, "inverse {i}: {tau} vs {}", ma - f0);
+            assert!(
+                (tau - (ma - f0)).abs() < 1e-11,
+                "inverse {i}: {tau} vs {}",
+                ma - f0
+            );
             let my: f64 = (0..l).map(|j| value(mass[i * l + j]) * ydd[j]).sum();
             let f = value(forcing[i]);
-            assert!((my - f).abs() < 1e-10 * (1.0 + f.abs()), "ABA row {i}: {my} vs {f}");
+            assert!(
+                (my - f).abs() < 1e-10 * (1.0 + f.abs()),
+                "ABA row {i}: {my} vs {f}"
+            );
             let grav = value(s.gravity[i]);
             let moving: Vec<(&str, f64)> = zero_inputs
                 .iter()
-                .map(|&(n, v)| if d.model.speed_specs.iter().any(|sp| g.symbol_name(sp.symbol) == n) { (n, 0.0) } else { (n, v) })
+                .map(|&(n, v)| {
+                    if d.model
+                        .speed_specs
+                        .iter()
+                        .any(|sp| g.symbol_name(sp.symbol) == n)
+                    {
+                        (n, 0.0)
+                    } else {
+                        (n, v)
+                    }
+                })
                 .collect();
             let f00 = g.eval_named(forcing[i], &moving).expect("evaluates");
-            assert!((grav + f00).abs() < 1e-11, "gravity {i}: {grav} vs {}", -f00);
+            assert!(
+                (grav + f00).abs() < 1e-11,
+                "gravity {i}: {grav} vs {}",
+                -f00
+            );
         }
     }
 }
 
 fn lookup(at: &[(&str, f64)], name: &str) -> f64 {
-    at.iter().find(|(n, _)| *n == name).map(|(_, v)| *v).expect("bound")
+    at.iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, v)| *v)
+        .expect("bound")
 }
