@@ -1,5 +1,5 @@
-//! The n-link spatial chain, n = 2, 4, 8 or 16 (32 with the cargo feature
-//! `large-models`), chosen with `--n N` (default 4), with the model command
+//! The n-link spatial chain, n = 2, 4, 8, 16 or 32 (64 with the cargo
+//! feature `large-models`), chosen with `--n N` (default 4), with the model command
 //! line: `cargo run --release --example spatial_chain -- --n 8 info`,
 //! `eval`, `bench`. The mechanism is the one of
 //! `examples/robots/spatial_chain/spatial_chain_N.urdf`, written here with
@@ -15,14 +15,14 @@ use std::process::ExitCode;
 
 use appell::Model;
 #[cfg(feature = "large-models")]
-use model::SpatialChain32;
-use model::{SpatialChain16, SpatialChain2, SpatialChain4, SpatialChain8};
+use model::SpatialChain64;
+use model::{SpatialChain16, SpatialChain2, SpatialChain32, SpatialChain4, SpatialChain8};
 
 /// The sizes this build has.
 const SIZES: &[usize] = if cfg!(feature = "large-models") {
-    &[2, 4, 8, 16, 32]
+    &[2, 4, 8, 16, 32, 64]
 } else {
-    &[2, 4, 8, 16]
+    &[2, 4, 8, 16, 32]
 };
 
 fn main() -> ExitCode {
@@ -32,7 +32,7 @@ fn main() -> ExitCode {
         match args.get(i + 1).and_then(|s| s.parse().ok()) {
             Some(v) if SIZES.contains(&v) => n = v,
             _ => {
-                eprintln!("--n takes one of {SIZES:?} (32 needs `--features large-models`)");
+                eprintln!("--n takes one of {SIZES:?} (64 needs `--features large-models`)");
                 return ExitCode::from(2);
             }
         }
@@ -42,8 +42,9 @@ fn main() -> ExitCode {
         2 => run(SpatialChain2, &args),
         8 => run(SpatialChain8, &args),
         16 => run(SpatialChain16, &args),
-        #[cfg(feature = "large-models")]
         32 => run(SpatialChain32, &args),
+        #[cfg(feature = "large-models")]
+        64 => run(SpatialChain64, &args),
         _ => run(SpatialChain4, &args),
     }
 }

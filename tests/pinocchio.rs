@@ -264,6 +264,7 @@ fn the_spatial_chains_written_with_joints_agree_with_pinocchio() {
     assert_agrees(&SpatialChain4, "spatial_chain_4");
     assert_agrees(&SpatialChain8, "spatial_chain_8");
     assert_agrees(&SpatialChain16, "spatial_chain_16");
+    assert_agrees(&SpatialChain32, "spatial_chain_32");
 }
 
 /// The largest relative difference between the rhs and the multiplier

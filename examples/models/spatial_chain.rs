@@ -1,5 +1,5 @@
-//! The n-link spatial chain for n = 2, 4, 8, 16 (32 with the cargo feature
-//! `large-models`): revolute joints `j_1` ... `j_n` about z for odd k and y
+//! The n-link spatial chain for n = 2, 4, 8, 16, 32 (64 with the cargo
+//! feature `large-models`): revolute joints `j_1` ... `j_n` about z for odd k and y
 //! for even k, each link's mass centre off its axis and its inertia matrix
 //! full. The same mechanism as `examples/robots/spatial_chain/*.urdf`
 //! (written by `make_urdf.py`), here written with `joint(...)` and
@@ -64,8 +64,7 @@ pub struct SpatialChain8;
 #[appell(gravity(-9.81 * N.z))]
 pub struct SpatialChain16;
 
-/// Thirty-two links: behind the feature `large-models` (its expansion and compilation take minutes and gigabytes).
-#[cfg(feature = "large-models")]
+/// Thirty-two links (the structured form only: see `info().form`).
 #[derive(Appell, Clone, Debug, Default, PartialEq)]
 #[appell(joint(j[1], revolute(z), parent = N, child = link[1], actuated))]
 #[appell(repeat(k in 2..=32,
@@ -76,3 +75,17 @@ pub struct SpatialChain16;
     inertia = matrix(0.02 + 0.001 * k, 0.03 + 0.001 * k, 0.01 + 0.001 * k, 0.001, 0.0015, -0.002))))]
 #[appell(gravity(-9.81 * N.z))]
 pub struct SpatialChain32;
+
+/// Sixty-four links: behind the feature `large-models` (a release build
+/// of its expansion takes about a minute).
+#[cfg(feature = "large-models")]
+#[derive(Appell, Clone, Debug, Default, PartialEq)]
+#[appell(joint(j[1], revolute(z), parent = N, child = link[1], actuated))]
+#[appell(repeat(k in 2..=64,
+    repeat(even in 0..1 - k % 2, joint(j[k], revolute(y), parent = link[k - 1], child = link[k], xyz = [0, 0, 0.5], actuated)),
+    repeat(odd in 0..k % 2, joint(j[k], revolute(z), parent = link[k - 1], child = link[k], xyz = [0, 0, 0.5], actuated))))]
+#[appell(repeat(k in 1..=64, body(link[k], frame = link[k], mass = 1 + 0.1 * k,
+    center = origin(link[k]) + 0.05 * link[k].x + 0.02 * link[k].y + 0.25 * link[k].z,
+    inertia = matrix(0.02 + 0.001 * k, 0.03 + 0.001 * k, 0.01 + 0.001 * k, 0.001, 0.0015, -0.002))))]
+#[appell(gravity(-9.81 * N.z))]
+pub struct SpatialChain64;

@@ -15,6 +15,11 @@
 //! | 10. loads; M and f final | [`loads`] | folded → [`Equations`] |
 //! | 11. energies | [`energies`] | partials → [`Energies`] |
 //! | 12. reduced state, cyclic coordinates (eq. 42) | [`reduction`] | equations → [`Reduction`] |
+//! | 13. structured form of a tree of joints (ABA, RNEA, CRBA) | [`tree`] | `TreeSpec` → [`tree::Structured`] |
+//!
+//! A tree of [`tree::STRUCTURED_ONLY_LINKS`] moving links or more skips
+//! stages 6 to 11: its M, f and energies come from the structured form
+//! ([`tree::equations`]), whose cost grows linearly with the links.
 //!
 //! Between stages 11 and 12, X's identically zero last column (kept so far
 //! because its rate carries w) is set to zero everywhere
@@ -155,6 +160,9 @@ pub struct Derivation {
     pub folded: Vec<String>,
     /// Readable equations.
     pub text: String,
+    /// Whether M and f are Appell's closed form (false: a large tree's,
+    /// from the structured form; see [`tree::STRUCTURED_ONLY_LINKS`]).
+    pub closed_form: bool,
     /// The structured form (a plain tree of joints), or why there is none.
     pub structured: Result<tree::Structured, String>,
 }
@@ -256,6 +264,7 @@ struct Stages {
     energies: Energies,
     reduction: Reduction,
     unreduced: Unreduced,
+    closed_form: bool,
     folded: Vec<String>,
 }
 
@@ -275,6 +284,7 @@ impl Stages {
             reduction: self.reduction,
             unreduced: self.unreduced,
             folded: self.folded,
+            closed_form: self.closed_form,
             text: String::new(),
             structured: Err(String::new()),
         };
@@ -316,33 +326,28 @@ fn stages(
         )?),
         None => Elimination::Symbolic,
     };
-    let partials = partials::partial_velocities(model, &map, &calculus.rules, &rates.fixed)?;
-    let mut remainders = remainders::remainders(
-        model,
-        &speeds.dependent,
-        &map,
-        &partials,
-        &mut rates,
-        &mut calculus,
-    )?;
-    let folded = assemble_and_fold(
-        model,
-        &partials,
-        &mut remainders,
-        &map,
-        &mut rates,
-        &mut calculus,
-        options,
-    )?;
-    let mut equations = loads::equations(
-        model,
-        folded.assembled,
-        &folded.composites,
-        &partials,
-        &map,
-        &calculus.rules,
-    )?;
-    let mut energies = energies::energies(model, &partials, &map)?;
+    let large_tree = model.tree.as_ref().ok().filter(|spec| {
+        !options.closed_form_only
+            && matches!(elimination, Elimination::Symbolic)
+            && tree::moving_links(spec) >= tree::STRUCTURED_ONLY_LINKS
+    });
+    let (mut equations, mut energies, folded_lines) = match large_tree.cloned() {
+        Some(spec) => {
+            let s = tree::structured(model, &spec, &[])?;
+            let (equations, energies) = tree::equations::equations(model, &spec, &s)?;
+            (equations, energies, None)
+        }
+        None => {
+            let parts = ClosedForm {
+                speeds: &speeds,
+                map: &map,
+                rates: &mut rates,
+                calculus: &mut calculus,
+            };
+            let (equations, energies, lines) = closed_form(model, parts, options)?;
+            (equations, energies, Some(lines))
+        }
+    };
     numeric::drop_vanishing(
         &mut model.g,
         &solved.vanishing,
@@ -378,8 +383,54 @@ fn stages(
         energies,
         reduction,
         unreduced,
-        folded: folded.lines,
+        closed_form: folded_lines.is_some(),
+        folded: folded_lines.unwrap_or_default(),
     }))
+}
+
+/// What stages 6 to 11 of the closed form read and update.
+struct ClosedForm<'a> {
+    speeds: &'a SpeedDefinitions,
+    map: &'a SpeedMap,
+    rates: &'a mut Rates,
+    calculus: &'a mut Calculus,
+}
+
+/// Stages 6 to 11: partial velocities, remainders, M and f, energies;
+/// with the folded bodies' lines.
+fn closed_form(
+    model: &mut Model,
+    parts: ClosedForm<'_>,
+    options: &Options,
+) -> Result<(Equations, Energies, Vec<String>), SymbolicError> {
+    let ClosedForm {
+        speeds,
+        map,
+        rates,
+        calculus,
+    } = parts;
+    let partials = partials::partial_velocities(model, map, &calculus.rules, &rates.fixed)?;
+    let mut remainders =
+        remainders::remainders(model, &speeds.dependent, map, &partials, rates, calculus)?;
+    let folded = assemble_and_fold(
+        model,
+        &partials,
+        &mut remainders,
+        map,
+        rates,
+        calculus,
+        options,
+    )?;
+    let equations = loads::equations(
+        model,
+        folded.assembled,
+        &folded.composites,
+        &partials,
+        map,
+        &calculus.rules,
+    )?;
+    let energies = energies::energies(model, &partials, map)?;
+    Ok((equations, energies, folded.lines))
 }
 
 /// Stages 8 and 9: M and f's inertial terms, folded where that is

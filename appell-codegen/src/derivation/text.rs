@@ -13,6 +13,22 @@ use crate::model::Model;
 /// chain's mass matrix entries reach megabytes otherwise).
 const MAX_TEXT: usize = 8192;
 
+/// The nodes `e` has written out as a tree, its shared parts counted each
+/// time they occur, up to `cap`: a few hundred shared nodes (a recursion's)
+/// can write out as millions.
+fn written_size(g: &appell_symbolic::Graph, e: Id, cap: usize) -> usize {
+    // Children are made before their parents: ascending ids visit them first.
+    let nodes = g.reachable(&[e]);
+    let mut size = std::collections::HashMap::with_capacity(nodes.len());
+    for id in nodes {
+        let below = g.node(id).children().iter().fold(1usize, |s, c| {
+            s.saturating_add(size.get(c).copied().unwrap_or(cap))
+        });
+        size.insert(id, below.min(cap));
+    }
+    size.get(&e).copied().unwrap_or(cap)
+}
+
 /// The readable form of the derived equations.
 pub fn equations_text(model: &Model, d: &Derivation) -> String {
     let g = &model.g;
@@ -22,7 +38,8 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
     // MAX_TEXT characters is named by its size too.
     let show = |e: Id| -> String {
         let nodes = g.dag_size(&[e]);
-        let text = (nodes <= 400).then(|| g.display(e).to_string());
+        let small = nodes <= 400 && written_size(g, e, MAX_TEXT) < MAX_TEXT;
+        let text = small.then(|| g.display(e).to_string());
         match text {
             Some(text) if text.len() <= MAX_TEXT => text,
             Some(text) => format!(

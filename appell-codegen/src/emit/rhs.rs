@@ -67,6 +67,16 @@ impl Emitter<'_> {
     /// operations and names the form): the structured form where the model
     /// has one and it costs fewer operations per call, else the closed form.
     pub(super) fn rhs(&self, common: &super::functions::Common) -> RhsParts {
+        if let (false, Ok(s)) = (self.d.closed_form, &self.d.structured) {
+            let chosen = self.structured_rhs(common, &s.accelerations);
+            let form = format!(
+                "structured: the articulated-body algorithm over the joint tree, {} operations per call (the closed form is not derived for trees of {} moving links or more)",
+                chosen.ops.total(),
+                crate::derivation::tree::STRUCTURED_ONLY_LINKS
+            );
+            let info = self.info(chosen.ops, chosen.extra, &form);
+            return RhsParts { info, ..chosen };
+        }
         let flat = self.flat_rhs(common);
         let flat_total = flat.ops.total() + flat.extra;
         let (chosen, form) = match &self.d.structured {

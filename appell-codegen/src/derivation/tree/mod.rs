@@ -10,6 +10,7 @@
 //!
 //! Input: the model's [`TreeSpec`]; output: [`Structured`].
 
+pub mod equations;
 mod links;
 mod recursions;
 pub mod spatial;
@@ -40,6 +41,29 @@ pub struct Structured {
 
 /// The structured equations of `model`'s tree; `fixed` lists the
 /// coordinates (indices) the accelerations take at zero.
+///
+/// ```
+/// use appell_codegen::{ctxt::Ctxt, derivation::{self, tree}, model, parse};
+///
+/// // A pendulum as a one-joint tree: a point mass m at distance l.
+/// let input: syn::DeriveInput = syn::parse_str(r#"
+///     #[appell(joint(j, revolute(y), parent = N, child = A, actuated))]
+///     #[appell(point(P = origin(A) + l * A.x), particle(P, mass = m))]
+///     #[appell(gravity(-g * N.z))]
+///     struct Pendulum { m: f64, l: f64, g: f64 }
+/// "#).unwrap();
+/// let cx = Ctxt::new();
+/// let ast = parse::parse(&cx, &input);
+/// let kinematics = model::build(&cx, &ast).unwrap();
+/// let mut derived = derivation::derive(&cx, kinematics).unwrap();
+/// cx.check().unwrap();
+/// let spec = derived.model.tree.clone().unwrap();
+/// let s = tree::structured(&mut derived.model, &spec, &[]).unwrap();
+/// // M = m l² by the composite-rigid-body algorithm.
+/// let at = [("m", 2.0), ("l", 0.5), ("g", 9.81), ("j", 0.3)];
+/// let m = derived.model.g.eval_named(s.mass[0], &at).unwrap();
+/// assert!((m - 2.0 * 0.25).abs() < 1e-12);
+/// ```
 pub fn structured(
     model: &mut Model,
     spec: &TreeSpec,
@@ -63,6 +87,17 @@ pub fn structured(
         bias,
         gravity: gravity_term,
     })
+}
+
+/// Moving links from which the closed form is not derived at all: its
+/// cost grows like n³ (measured on the spatial chains: 4,505 operations
+/// per rhs call at 8 links, 23,795 at 16, against the structured form's
+/// 2,772 and 6,637), and so do its expansion time and emitted size.
+pub const STRUCTURED_ONLY_LINKS: usize = 12;
+
+/// The number of moving links of `spec`.
+pub fn moving_links(spec: &TreeSpec) -> usize {
+    spec.links.iter().filter(|k| k.motion.is_some()).count()
 }
 
 #[cfg(test)]
