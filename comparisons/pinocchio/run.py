@@ -1,0 +1,519 @@
+#!/usr/bin/env python3
+"""Builds the drivers and times appell's generated dynamics against
+Pinocchio's (and MuJoCo's mj_forward) on the same random states, then prints
+markdown tables. See README.md beside this script.
+
+    ./setup.sh        # once: .venv with pin, example-robot-data, mujoco, ...
+    ./run.py          # build everything, check, time, print the tables
+
+Steps:
+1. `make -j1` (the C++ and C drivers) and `cargo build --release` of rust/,
+   once for the default x86-64 target and once with -C target-cpu=native,
+   into $CARGO_TARGET_DIR/{generic,native} (default build/target/...),
+   with CARGO_BUILD_JOBS=1 unless it is set.
+2. URDFs of the chains without one in examples/robots (n = 24, 48, 64; appell
+   times 64 too when the Rust driver is built with --features large-models,
+   run.py's default) are written into build/urdf/ with make_urdf.py's
+   chain_urdf; MuJoCo's
+   copies (no <visual>/<collision>, the Panda's fingers fixed) go to
+   build/mujoco/.
+3. Correctness: both Pinocchio builds evaluate the states of
+   tests/reference/pinocchio/*.json (computed by Pinocchio's Python
+   bindings) and must agree with them to 1e-9 relative.
+4. Timing: ROUNDS rounds; in each, every model is timed by every
+   implementation, one process each, TRIES times over (the order of the
+   implementations reversed from one round to the next). Each process
+   times each function over BATCH states REPS times and reports the median
+   per-call time; of a round's TRIES processes the fastest median is kept
+   (the shared machine switches between a fast and a slow state from one
+   process to the next).
+5. Tables: for each model and function, the median over the rounds of the
+   kept medians, and in parentheses their range (min-max over the rounds);
+   ratios are taken within each round, then the median (range).
+   Checksums of paired functions (appell's rhs and Pinocchio's ABA and
+   MuJoCo's qacc; M and f against CRBA and NLE) are compared too.
+
+Raw JSON lines go to build/results.jsonl, the tables to build/results.md.
+"""
+import argparse
+import importlib.util
+import json
+import os
+import platform
+import statistics
+import subprocess
+import sys
+import time
+import xml.etree.ElementTree as ET
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.normpath(os.path.join(HERE, "..", ".."))
+BUILD = os.path.join(HERE, "build")
+VENV_PYTHON = os.path.join(HERE, ".venv", "bin", "python")
+ROBOTS = os.path.join(ROOT, "examples", "robots")
+REFERENCE = os.path.join(ROOT, "tests", "reference", "pinocchio")
+
+PANDA_WELD = ["panda_finger_joint1", "panda_finger_joint2"]
+
+# (name, URDF, joints welded at 0, timed by appell too). Whether appell
+# times a model is finally decided by the Rust build's `appell_bench list`
+# (spatial_chain_64 needs --features large-models, which run.py passes).
+MODELS = [
+    ("ur5", os.path.join(ROBOTS, "ur5", "ur5_robot.urdf"), [], True),
+    ("panda", os.path.join(ROBOTS, "panda", "panda.urdf"), PANDA_WELD, True),
+] + [
+    (f"spatial_chain_{n}", os.path.join(ROBOTS, "spatial_chain", f"spatial_chain_{n}.urdf"), [], True)
+    for n in (2, 4, 8, 16, 32)
+]
+# Chains without a URDF in examples/robots, written into build/urdf by
+# make_urdf.py's chain_urdf; (n, timed by appell too).
+LARGE_CHAINS = ((24, False), (48, False), (64, True))
+
+# appell function -> the Pinocchio function computing the same thing. A
+# function the Rust driver gains (rust/src/main.rs) is paired here.
+PAIRS = [
+    ("rhs", "aba"),
+    ("mass_matrix_and_forcing", "crba_nle"),
+    ("inverse_dynamics", "rnea"),
+    ("mass_matrix", "crba_sym"),
+    ("gravity", "gravity"),
+]
+# Pinocchio functions shown in the second table, in order.
+PINOCCHIO_FUNCTIONS = ["aba", "rnea", "crba", "crba_sym", "nle", "gravity", "crba_nle"]
+
+
+def appell_revision():
+    """The commit the Rust driver was built from, and whether the tree had
+    changes outside this directory (read-only git queries); outside a git
+    checkout (a `git archive` snapshot), $APPELL_REVISION."""
+    try:
+        head = subprocess.run(["git", "rev-parse", "--short", "HEAD"], cwd=ROOT,
+                              capture_output=True, text=True, check=True).stdout.strip()
+        status = subprocess.run(["git", "status", "--porcelain", "--", ".", ":!comparisons/pinocchio"],
+                                cwd=ROOT, capture_output=True, text=True, check=True).stdout
+        return head + (" with uncommitted changes" if status.strip() else "")
+    except (OSError, subprocess.CalledProcessError):
+        return os.environ.get("APPELL_REVISION", "unknown (not a git checkout; set APPELL_REVISION)")
+
+
+def cpu_name():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return platform.processor() or platform.machine()
+
+
+def log(msg):
+    print(msg, file=sys.stderr, flush=True)
+
+
+def run(cmd, **kw):
+    log("+ " + " ".join(cmd))
+    subprocess.run(cmd, check=True, **kw)
+
+
+# --------------------------------------------------------------- building
+
+
+def build_cxx():
+    run(["make", "-j1", f"PYTHON={VENV_PYTHON}"], cwd=HERE)
+
+
+def rust_target_dir(variant):
+    base = os.environ.get("CARGO_TARGET_DIR") or os.path.join(BUILD, "target")
+    return os.path.join(base, variant)
+
+
+def build_rust(variant, features):
+    env = dict(os.environ)
+    env.setdefault("CARGO_BUILD_JOBS", "1")
+    env["CARGO_TARGET_DIR"] = rust_target_dir(variant)
+    flags = env.get("RUSTFLAGS", "")
+    if variant == "native":
+        flags = (flags + " -C target-cpu=native").strip()
+    env["RUSTFLAGS"] = flags
+    manifest = os.path.join(HERE, "rust", "Cargo.toml")
+    start = time.time()
+    cmd = ["cargo", "build", "--release", "--manifest-path", manifest]
+    if features:
+        cmd += ["--features", features]
+    run(cmd, env=env)
+    log(f"  rust ({variant}) built in {time.time() - start:.0f} s")
+    return os.path.join(env["CARGO_TARGET_DIR"], "release", "appell_bench")
+
+
+def write_chain_urdfs():
+    """The larger chains, by make_urdf.py's own writer, into build/urdf."""
+    spec = importlib.util.spec_from_file_location(
+        "make_urdf", os.path.join(ROBOTS, "spatial_chain", "make_urdf.py")
+    )
+    make_urdf = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(make_urdf)
+    out = os.path.join(BUILD, "urdf")
+    os.makedirs(out, exist_ok=True)
+    paths = []
+    for n, with_appell in LARGE_CHAINS:
+        path = os.path.join(out, f"spatial_chain_{n}.urdf")
+        with open(path, "w", newline="\n") as f:
+            f.write(make_urdf.chain_urdf(n))
+        paths.append((f"spatial_chain_{n}", path, [], with_appell))
+    return paths
+
+
+def mujoco_urdf(name, urdf, weld):
+    """A copy MuJoCo can load: no meshes, welded joints fixed, no mimic."""
+    tree = ET.parse(urdf)
+    robot = tree.getroot()
+    for link in robot.findall("link"):
+        for tag in ("visual", "collision"):
+            for e in link.findall(tag):
+                link.remove(e)
+    for joint in robot.findall("joint"):
+        if joint.get("name") in weld:
+            joint.set("type", "fixed")
+            for tag in ("mimic", "limit", "axis", "dynamics"):
+                for e in joint.findall(tag):
+                    joint.remove(e)
+    out = os.path.join(BUILD, "mujoco")
+    os.makedirs(out, exist_ok=True)
+    path = os.path.join(out, f"{name}.urdf")
+    tree.write(path)
+    return path
+
+
+# ------------------------------------------------------------- correctness
+
+
+def check_against_reference(binary):
+    """Largest relative difference of `binary --check` from the reference
+    files, over every quantity and robot."""
+    worst = 0.0
+    for name, urdf, weld, _ in MODELS:
+        with open(os.path.join(REFERENCE, f"{name}.json")) as f:
+            ref = json.load(f)
+        lines = []
+        for s in ref["states"]:
+            lines.append(" ".join(repr(x) for x in s["q"] + s["v"] + s["tau"] + s["a"]))
+        cmd = [binary, urdf, "--check"] + (["--weld", ",".join(weld)] if weld else [])
+        out = subprocess.run(cmd, input="\n".join(lines) + "\n", capture_output=True, text=True, check=True)
+        got = [json.loads(line) for line in out.stdout.splitlines()]
+        assert len(got) == len(ref["states"]), (name, len(got))
+        for s, g in zip(ref["states"], got):
+            for key in ("ddq", "rnea", "mass_matrix", "nle", "gravity_torque"):
+                want = s[key]
+                if key == "mass_matrix":
+                    want = [x for row in want for x in row]
+                scale = 1.0 + max(abs(x) for x in want)
+                diff = max(abs(a - b) for a, b in zip(g[key], want)) / scale
+                worst = max(worst, diff)
+    return worst
+
+
+# ----------------------------------------------------------------- timing
+
+
+def run_driver(cmd):
+    out = subprocess.run(cmd, capture_output=True, text=True)
+    if out.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{out.stderr}")
+    return [json.loads(line) for line in out.stdout.splitlines() if line.strip()]
+
+
+def fmt_ns(x):
+    """Nanoseconds to 3 significant digits, with thousands separators."""
+    digits = max(0, 2 - len(str(int(x))) + 1) if x < 100 else 0
+    return f"{round(x, digits) if digits else int(float(f'{x:.3g}')):,}"
+
+
+def fmt_range(values, unit=None):
+    unit = unit or fmt_ns
+    if not values:
+        return "–"
+    med = statistics.median(values)
+    lo, hi = min(values), max(values)
+    return f"{unit(med)} ({unit(lo)}–{unit(hi)})"
+
+
+def fmt_ratio(x):
+    return f"{x:.2f}"
+
+
+def measure(args):
+    """Builds, checks and times; writes every driver line to
+    build/results.jsonl after one line of metadata; returns its path."""
+    if not os.path.exists(VENV_PYTHON):
+        sys.exit("no .venv here: run ./setup.sh first")
+    os.makedirs(BUILD, exist_ok=True)
+    started = time.time()
+    variants = [v for v in args.rust.split(",") if v]
+
+    pin_bin = os.path.join(BUILD, "pinocchio_bench")
+    pin_lib_bin = os.path.join(BUILD, "pinocchio_bench_lib")
+    mj_bin = os.path.join(BUILD, "mujoco_bench")
+    rust_bins = {}
+    if args.no_build:
+        for v in variants:
+            rust_bins[v] = os.path.join(rust_target_dir(v), "release", "appell_bench")
+    else:
+        t0 = time.time()
+        build_cxx()
+        log(f"  C++ drivers built in {time.time() - t0:.0f} s")
+        for v in variants:
+            rust_bins[v] = build_rust(v, args.features)
+
+    models = MODELS + ([] if args.no_large else write_chain_urdfs())
+    # The robots, then the chains by size.
+    models.sort(key=lambda m: (m[0].startswith("spatial_chain_"), int(m[0].rsplit("_", 1)[1]) if m[0].startswith("spatial_chain_") else 0))
+    if args.models:
+        keep = set(args.models.split(","))
+        models = [m for m in models if m[0] in keep]
+    # The models each Rust build has (spatial_chain_64 only with the
+    # large-models feature).
+    rust_models = {}
+    for v in variants:
+        listed = subprocess.run([rust_bins[v], "list"], capture_output=True, text=True, check=True).stdout.split()
+        rust_models[v] = set(listed)
+        missing = [name for name, _, _, with_appell in models if with_appell and name not in listed]
+        if missing:
+            log(f"  appell_{v} lacks {', '.join(missing)} (build it with --features large-models)")
+    models = [(name, urdf, weld, with_appell and any(name in rust_models[v] for v in variants))
+              for name, urdf, weld, with_appell in models]
+
+    # Correctness of the C++ builds against the Python bindings' data.
+    checks = {}
+    for label, binary in (("header-only", pin_bin), ("library", pin_lib_bin)):
+        checks[label] = check_against_reference(binary)
+        log(f"  pinocchio_bench ({label}) against tests/reference/pinocchio: max rel. diff {checks[label]:.1e}")
+        assert checks[label] < 1e-9, checks[label]
+
+    common = ["--batch", str(args.batch), "--reps", str(args.reps), "--seed", str(args.seed)]
+    # Joint order: Pinocchio's, from one untimed call.
+    joints = {}
+    for name, urdf, weld, _ in models:
+        wl = ["--weld", ",".join(weld)] if weld else []
+        head = run_driver([pin_bin, urdf, "--name", name, "--batch", "1", "--reps", "1", "--only", "gravity"] + wl)[0]
+        joints[name] = head["joints"]
+    mj_urdf = {} if args.no_mujoco else {name: mujoco_urdf(name, urdf, weld) for name, urdf, weld, _ in models}
+
+    path = os.path.join(BUILD, "results.jsonl")
+    raw = open(path, "w")
+    meta = {
+        "date": time.strftime("%Y-%m-%d %H:%M"),
+        "cpu": cpu_name(),
+        "cores": os.cpu_count(),
+        "revision": appell_revision(),
+        "rounds": args.rounds,
+        "tries": args.tries,
+        "reps": args.reps,
+        "batch": args.batch,
+        "seed": args.seed,
+        "rust": variants,
+        "rust_features": args.features,
+        "models": [[name, with_appell] for name, _, _, with_appell in models],
+        "checks": checks,
+    }
+    raw.write(json.dumps({"meta": meta}) + "\n")
+    for r in range(args.rounds):
+        log(f"round {r + 1}/{args.rounds}")
+        for name, urdf, weld, with_appell in models:
+            wl = ["--weld", ",".join(weld)] if weld else []
+            jl = ["--joints", ",".join(joints[name])]
+            jobs = [
+                ("pinocchio", [pin_bin, urdf, "--name", name] + wl + common),
+                ("pinocchio_lib", [pin_lib_bin, urdf, "--name", name] + wl + common),
+            ]
+            if with_appell:
+                for v in [v for v in variants if name in rust_models[v]]:
+                    jobs.append((f"appell_{v}", [rust_bins[v], name] + jl + common))
+            if not args.no_mujoco:
+                jobs.append(("mujoco", [mj_bin, mj_urdf[name], "--name", name] + jl + common))
+            if r % 2:
+                jobs.reverse()
+            for t in range(args.tries):
+                for key, cmd in jobs:
+                    for line in run_driver(cmd):
+                        line["round"], line["try"], line["impl_key"] = r, t, key
+                        raw.write(json.dumps(line) + "\n")
+            raw.flush()
+    elapsed = time.time() - started
+    raw.write(json.dumps({"meta_end": {"seconds": round(elapsed)}}) + "\n")
+    raw.close()
+    return path
+
+
+def report(path):
+    """The markdown tables of a results.jsonl file."""
+    meta, timed, heads, seconds = None, [], [], None
+    with open(path) as f:
+        for text in f:
+            line = json.loads(text)
+            if "meta" in line:
+                meta = line["meta"]
+            elif "meta_end" in line:
+                seconds = line["meta_end"]["seconds"]
+            elif "fn" in line:
+                timed.append(line)
+            else:
+                heads.append(line)
+    variants = meta["rust"]
+    appell_keys = [f"appell_{v}" for v in variants]
+    models = meta["models"]
+    small = [name for name, with_appell in models if with_appell]
+    has_mujoco = any(x["impl_key"] == "mujoco" for x in timed)
+
+    # Of each round's tries, the fastest median.
+    best = {}
+    for x in timed:
+        k = (x["impl_key"], x["model"], x["fn"], x["round"])
+        if k not in best or x["median_ns"] < best[k]["median_ns"]:
+            best[k] = x
+
+    def per_round(key, model, fn):
+        return {r: x["median_ns"] for (k, m, f, r), x in best.items() if (k, m, f) == (key, model, fn)}
+
+    def medians(key, model, fn):
+        return list(per_round(key, model, fn).values())
+
+    def ratios(key_a, fn_a, key_b, fn_b, model):
+        a, b = per_round(key_a, model, fn_a), per_round(key_b, model, fn_b)
+        return [a[r] / b[r] for r in a if r in b]
+
+    def checksum(key, model, fn):
+        for x in timed:
+            if (x["impl_key"], x["model"], x["fn"]) == (key, model, fn):
+                return x["checksum"]
+        return None
+
+    def head(key, model=None):
+        for x in heads:
+            if x["impl_key"] == key and (model is None or x["model"] == model):
+                return x
+        return {}
+
+    def table(cols, rows):
+        lines = ["| " + " | ".join(cols) + " |", "| " + " | ".join(["---"] + ["---:"] * (len(cols) - 1)) + " |"]
+        lines += ["| " + " | ".join(row) + " |" for row in rows]
+        return lines + [""]
+
+    out = [
+        f"Pinocchio {head('pinocchio').get('version', '?')}; {meta['date']}; {meta['cpu']}, {meta['cores']} cores; "
+        f"appell at commit {meta['revision']}. {meta['rounds']} rounds; in each, {meta['tries']} processes per "
+        f"implementation and model, each timing {meta['reps']} passes over {meta['batch']} states and reporting its "
+        f"median pass, the faster of the {meta['tries']} kept. Cells: median over the rounds (min–max over the "
+        f"rounds), ns per call; ratios taken within each round.",
+        "",
+    ]
+
+    # Table 1: forward dynamics.
+    cols = ["model", "dof", "appell rhs ops"] + [f"appell rhs ({v}), ns" for v in variants]
+    cols += ["Pinocchio ABA, ns"] + [f"ABA / appell ({v})" for v in variants]
+    cols += ["Pinocchio ABA (library), ns"] + (["MuJoCo mj_forward, ns"] if has_mujoco else [])
+    rows = []
+    for name in small:
+        h = head(appell_keys[0], name) if appell_keys else {}
+        row = [name, str(h.get("nv", head("pinocchio", name).get("nv", "?"))), f"{h.get('rhs_ops', 0):,}"]
+        row += [fmt_range(medians(k, name, "rhs")) for k in appell_keys]
+        row += [fmt_range(medians("pinocchio", name, "aba"))]
+        row += [fmt_range(ratios("pinocchio", "aba", k, "rhs", name), fmt_ratio) for k in appell_keys]
+        row += [fmt_range(medians("pinocchio_lib", name, "aba"))]
+        if has_mujoco:
+            row += [fmt_range(medians("mujoco", name, "mj_forward"))]
+        rows.append(row)
+    out += table(cols, rows)
+
+    # Table 2: the other appell functions against their counterparts.
+    for fa, fp in PAIRS[1:]:
+        if not appell_keys or not any(medians(appell_keys[0], m, fa) for m in small):
+            continue  # a function the Rust driver does not time (yet)
+        cols = ["model"] + [f"appell {fa} ({v}), ns" for v in variants] + [f"Pinocchio {fp}, ns"]
+        cols += [f"{fp} / appell ({v})" for v in variants]
+        rows = []
+        for name in small:
+            row = [name] + [fmt_range(medians(k, name, fa)) for k in appell_keys]
+            row += [fmt_range(medians("pinocchio", name, fp))]
+            row += [fmt_range(ratios("pinocchio", fp, k, fa, name), fmt_ratio) for k in appell_keys]
+            rows.append(row)
+        out += table(cols, rows)
+
+    # Table 3: every Pinocchio function, every model.
+    cols = ["model", "dof"] + [f"{f}, ns" for f in PINOCCHIO_FUNCTIONS]
+    cols += ["MuJoCo mj_forward, ns"] if has_mujoco else []
+    rows = []
+    for name, _ in models:
+        row = [name, str(head("pinocchio", name).get("nv", "?"))]
+        row += [fmt_range(medians("pinocchio", name, f)) for f in PINOCCHIO_FUNCTIONS]
+        if has_mujoco:
+            row += [fmt_range(medians("mujoco", name, "mj_forward"))]
+        rows.append(row)
+    out += table(cols, rows)
+
+    # Table 4: the library build beside the header-only one.
+    fns = ("aba", "rnea", "crba", "gravity")
+    cols = ["model"] + [f"{f}: header-only / library, ns" for f in fns]
+    rows = []
+    for name, _ in models:
+        row = [name]
+        for f in fns:
+            a, b = medians("pinocchio", name, f), medians("pinocchio_lib", name, f)
+            row.append(f"{fmt_ns(statistics.median(a))} / {fmt_ns(statistics.median(b))}" if a and b else "–")
+        rows.append(row)
+    out += table(cols, rows)
+
+    # Agreement of the checksums (sum of all outputs over the batch).
+    out += ["Checksums (sum of every output over the batch), largest relative difference from Pinocchio's "
+            "over the models:", ""]
+    worst = {}
+    pairs = [(k, fa, fp) for k in appell_keys for fa, fp in PAIRS]
+    pairs += [("mujoco", "mj_forward", "aba"), ("pinocchio_lib", "aba", "aba"), ("pinocchio_lib", "crba_nle", "crba_nle")]
+    for name, _ in models:
+        for k, fa, fp in pairs:
+            a, b = checksum(k, name, fa), checksum("pinocchio", name, fp)
+            if a is not None and b is not None:
+                label = f"{k} {fa} vs {fp}"
+                worst[label] = max(worst.get(label, 0.0), abs(a - b) / max(abs(b), 1.0))
+    out += [f"- {label}: {d:.1e}" for label, d in worst.items()] + [""]
+    out.append(
+        "pinocchio_bench against tests/reference/pinocchio (Python bindings' values): "
+        + ", ".join(f"{k} {v:.1e}" for k, v in meta["checks"].items())
+        + "."
+    )
+    mj = head("mujoco")
+    if mj:
+        out.append(f"MuJoCo {mj.get('version', '?')}.")
+    if seconds is not None:
+        out.append(f"Run time (build, check and timing): {seconds} s.")
+    return "\n".join(out) + "\n"
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--rounds", type=int, default=5)
+    ap.add_argument("--reps", type=int, default=21, help="timed passes per process")
+    ap.add_argument("--batch", type=int, default=1000, help="states per pass")
+    ap.add_argument("--seed", type=int, default=20240917)
+    ap.add_argument("--tries", type=int, default=2,
+                    help="processes per implementation, model and round; each function keeps its fastest median")
+    ap.add_argument("--rust", default="native,generic", help="Rust builds to time: native, generic or both")
+    ap.add_argument("--features", default="large-models",
+                    help="cargo features of the Rust driver (large-models: the 64-link chain; '' for none)")
+    ap.add_argument("--no-build", action="store_true", help="use the binaries already built")
+    ap.add_argument("--no-mujoco", action="store_true")
+    ap.add_argument("--no-large", action="store_true", help="skip the chains n = 24, 48, 64 (written into build/urdf)")
+    ap.add_argument("--models", default=None, help="comma-separated subset of the models")
+    ap.add_argument("--report", metavar="RESULTS_JSONL", default=None,
+                    help="only print the tables of an earlier run's build/results.jsonl")
+    args = ap.parse_args()
+    path = args.report or measure(args)
+    text = report(path)
+    if not args.report:
+        with open(os.path.join(BUILD, "results.md"), "w") as f:
+            f.write(text)
+    print(text)
+
+
+if __name__ == "__main__":
+    main()
