@@ -333,7 +333,7 @@ fn stages(
     });
     let (mut equations, mut energies, folded_lines) = match large_tree.cloned() {
         Some(spec) => {
-            let s = tree::structured(model, &spec, &[])?;
+            let s = tree::controller(model, &spec)?;
             let (equations, energies) = tree::equations::equations(model, &spec, &s)?;
             (equations, energies, None)
         }

@@ -103,7 +103,7 @@ pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> 
             // A weld: the link is part of `moving`.
             if let Some(m) = moving {
                 let moved = a.congruence(&joint_frame, &inertia)?;
-                out[m].inertia = add6(&mut a, &out[m].inertia, &moved)?;
+                out[m].inertia = a.add6(&out[m].inertia, &moved)?;
             }
             places.push(Place {
                 moving,
@@ -327,7 +327,7 @@ fn link_inertia(a: &mut Algebra, bodies: &[crate::model::tree::MassSpec]) -> R<M
             None => [[a.zero(); 3]; 3],
         };
         let body = a.rigid_inertia(m, c, &central)?;
-        total = add6(a, &total, &body)?;
+        total = a.add6(&total, &body)?;
     }
     Ok(total)
 }
@@ -357,14 +357,6 @@ fn transpose(m: &M3) -> M3 {
         }
     }
     t
-}
-
-fn add6(a: &mut Algebra, x: &M6, y: &M6) -> R<M6> {
-    let mut out = *x;
-    for i in 0..6 {
-        out[i] = a.add(x[i], y[i])?;
-    }
-    Ok(out)
 }
 
 /// A constant of the model language (numbers and parameters) in the

@@ -69,6 +69,18 @@ pub fn structured(
     spec: &TreeSpec,
     fixed: &[usize],
 ) -> Result<Structured, SymbolicError> {
+    let mut s = controller(model, spec)?;
+    let parts = links::Parts::new(model)?;
+    let gravity = links::gravity(&mut model.g, spec)?;
+    let reduced = links::links(&mut model.g, spec, &parts, fixed)?;
+    let mut r = recursions::Recursions::new(&mut model.g, &reduced, gravity)?;
+    s.accelerations = r.articulated_body(&parts.speeds)?;
+    Ok(s)
+}
+
+/// The structured form without the accelerations (left empty): what M, f
+/// and the controller functions need, at the coordinates as they are.
+pub fn controller(model: &mut Model, spec: &TreeSpec) -> Result<Structured, SymbolicError> {
     let parts = links::Parts::new(model)?;
     let free = links::links(&mut model.g, spec, &parts, &[])?;
     let gravity = links::gravity(&mut model.g, spec)?;
@@ -77,11 +89,8 @@ pub fn structured(
     let bias = r.newton_euler(&parts.speeds, None, true)?;
     let gravity_term = r.newton_euler(&parts.speeds, None, false)?;
     let mass = r.composite_rigid_body()?;
-    let reduced = links::links(&mut model.g, spec, &parts, fixed)?;
-    let mut r = recursions::Recursions::new(&mut model.g, &reduced, gravity)?;
-    let accelerations = r.articulated_body(&parts.speeds)?;
     Ok(Structured {
-        accelerations,
+        accelerations: Vec::new(),
         inverse,
         mass,
         bias,

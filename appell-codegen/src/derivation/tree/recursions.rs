@@ -120,7 +120,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
         for i in (0..n).rev() {
             if let Some(p) = self.links[i].parent {
                 let moved = self.a.congruence(&self.links[i].transform, &composite[i])?;
-                composite[p] = add6(&mut self.a, &composite[p], &moved)?;
+                composite[p] = self.a.add6(&composite[p], &moved)?;
             }
         }
         let mut m = vec![self.a.zero(); n * n];
@@ -176,7 +176,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
             let pa = self.a.add(bias[i], ic)?;
             let pa = self.a.add(pa, uu)?;
             let moved = self.a.congruence(&self.links[i].transform, &ia)?;
-            inertia[p] = add6(&mut self.a, &inertia[p], &moved)?;
+            inertia[p] = self.a.add6(&inertia[p], &moved)?;
             let pushed = self.a.force_to_parent(&self.links[i].transform, pa)?;
             bias[p] = self.a.add(bias[p], pushed)?;
         }
@@ -193,12 +193,4 @@ impl<'g, 'l> Recursions<'g, 'l> {
         }
         Ok(qdd)
     }
-}
-
-fn add6(a: &mut Algebra, x: &M6, y: &M6) -> R<M6> {
-    let mut out = *x;
-    for i in 0..6 {
-        out[i] = a.add(x[i], y[i])?;
-    }
-    Ok(out)
 }

@@ -78,6 +78,15 @@ impl<'g> Algebra<'g> {
         Ok(out)
     }
 
+    /// x + y for 6×6 matrices.
+    pub fn add6(&mut self, x: &M6, y: &M6) -> R<M6> {
+        let mut out = *x;
+        for i in 0..6 {
+            out[i] = self.add(x[i], y[i])?;
+        }
+        Ok(out)
+    }
+
     /// k · a.
     pub fn scale<const N: usize>(&mut self, a: [Id; N], k: Id) -> R<[Id; N]> {
         let mut out = [self.zero; N];
