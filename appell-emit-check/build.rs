@@ -176,7 +176,7 @@ fn main() {
             g.display(e).to_string(),
             rust.ops.total() + rust.prepare_ops.total(),
             rust.ops.powi + rust.prepare_ops.powi > 0,
-            fused_fn.contains("fused_mul_add"),
+            fused_fn.contains(".fma("),
         );
     }
     table.push_str("];\n");

@@ -14,9 +14,9 @@ pub struct Case {
     pub joint_f64: fn(f64, f64, f64, f64, f64) -> [f64; 2],
     pub joint_f32: fn(f32, f32, f32, f32, f32) -> [f32; 2],
     pub joint_dual: fn(Dual64, Dual64, Dual64, Dual64, Dual64) -> [Dual64; 2],
-    /// Whether the fused text uses `fused_mul_add` at all.
+    /// Whether the fused text uses `fma` (`Scalar::fused_mul_add`) at all.
     pub fused_text: bool,
-    /// The same program written with `fused_mul_add`.
+    /// The same program written with `fma` (`Scalar::fused_mul_add`).
     pub fused_f64: fn(f64, f64, f64, f64, f64) -> [f64; 2],
     pub split: fn([f64; 2], [f64; 3]) -> [f64; 2],
     pub points: &'static [([f64; 5], [f64; 2])],
@@ -74,7 +74,7 @@ fn emitted_code_equals_the_engine_bit_for_bit() {
     assert_eq!(checked, CASES.len() * 6 * 2);
 }
 
-/// Written with `fused_mul_add`, the code gives the engine's values to the
+/// Written with `fma` (`Scalar::fused_mul_add`), the code gives the engine's values to the
 /// bit on a target without FMA instructions (the default x86-64 target, as
 /// in CI): a difference a − x·y is written (−x)·y + a, which IEEE arithmetic
 /// gives exactly. With FMA each fused pair rounds once, so only closeness is

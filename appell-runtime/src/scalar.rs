@@ -74,6 +74,19 @@ pub trait Scalar:
     fn fused_mul_add(self, a: Self, b: Self) -> Self {
         self * a + b
     }
+    /// [`Scalar::fused_mul_add`] under the short name generated code
+    /// writes: a large model writes it tens of thousands of times, and the
+    /// emitted text is what rustc has to read. Implement
+    /// `fused_mul_add`, not this.
+    ///
+    /// ```
+    /// use appell_runtime::Scalar;
+    /// assert_eq!(2.0_f64.fma(3.0, 1.0), 7.0);
+    /// ```
+    #[inline(always)]
+    fn fma(self, a: Self, b: Self) -> Self {
+        self.fused_mul_add(a, b)
+    }
     /// Zero.
     fn zero() -> Self {
         Self::from_f64(0.0)

@@ -334,7 +334,7 @@ fn stages(
     let (mut equations, mut energies, folded_lines) = match large_tree.cloned() {
         Some(spec) => {
             let s = tree::controller(model, &spec)?;
-            let (equations, energies) = tree::equations::equations(model, &spec, &s)?;
+            let (equations, energies) = tree::equations::equations(model, &s)?;
             (equations, energies, None)
         }
         None => {

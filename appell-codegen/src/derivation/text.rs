@@ -13,6 +13,10 @@ use crate::model::Model;
 /// chain's mass matrix entries reach megabytes otherwise).
 const MAX_TEXT: usize = 8192;
 
+/// The length of the listing of M and f past which entries are counted,
+/// not printed.
+const MAX_LISTING: usize = 16384;
+
 /// The nodes `e` has written out as a tree, its shared parts counted each
 /// time they occur, up to `cap`: a few hundred shared nodes (a recursion's)
 /// can write out as millions.
@@ -36,19 +40,16 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
     // A small graph can still print as a long tree (its shared parts
     // written out each time they occur): an expression whose text passes
     // MAX_TEXT characters is named by its size too.
-    let show = |e: Id| -> String {
+    let printed = |e: Id| -> Result<String, usize> {
         let nodes = g.dag_size(&[e]);
         let small = nodes <= 400 && written_size(g, e, MAX_TEXT) < MAX_TEXT;
         let text = small.then(|| g.display(e).to_string());
         match text {
-            Some(text) if text.len() <= MAX_TEXT => text,
-            Some(text) => format!(
-                "<expression of {nodes} nodes, {} characters written out; see the generated code>",
-                text.len()
-            ),
-            None => format!("<expression of {nodes} nodes; see the generated code>"),
+            Some(text) if text.len() <= MAX_TEXT => Ok(text),
+            _ => Err(nodes),
         }
     };
+    let show = |e: Id| printed(e).unwrap_or_else(too_long);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -125,21 +126,50 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
         "M(q) y_ddot = f(q, y_dot, t) with y_ddot = ({}):",
         accels.join(", ")
     );
+    // Entries too long to print are counted on one line, not listed: a
+    // large tree's M has hundreds of them.
+    let mut entries = Vec::new();
     for k in 0..d.l {
         for j in k..d.l {
-            let _ = writeln!(
-                s,
-                "  M[{}, {}] = {}",
-                speeds[k],
-                speeds[j],
-                show(d.equations.mass[k * d.l + j])
-            );
+            let e = d.equations.mass[k * d.l + j];
+            entries.push((format!("M[{}, {}]", speeds[k], speeds[j]), e));
         }
     }
     for k in 0..d.l {
-        let _ = writeln!(s, "  f[{}] = {}", speeds[k], show(d.equations.forcing[k]));
+        entries.push((format!("f[{}]", speeds[k]), d.equations.forcing[k]));
+    }
+    let mut long: Vec<(String, usize)> = Vec::new();
+    let budget = s.len() + MAX_LISTING;
+    for (label, e) in entries {
+        let fits = s.len() < budget;
+        match printed(e) {
+            Ok(text) if fits => {
+                let _ = writeln!(s, "  {label} = {text}");
+            }
+            Ok(_) => long.push((label, g.dag_size(&[e]))),
+            Err(nodes) => long.push((label, nodes)),
+        }
+    }
+    match long.as_slice() {
+        [] => {}
+        [(label, nodes)] => {
+            let _ = writeln!(s, "  {label} = {}", too_long(*nodes));
+        }
+        [(first, _), .., (last, _)] => {
+            let most = long.iter().map(|(_, n)| *n).max().unwrap_or(0);
+            let _ = writeln!(
+                s,
+                "  {} entries from {first} to {last} are not printed (too long, or past the listing's length; up to {most} nodes each): see the generated code",
+                long.len()
+            );
+        }
     }
     s
+}
+
+/// The placeholder for an expression too long to print.
+fn too_long(nodes: usize) -> String {
+    format!("<expression of {nodes} nodes; see the generated code>")
 }
 
 #[cfg(test)]

@@ -37,6 +37,8 @@ pub struct Code {
     pub stages: Vec<Vec<TokenStream>>,
     /// One expression per root.
     pub outputs: Vec<TokenStream>,
+    /// Which roots are the constant 0.
+    pub zero: Vec<bool>,
     /// Operations per call.
     pub ops: OpCount,
 }
@@ -102,11 +104,13 @@ pub fn code(g: &Graph, roots: &[Id], target: Target) -> Code {
 
 /// The program computing `roots`, written with `options`.
 pub fn code_with(g: &Graph, roots: &[Id], options: &EmitOptions) -> Code {
-    from_tokens(Program::lower(g, roots).to_tokens(g, options))
+    let zero = roots.iter().map(|&r| g.is_zero(r)).collect();
+    from_tokens(Program::lower(g, roots).to_tokens(g, options), zero)
 }
 
-fn from_tokens(c: RustTokens) -> Code {
+fn from_tokens(c: RustTokens, zero: Vec<bool>) -> Code {
     Code {
+        zero,
         prepare: c.prepare,
         hoisted: c.hoisted.iter().map(|h| quote::quote!(#h)).collect(),
         body: c.body,

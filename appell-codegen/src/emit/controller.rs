@@ -8,9 +8,10 @@ use appell_symbolic::Id;
 use proc_macro2::TokenStream;
 use quote::quote;
 
-use super::code::{code, Target};
+use super::code::{braced, code, Target};
 use super::functions::Common;
 use super::{int, p, Emitter};
+use crate::derivation::tree::Structured;
 
 impl Emitter<'_> {
     /// `inverse_dynamics`, `mass_matrix`, `bias_forces`, `gravity_forces`.
@@ -19,7 +20,7 @@ impl Emitter<'_> {
             (Ok(s), None) => {
                 let inverse = self.structured_function(c, "inverse_dynamics", &s.inverse);
                 let mass = self.structured_function(c, "mass_matrix", &s.mass);
-                let bias = self.structured_function(c, "bias_forces", &s.bias);
+                let bias = self.bias_through_inverse();
                 let gravity = self.structured_function(c, "gravity_forces", &s.gravity);
                 quote!(#inverse #mass #bias #gravity)
             }
@@ -79,6 +80,83 @@ impl Emitter<'_> {
                 #p::Ok(())
             }
         }
+    }
+
+    /// h as the inverse dynamics at zero accelerations: the same
+    /// recursion but for one addition per link, emitted once.
+    fn bias_through_inverse(&self) -> TokenStream {
+        let p = p();
+        let l = int(self.d.l);
+        let checks = [
+            self.check("__q", self.d.n),
+            self.check("__u", self.d.l),
+            self.check("__bias", self.d.l),
+        ];
+        quote! {
+            fn bias_forces<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __bias: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #(#checks)*
+                let __accel = [<__T as #p::Scalar>::zero(); #l];
+                self.inverse_dynamics(t, __q, __u, &__accel, __bias)
+            }
+        }
+    }
+
+    /// The body of a large tree's `mass_matrix_and_forcing`: M from
+    /// `mass_matrix`, h from `bias_forces`, f = τ − h, so that the
+    /// recursions are emitted once.
+    pub(super) fn structured_mass_and_forcing(
+        &self,
+        c: &Common,
+        s: &Structured,
+    ) -> proc_macro2::Group {
+        let p = p();
+        let (n, l, ni) = (self.d.n, self.d.l, self.model.inputs.len());
+        let checks = [
+            self.check("__q", n),
+            self.check("__u", l),
+            self.check("__inputs", ni),
+            self.check("__m", l * l),
+            self.check("__f", l),
+        ];
+        let mut program = code(&self.model.g, &s.inputs, Target::Generic { hoist: false });
+        let body = program.take_statements();
+        let stores = program.outputs.iter().enumerate().map(|(k, tau)| {
+            let k = int(k);
+            quote!(__f[#k] = #tau - __f[#k];)
+        });
+        let (params_t, bind_inputs) = (&c.params_t, &c.bind_inputs);
+        braced([quote! {
+            #(#checks)*
+            self.mass_matrix(t, __q, __m)?;
+            self.bias_forces(t, __q, __u, __f)?;
+            #params_t #bind_inputs #body
+            #(#stores)*
+            #p::Ok(())
+        }])
+    }
+
+    /// The body of a large tree's `kinetic_energy`: ½ uᵀ M u with M from
+    /// `mass_matrix`, rather than a second copy of the velocity recursion.
+    pub(super) fn kinetic_through_mass(&self) -> proc_macro2::Group {
+        let p = p();
+        let (n, l) = (self.d.n, self.d.l);
+        let checks = [self.check("__q", n), self.check("__u", l)];
+        let (li, ll) = (int(l), int(l * l));
+        let zero = quote!(<__T as #p::Scalar>::zero());
+        braced([quote! {
+            #(#checks)*
+            let mut __m = [#zero; #ll];
+            self.mass_matrix(t, __q, &mut __m)?;
+            let mut __twice = #zero;
+            for __i in 0..#li {
+                let mut __row = #zero;
+                for __j in 0..#li {
+                    __row = __m[__i * #li + __j].fma(__u[__j], __row);
+                }
+                __twice = __u[__i].fma(__row, __twice);
+            }
+            #p::Ok(__twice * <__T as #p::Scalar>::from_f64(0.5))
+        }])
     }
 
     /// The four functions through `mass_matrix_and_forcing`.

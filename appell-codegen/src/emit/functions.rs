@@ -16,14 +16,26 @@ use super::code::{braced, code, Code, Target};
 use super::{int, p, Emitter};
 use crate::derivation::RowSource;
 
-/// `target[i] = output_i;` for the outputs `range`, from index 0.
+/// `target[i] = output_i;` for the outputs `range`, from index 0. Where
+/// most of them are 0 (C of a tree is the identity), the slice is filled
+/// with zeros first and only the others are stored.
 fn outputs_into(c: &Code, target: &str, range: std::ops::Range<usize>) -> TokenStream {
+    let p = p();
     let target = format_ident!("{}", target);
-    let stores = c.outputs[range].iter().enumerate().map(|(i, o)| {
-        let i = int(i);
-        quote!(#target[#i] = #o;)
+    let zeros = c.zero[range.clone()].iter().filter(|z| **z).count();
+    let sparse = zeros > 8 && 2 * zeros > range.len();
+    let fill = if sparse {
+        let len = int(range.len());
+        quote!(#target[..#len].fill(<__T as #p::Scalar>::zero());)
+    } else {
+        TokenStream::new()
+    };
+    let skip = &c.zero[range.clone()];
+    let stores = c.outputs[range].iter().enumerate().filter_map(|(i, o)| {
+        let k = int(i);
+        (!(sparse && skip[i])).then(|| quote!(#target[#k] = #o;))
     });
-    quote!(#(#stores)*)
+    quote!(#fill #(#stores)*)
 }
 
 /// `target[k] = [outputs...];` for `count` groups of `width` outputs from
@@ -150,14 +162,6 @@ impl Emitter<'_> {
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let (chk_q, chk_u, chk_inputs) = (chk("__q", n), chk("__u", l), chk("__inputs", ni));
         let generic = Target::Generic { hoist: false };
-        let mut mf_roots = d.equations.mass.clone();
-        mf_roots.extend(&d.equations.forcing);
-        let mut mf = code(&self.model.g, &mf_roots, generic);
-        let (mf_body, mf_m, mf_f) = (
-            mf.take_statements(),
-            outputs_into(&mf, "__m", 0..l * l),
-            outputs_into(&mf, "__f", l * l..l * l + l),
-        );
         let mut ct_roots = d.map.c.clone();
         ct_roots.extend(&d.map.c0);
         let mut ct = code(&self.model.g, &ct_roots, generic);
@@ -190,13 +194,34 @@ impl Emitter<'_> {
         };
         let (ip_body, ip_out) = single(d.energies.input_power);
         let (pe_body, pe_out) = single(d.energies.potential);
-        let (ke_body, ke_out) = single(d.energies.kinetic);
+        let ke_fn = match (&d.structured, d.closed_form) {
+            (Ok(_), false) => self.kinetic_through_mass(),
+            _ => {
+                let (ke_body, ke_out) = single(d.energies.kinetic);
+                braced([
+                    quote!(#chk_q #chk_u #pos #params_t #bind_q #bind_u #solve_x #ke_body),
+                    quote!(#p::Ok(#ke_out)),
+                ])
+            }
+        };
         let checks_mf = [chk("__m", l * l), chk("__f", l)];
-        let mf_fn = braced([
-            quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #solve_x_and_w),
-            mf_body,
-            quote!(#mf_m #mf_f #p::Ok(())),
-        ]);
+        let mf_fn = match (&d.structured, d.closed_form) {
+            (Ok(s), false) => self.structured_mass_and_forcing(c, s),
+            _ => {
+                let mut mf_roots = d.equations.mass.clone();
+                mf_roots.extend(&d.equations.forcing);
+                let mut mf = code(&self.model.g, &mf_roots, generic);
+                let (mf_m, mf_f) = (
+                    outputs_into(&mf, "__m", 0..l * l),
+                    outputs_into(&mf, "__f", l * l..l * l + l),
+                );
+                braced([
+                    quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #solve_x_and_w),
+                    mf.take_statements(),
+                    quote!(#mf_m #mf_f #p::Ok(())),
+                ])
+            }
+        };
         let checks_ct = [chk("__c", n * l), chk("__c0", n)];
         let chk_qdot = chk("__qdot", n);
         let checks_res = [chk("__holonomic", nh), chk("__velocity", m)];
@@ -227,10 +252,7 @@ impl Emitter<'_> {
                 #chk_q #params_t #bind_q #pe_body
                 #p::Ok(#pe_out)
             }
-            fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> {
-                #chk_q #chk_u #pos #params_t #bind_q #bind_u #solve_x #ke_body
-                #p::Ok(#ke_out)
-            }
+            fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #ke_fn
         }
     }
 

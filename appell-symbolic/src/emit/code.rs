@@ -38,11 +38,11 @@ pub struct EmitOptions {
     /// shares every common subexpression.
     pub symbol_stage: BTreeMap<Symbol, usize>,
     /// Write a product that feeds a sum or a difference, and is not shared,
-    /// as `x.fused_mul_add(y, z)` (a method the scalar trait must provide,
-    /// equal to `x * y + z`): one instruction where the target fuses them.
-    /// A difference is written with the sign moved onto a factor or the
+    /// as `x.fma(y, z)` (a method the scalar trait must provide, equal to
+    /// `x * y + z`; appell's `Scalar::fma` calls its `fused_mul_add`): one
+    /// instruction where the target fuses them. A difference is written with the sign moved onto a factor or the
     /// addend, which IEEE arithmetic gives exactly, so an unfused
-    /// `fused_mul_add` gives the same values as the plain text.
+    /// `fma` gives the same values as the plain text.
     pub fused: bool,
 }
 

@@ -105,12 +105,12 @@ fn fused_products_and_powers() {
     let t = p.to_tokens(&g, &o);
     assert_eq!(
         c.outputs,
-        ["y.atan2(x).fused_mul_add(w, x.fused_mul_add(y - x.powi(69) / z.powi(80), -z))"]
+        ["y.atan2(x).fma(w, x.fma(y - x.powi(69) / z.powi(80), -z))"]
     );
     assert_eq!(
         strings(&t.outputs),
-        ["y . atan2 (x) . fused_mul_add (w , \
-             x . fused_mul_add (y - x . powi (69) / z . powi (80) , - z))"]
+        ["y . atan2 (x) . fma (w , \
+             x . fma (y - x . powi (69) / z . powi (80) , - z))"]
     );
 }
 

@@ -460,14 +460,14 @@ impl<'a> Writer<'a> {
         }
     }
 
-    /// `x.fused_mul_add(y, z)` for a sum or difference with an inline
+    /// `x.fma(y, z)` (the scalar trait's short name for `fused_mul_add`)
+    /// for a sum or difference with an inline
     /// product operand: a + x·y, x·y + b, a − x·y as (−x)·y + a, and
     /// x·y − b as x·y + (−b).
     fn fused_inline(&self, i: usize) -> Option<Frag> {
         let atom = |j: u32| Frag::wrap(self.expr(j as usize), Prec::Atom);
         let arg = |j: u32| self.expr(j as usize).0;
-        let fused =
-            |x: Frag, y: u32, z: Frag| Frag::Method(Box::new(x), "fused_mul_add", vec![arg(y), z]);
+        let fused = |x: Frag, y: u32, z: Frag| Frag::Method(Box::new(x), "fma", vec![arg(y), z]);
         let neg = |x: Frag| Frag::Neg(Box::new(x));
         match self.p.insts[i] {
             Inst::Add(a, b) => {

@@ -37,6 +37,11 @@ pub struct Structured {
     pub bias: Vec<Id>,
     /// The gravity term: h at zero speeds.
     pub gravity: Vec<Id>,
+    /// The joints' inputs as generalized forces τ (0 where a joint is not
+    /// actuated), in speed order: f = τ − h.
+    pub inputs: Vec<Id>,
+    /// The kinetic energy ½ Σ vᵢ · Iᵢ vᵢ, from the links' velocities.
+    pub kinetic: Id,
 }
 
 /// The structured equations of `model`'s tree; `fixed` lists the
@@ -89,12 +94,15 @@ pub fn controller(model: &mut Model, spec: &TreeSpec) -> Result<Structured, Symb
     let bias = r.newton_euler(&parts.speeds, None, true)?;
     let gravity_term = r.newton_euler(&parts.speeds, None, false)?;
     let mass = r.composite_rigid_body()?;
+    let kinetic = r.kinetic_energy(&parts.speeds)?;
     Ok(Structured {
         accelerations: Vec::new(),
         inverse,
         mass,
         bias,
         gravity: gravity_term,
+        inputs: r.inputs(),
+        kinetic,
     })
 }
 

@@ -3,7 +3,7 @@
 //! Featherstone's form (Rigid Body Dynamics Algorithms, 2008, Tables 5.1,
 //! 6.2 and 7.1), with gravity as an acceleration of the ground.
 
-use appell_symbolic::{Graph, Id, SymbolicError};
+use appell_symbolic::{Graph, Id, Number, SymbolicError};
 
 use super::links::Link;
 use super::spatial::{join, Algebra, M6, V3, V6};
@@ -111,6 +111,23 @@ impl<'g, 'l> Recursions<'g, 'l> {
             }
         }
         Ok(tau)
+    }
+
+    /// T = ½ Σ vᵢ · Iᵢ vᵢ over the links, from the velocity recursion.
+    pub fn kinetic_energy(&mut self, speeds: &[Id]) -> R<Id> {
+        let vel = self.velocities(speeds)?;
+        let mut terms = Vec::with_capacity(vel.len());
+        for (i, (v, _)) in vel.iter().enumerate() {
+            let iv = self.a.mat6_vec(&self.links[i].inertia, *v)?;
+            terms.push(self.a.dot((0..6).map(|k| (v[k], iv[k])))?);
+        }
+        let twice = self.a.g.sum(&terms)?;
+        self.a.g.scale(twice, Number::ratio(1, 2).expect("1/2"))
+    }
+
+    /// The joints' inputs as generalized forces, in speed order.
+    pub fn inputs(&self) -> Vec<Id> {
+        self.links.iter().map(|l| l.input).collect()
     }
 
     /// M by the composite-rigid-body algorithm, l×l row-major.
