@@ -38,6 +38,31 @@ pub use model::{
 };
 pub use scalar::Scalar;
 
+/// nalgebra, the matrices of [`linearize`] and of the oracle, re-exported so
+/// that a user needs no dependency line of their own (nor to match its
+/// version).
+///
+/// ```
+/// use appell_runtime::nalgebra::DMatrix;
+/// let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -4.0, 0.0]);
+/// let eig = appell_runtime::linearize::eigenvalues(&a).unwrap();
+/// assert!(eig.iter().all(|&(re, im)| re.abs() < 1e-12 && (im.abs() - 2.0).abs() < 1e-12));
+/// ```
+#[cfg(feature = "std")]
+pub use nalgebra;
+
+/// num-dual, the dual numbers [`Scalar`] is implemented for (derivatives of
+/// every generated function), re-exported for the same reason.
+///
+/// ```
+/// use appell_runtime::{num_dual::Dual64, Scalar};
+/// let x = Dual64::new(0.5, 1.0);
+/// let y = x.sin();
+/// assert!((y.eps - 0.5_f64.cos()).abs() < 1e-15);
+/// ```
+#[cfg(feature = "std")]
+pub use num_dual;
+
 /// Items the generated code refers to; not a stable API.
 #[doc(hidden)]
 pub mod __private {
