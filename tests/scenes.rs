@@ -57,14 +57,9 @@ fn each_scene_equals_the_full_model_with_the_other_effects_switched_off() {
             .unwrap();
         let coasting = WheelAxleCoasting(p.clone());
         let mut d = [0.0; 3];
+        // Gravity alone reads no input: the scene takes none.
         coasting
-            .rhs(
-                &coasting.prepare::<f64>(),
-                0.0,
-                &[phi, w, s],
-                &[tau],
-                &mut d,
-            )
+            .rhs(&coasting.prepare::<f64>(), 0.0, &[phi, w, s], &[], &mut d)
             .unwrap();
         for k in 0..3 {
             assert!(
@@ -225,13 +220,13 @@ fn contact_check_scene_reports_its_outputs_on_the_command_line() {
         info["scenes"][0]["state_len"]
     );
 
-    let line = br#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}, "inputs": {"tau": 0.5}}"#;
+    let line = br#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}}"#;
     let p = WheelAxle::default();
     let scene = WheelAxleContactCheck(p.clone());
     let q = [0.0, 0.0, 0.0, 0.0, 0.0, 0.0, 0.2];
     let u = [0.1, 2.0];
-    let expected = appell::constraint_forces::contact_forces(&scene, 0.0, &q, &u, &[0.5]).unwrap();
-    let energies = appell::energy::energies(&scene, 0.0, &q, &u, &[0.5]).unwrap();
+    let expected = appell::constraint_forces::contact_forces(&scene, 0.0, &q, &u, &[]).unwrap();
+    let energies = appell::energy::energies(&scene, 0.0, &q, &u, &[]).unwrap();
     // `eval --scene contact_check`: rates plus the two outputs.
     let v = run(&["wheel_axle", "eval", "--scene", "contact_check"], line);
     assert!(v["udot"]["phi"].is_f64());
@@ -290,13 +285,23 @@ fn input_power_is_torque_times_wheel_rate() {
     let q = [0.1, 0.2, 0.3, 0.4, 0.5, 0.6, 0.7];
     let power = p.input_power(0.0, &q, &[0.8, -1.3], &[0.25]).unwrap();
     assert!(close(power, 0.25 * -1.3, 1e-15), "{power}");
-    // The coasting scene has no input loads.
+    // The coasting scene has no input loads, and so no inputs; given the
+    // full model's, it names the argument as the trait does.
+    let coasting = WheelAxleCoasting(p);
+    assert_eq!(WheelAxleCoasting::info().inputs, &[] as &[&str]);
     assert_eq!(
-        WheelAxleCoasting(p)
-            .input_power(0.0, &q, &[0.8, -1.3], &[0.25])
-            .unwrap(),
+        coasting.input_power(0.0, &q, &[0.8, -1.3], &[]).unwrap(),
         0.0
     );
+    assert_eq!(
+        coasting.input_power(0.0, &q, &[0.8, -1.3], &[0.25]),
+        Err(appell::ModelError::Length {
+            argument: "inputs",
+            expected: 0,
+            found: 1
+        })
+    );
+    assert_eq!(WheelAxleDriven::info().inputs, &["tau"]);
 }
 
 #[test]
@@ -313,7 +318,7 @@ fn energy_rate_is_the_input_power_in_every_scene() {
         let u = [rng.uniform(-3.0, 3.0), rng.uniform(-10.0, 10.0)];
         let tau = [rng.uniform(-2.0, 2.0)];
         let full = energies(&p, 0.0, &q, &u, &tau).unwrap();
-        let coasting = energies(&WheelAxleCoasting(p.clone()), 0.0, &q, &u, &tau).unwrap();
+        let coasting = energies(&WheelAxleCoasting(p.clone()), 0.0, &q, &u, &[]).unwrap();
         let driven = energies(&WheelAxleDriven(p.clone()), 0.0, &q, &u, &tau).unwrap();
         let scale = 1.0 + full.kinetic.abs() + full.potential.abs();
         assert!(close(full.input_power, tau[0] * u[1], 1e-15));

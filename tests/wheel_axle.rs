@@ -228,3 +228,37 @@ fn controller_functions_agree_with_the_equations() {
     let worst = common::controller_agrees(&WheelAxle::default(), &mut rng, 50, 3.0);
     assert!(worst < 1e-12, "{worst:.2e}");
 }
+
+#[test]
+fn every_coordinate_acceleration_is_the_rate_of_its_rate() {
+    // q̈ of all seven coordinates, the five dependent ones included, against
+    // a central difference of q̇ along the motion: q̇(q ± h q̇, u ± h u̇).
+    use appell::motion::rates;
+    let mut rng = Rng(0x9a11);
+    let mut worst: f64 = 0.0;
+    for _ in 0..200 {
+        let p = random_model(&mut rng);
+        let q: Vec<f64> = (0..7).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let u = [rng.uniform(-2.0, 2.0), rng.uniform(-5.0, 5.0)];
+        let inputs = [rng.uniform(-1.0, 1.0)];
+        let r = rates(&p, 0.0, &q, &u, &inputs).unwrap();
+        let h = 1e-5;
+        let rate_at = |s: f64| {
+            let qs: Vec<f64> = q.iter().zip(&r.qdot).map(|(q, v)| q + s * v).collect();
+            let us: Vec<f64> = u.iter().zip(&r.udot).map(|(u, a)| u + s * a).collect();
+            let mut out = [0.0; 7];
+            p.coordinate_rates(0.0, &qs, &us, &mut out).unwrap();
+            out
+        };
+        let (ahead, behind) = (rate_at(h), rate_at(-h));
+        for k in 0..7 {
+            let fd = (ahead[k] - behind[k]) / (2.0 * h);
+            worst = worst.max((r.qddot[k] - fd).abs() / (1.0 + fd.abs()));
+        }
+        // The privileged speeds' coordinates: q̈ is u̇ itself.
+        assert_eq!(r.qddot[6], r.udot[0]);
+        assert_eq!(r.qddot[2], r.udot[1]);
+    }
+    println!("wheel-axle: q̈ against central differences of q̇: {worst:.1e}");
+    assert!(worst < 1e-8, "{worst:e}");
+}

@@ -133,7 +133,8 @@ fn coasting_scene_is_the_bicycle_without_its_rider() {
     let state = [0.1, std::f64::consts::PI / 10.0, -0.2, 0.3, -15.0, 0.4];
     let (mut a, mut b, mut c) = ([0.0; 6], [0.0; 6], [0.0; 6]);
     p.rhs(&full, 0.0, &state, &[0.0], &mut a).unwrap();
-    coasting.rhs(&cp, 0.0, &state, &[2.0], &mut b).unwrap();
+    // Gravity alone reads no input: the coasting scene takes none.
+    coasting.rhs(&cp, 0.0, &state, &[], &mut b).unwrap();
     ridden.rhs(&rp, 0.0, &state, &[0.0], &mut c).unwrap();
     for k in 0..6 {
         assert!(

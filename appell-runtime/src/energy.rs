@@ -9,7 +9,8 @@
 //! other load left out of V (friction, damping, a motor without an input),
 //! and on a scene it shows what the chosen effects put in.
 
-use crate::model::{check_len, Model, ModelError};
+use crate::model::{Model, ModelError};
+use crate::motion::first_rates;
 use num_dual::Dual64;
 
 /// The energies at one state, from [`energies`].
@@ -95,35 +96,12 @@ pub fn energies<M: Model>(
     u: &[f64],
     inputs: &[f64],
 ) -> Result<Energies, ModelError> {
-    let info = M::info();
-    check_len("q", q, info.coordinates.len())?;
-    check_len("u", u, info.speeds.len())?;
-    check_len("inputs", inputs, info.inputs.len())?;
-    let finite = |xs: &[f64]| xs.iter().all(|x| x.is_finite());
-    if !(t.is_finite() && finite(q) && finite(u) && finite(inputs)) {
-        return Err(ModelError::NonFinite {
-            what: "energy arguments",
-        });
-    }
-    let mut state = Vec::with_capacity(info.state_len());
-    for name in info.retained {
-        let i = info.coordinate_index(name).ok_or(ModelError::NonFinite {
-            what: "retained coordinate",
-        })?;
-        state.push(q[i]);
-    }
-    state.extend_from_slice(u);
-    let mut dstate = vec![0.0; info.state_len()];
-    let prepared = model.prepare::<f64>();
-    model.rhs(&prepared, t, &state, inputs, &mut dstate)?;
-    let udot = &dstate[info.retained.len()..];
-    let mut qdot = vec![0.0; q.len()];
-    model.coordinate_rates(t, q, u, &mut qdot)?;
+    let (qdot, udot) = first_rates(model, t, q, u, inputs, "energy arguments")?;
 
     let seeded = |x: &[f64], dx: &[f64]| -> Vec<Dual64> {
         x.iter().zip(dx).map(|(&v, &d)| Dual64::new(v, d)).collect()
     };
-    let (td, qd, ud) = (Dual64::new(t, 1.0), seeded(q, &qdot), seeded(u, udot));
+    let (td, qd, ud) = (Dual64::new(t, 1.0), seeded(q, &qdot), seeded(u, &udot));
     let kinetic = model.kinetic_energy(td, &qd, &ud)?;
     let potential = model.potential_energy(td, &qd)?;
     let input_power = model.input_power(t, q, u, inputs)?;

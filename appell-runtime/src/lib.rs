@@ -28,6 +28,8 @@ pub mod linalg;
 pub mod linearize;
 mod model;
 #[cfg(feature = "std")]
+pub mod motion;
+#[cfg(feature = "std")]
 pub mod oracle;
 pub mod precision;
 mod scalar;

@@ -110,7 +110,7 @@ impl Emitter<'_> {
         s: &Structured,
     ) -> proc_macro2::Group {
         let p = p();
-        let (n, l, ni) = (self.d.n, self.d.l, self.model.inputs.len());
+        let (n, l, ni) = (self.d.n, self.d.l, self.inputs().len());
         let checks = [
             self.check("__q", n),
             self.check("__u", l),
@@ -162,7 +162,7 @@ impl Emitter<'_> {
     /// The four functions through `mass_matrix_and_forcing`.
     fn closed_form_controller(&self) -> TokenStream {
         let p = p();
-        let (l, ni) = (int(self.d.l), int(self.model.inputs.len()));
+        let (l, ni) = (int(self.d.l), int(self.inputs().len()));
         let ll = int(self.d.l * self.d.l);
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let (chk_accel, chk_forces) = (chk("__accel", self.d.l), chk("__forces", self.d.l));

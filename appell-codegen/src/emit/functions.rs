@@ -157,7 +157,7 @@ impl Emitter<'_> {
             solve_x,
             ..
         } = c;
-        let ni = self.model.inputs.len();
+        let ni = self.inputs().len();
         let nh = d.constraints.holonomic.len();
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let (chk_q, chk_u, chk_inputs) = (chk("__q", n), chk("__u", l), chk("__inputs", ni));
@@ -407,7 +407,7 @@ impl Emitter<'_> {
         let checks_contacts = [chk("__points", nc), chk("__directions", m)];
         let checks_loads = [
             chk("__qdot", n),
-            chk("__inputs", model.inputs.len()),
+            chk("__inputs", self.inputs().len()),
             chk("__forces", nf),
             chk("__torques", nt),
         ];
@@ -458,7 +458,7 @@ impl Emitter<'_> {
             let (k, what) = (int(k), format!("state component `{name}`"));
             out.extend(quote!(if !#p::Scalar::re(__state[#k]).is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
         }
-        for (k, (name, _)) in model.inputs.iter().enumerate() {
+        for (k, (name, _)) in self.inputs().into_iter().enumerate() {
             let (k, what) = (int(k), format!("input `{name}`"));
             out.extend(quote!(if !#p::Scalar::re(__inputs[#k]).is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
         }

@@ -52,7 +52,7 @@ impl Emitter<'_> {
         let cyclic = names(&d.reduction.cyclic);
         let ignorable = names(&d.reduction.ignorable);
         let retained = names(&d.reduction.retained);
-        let inputs = strings(model.inputs.iter().map(|(i, _)| i.to_string()).collect());
+        let inputs = strings(self.inputs().iter().map(|(i, _)| i.to_string()).collect());
         let effects = strings(self.effects());
         let outputs = strings(self.outputs());
         let holonomic = int(d.constraints.holonomic.len());

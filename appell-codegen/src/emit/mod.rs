@@ -95,6 +95,24 @@ impl Emitter<'_> {
             .collect()
     }
 
+    /// The inputs this implementation takes: the model's, or for a scene
+    /// those its kept loads read (a scene of loads without inputs takes
+    /// none).
+    fn inputs(&self) -> Vec<&(syn::Ident, appell_symbolic::Symbol)> {
+        let g = &self.model.g;
+        let loads: Vec<&Load> = self.forces().into_iter().chain(self.torques()).collect();
+        self.model
+            .inputs
+            .iter()
+            .filter(|(_, s)| {
+                self.scene.is_none()
+                    || loads
+                        .iter()
+                        .any(|l| l.vector.iter().any(|&e| g.depends_on(e, *s)))
+            })
+            .collect()
+    }
+
     /// The scene's outputs (none for the full model).
     fn outputs(&self) -> Vec<String> {
         self.scene.map_or_else(Vec::new, |s| s.outputs.clone())
@@ -173,19 +191,22 @@ impl Emitter<'_> {
     /// `let input_k = slice[k];` for every input.
     fn bind_inputs(&self, slice: &str) -> TokenStream {
         let slice = self.ident(slice);
-        let binds = self.model.inputs.iter().enumerate().map(|(k, (name, _))| {
+        let binds = self.inputs().into_iter().enumerate().map(|(k, (name, _))| {
             let k = int(k);
             quote!(let #name = #slice[#k];)
         });
         quote!(#(#binds)*)
     }
 
-    /// `check_len(arg, arg, len)?;`: a slice argument of the wrong length
-    /// is a typed error.
+    /// `check_len(name, arg, len)?;`: a slice argument of the wrong length
+    /// is a typed error naming it as the trait does (`inputs`, not
+    /// `__inputs`).
     fn check(&self, arg: &str, len: usize) -> TokenStream {
         let p = p();
         let (ident, len) = (self.ident(arg), int(len));
-        quote!(#p::check_len(#arg, #ident, #len)?;)
+        // The error names the argument as the `Model` trait does.
+        let name = arg.trim_start_matches("__");
+        quote!(#p::check_len(#name, #ident, #len)?;)
     }
 }
 

@@ -226,7 +226,7 @@ impl Emitter<'_> {
             (pieces.names, pieces.values, &pieces.prepare, &pieces.tail);
         let checks = [
             self.check("__state", ns),
-            self.check("__inputs", self.model.inputs.len()),
+            self.check("__inputs", self.inputs().len()),
             self.check("__dstate", ns),
         ];
         let diagnose = self.non_finite_diagnosis();

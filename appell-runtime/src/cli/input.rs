@@ -37,7 +37,11 @@ pub(super) fn named(
         let i = names
             .iter()
             .position(|n| n == key)
-            .ok_or_else(|| format!("unknown {kind} `{key}` in `{field}`"))?;
+            .ok_or_else(|| match names.is_empty() {
+                // A scene whose effects read no input takes none.
+                true => format!("unknown {kind} `{key}` in `{field}`: there are no {field} here"),
+                false => format!("unknown {kind} `{key}` in `{field}`"),
+            })?;
         out[i] = Some(number(value, &format!("`{field}.{key}`"))?);
     }
     Ok(out)
