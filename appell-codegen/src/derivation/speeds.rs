@@ -14,6 +14,7 @@ use super::rows::ConstraintRows;
 use crate::ctxt::Ctxt;
 use crate::model::{Model, SpeedSpec};
 use crate::probe::dependent_row;
+use appell_runtime::RowSource;
 
 /// The output of stage 2.
 #[derive(Clone)]
@@ -27,6 +28,26 @@ pub struct SpeedDefinitions {
     /// The coordinates whose rates are unknowns: the dependent ones, or
     /// every coordinate with quasi-velocities.
     pub dependent: Vec<usize>,
+}
+
+/// What to say of a constraint row that the others already imply. Two
+/// rolling contacts are the likely case: wheels on one axle each told not
+/// to slip sideways give the same row twice.
+fn dependent_row_message(model: &Model, rows: &ConstraintRows, row: usize) -> String {
+    let plain = "this constraint row is a linear combination of the others (the velocity constraints are linearly dependent); drop it, or give a rolling contact `along = [...]` directions";
+    let RowSource::Rolling { contact, .. } = rows.sources[row] else {
+        return plain.to_string();
+    };
+    let others = rows.sources[..row]
+        .iter()
+        .any(|s| matches!(s, RowSource::Rolling { contact: c, .. } if *c != contact));
+    if !others {
+        return plain.to_string();
+    }
+    let body = &model.bodies[model.rolling[contact].body].name;
+    format!(
+        "this row of `{body}`'s rolling contact is a linear combination of the other contacts' rows (the velocity constraints are linearly dependent): wheels on one axle share the row that keeps the axle from sliding sideways; keep it on one wheel and give this one only its rolling direction, e.g. `along = [A.x]` with A.x the direction the wheel rolls along"
+    )
 }
 
 /// Stage 2. `None` when errors were recorded in `cx`.
@@ -61,10 +82,7 @@ pub fn speed_definitions(
         return Ok(None);
     }
     if let Some(row) = dependent_row(&model.g, &rows.d, n, m) {
-        cx.error_spanned_by(
-            &rows.at[row],
-            "this constraint row is a linear combination of the others (the velocity constraints are linearly dependent); drop it, or give a rolling contact `along = [...]` directions",
-        );
+        cx.error_spanned_by(&rows.at[row], dependent_row_message(model, rows, row));
         return Ok(None);
     }
     if l + m != n {
