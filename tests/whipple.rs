@@ -212,3 +212,37 @@ fn folded_wheels_agree_with_the_oracle_for_other_bicycles() {
     println!("other bicycles vs oracle: largest relative difference {worst:.2e}");
     assert!(worst < 1e-9, "{worst:e}");
 }
+
+#[test]
+fn eval_warns_of_a_state_off_the_holonomic_constraint() {
+    // On the constraint (the pitch solved from it) the answer has no
+    // warning; with the pitch 0.01 rad off, it names the constraint and its
+    // residual, and still gives the rates.
+    let p = WhippleBicycle::default();
+    let q = whipple_bicycle::operating_point(&p).unwrap();
+    let eval = |pitch: f64| -> serde_json::Value {
+        let line = format!(
+            r#"{{"q": {{"q2": {}, "q3": {}, "q4": 0.0, "q5": {pitch}, "q7": 0.0}}, "u": {{"q4": 0.1, "q6": -10.0, "q7": 0.2}}}}"#,
+            q[1], q[2]
+        );
+        let mut out = Vec::new();
+        appell::cli::run_with(
+            p.clone(),
+            &["whipple".to_string(), "eval".to_string()],
+            &mut line.as_bytes(),
+            &mut out,
+            |_| Ok(()),
+        )
+        .unwrap();
+        serde_json::from_slice(&out).unwrap()
+    };
+    let on = eval(q[4]);
+    assert!(on["udot"]["q4"].is_f64(), "{on}");
+    assert!(on.get("warning").is_none(), "{on}");
+    let off = eval(q[4] + 0.01);
+    assert!(off["udot"]["q4"].is_f64(), "{off}");
+    let residual = off["warning"]["holonomic_residuals"][0].as_f64().unwrap();
+    assert!(residual.abs() > 1e-4, "{off}");
+    let message = off["warning"]["message"].as_str().unwrap();
+    assert!(message.contains("holonomic constraint 0"), "{message}");
+}

@@ -59,7 +59,10 @@
 //! ```
 //!
 //! where `qdot` comes from [`Model::coordinate_rates`] and `udot` from
-//! [`Model::rhs`] (after [`Model::prepare`]).
+//! [`Model::rhs`] (after [`Model::prepare`]). When `q` is off a holonomic
+//! constraint by more than 1e-9 × (1 + max |q|), the answer also carries
+//! `"warning": {"message": "...", "holonomic_residuals": [..]}`: the rates
+//! are still computed, but for a state the mechanism cannot take.
 //!
 //! With `--scene NAME` the scene's reduced equations answer, and the
 //! outputs its `outputs(...)` asked for are added: `"energies"`

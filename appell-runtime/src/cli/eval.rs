@@ -8,6 +8,11 @@ use crate::model::{Model, ModelError, ModelInfo, SceneVisitor};
 use serde_json::{json, Map, Value};
 use std::io::{BufRead, Write};
 
+/// How far, relative to 1 + max |q|, a holonomic residual may be from zero
+/// before `eval` warns: a thousand times what solving the constraints to
+/// round-off leaves.
+const HOLONOMIC_TOLERANCE: f64 = 1e-9;
+
 // Items the documentation links to.
 #[cfg(doc)]
 use super::run_with;
@@ -164,6 +169,9 @@ impl<M: Model> Evaluator<M> {
         let mut answer = Map::new();
         answer.insert("qdot".into(), Value::Object(qdot_out));
         answer.insert("udot".into(), Value::Object(udot_out));
+        if let Some(warning) = self.holonomic_warning(info, t, &q, &qdot)? {
+            answer.insert("warning".into(), warning);
+        }
         let (energies, contacts) = (
             info.has_output("energies"),
             info.has_output("contact_forces"),
@@ -172,6 +180,43 @@ impl<M: Model> Evaluator<M> {
             answer.extend(outputs(energies, contacts)?);
         }
         Ok(Value::Object(answer))
+    }
+
+    /// A warning when `q` is off a holonomic constraint by more than
+    /// [`HOLONOMIC_TOLERANCE`] × (1 + max |q|): the rates are still those
+    /// of the equations at `q`, but of a state the mechanism cannot take.
+    fn holonomic_warning(
+        &self,
+        info: &ModelInfo,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+    ) -> Result<Option<Value>, String> {
+        if info.holonomic == 0 {
+            return Ok(None);
+        }
+        let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
+        self.model
+            .constraint_residuals(t, q, qdot, &mut h, &mut v)
+            .map_err(|e| e.to_string())?;
+        let scale = 1.0 + q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        let tolerance = HOLONOMIC_TOLERANCE * scale;
+        let worst = h
+            .iter()
+            .enumerate()
+            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+        Ok(match worst {
+            // A NaN residual warns too.
+            Some((index, &residual)) if residual.is_nan() || residual.abs() > tolerance => {
+                Some(json!({
+                    "message": format!(
+                        "the coordinates violate holonomic constraint {index} by {residual:e} (tolerance {tolerance:e}): the rates are those of a state the mechanism cannot take; solve for a dependent coordinate first (appell::linearize::solve_holonomic)"
+                    ),
+                    "holonomic_residuals": h,
+                }))
+            }
+            _ => None,
+        })
     }
 
     /// Reads `t`, `params`, `q`, `u` and `inputs` of a JSON object (fields
