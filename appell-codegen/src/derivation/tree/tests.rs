@@ -90,6 +90,13 @@ fn structured_form_agrees_with_the_closed_form() {
             .map(|k| lookup(&at, g.symbol_name(d.model.speed_specs[k].accel)))
             .collect();
         let ydd: Vec<f64> = s.accelerations.iter().map(|&e| value(e)).collect();
+        // T from the links' velocities, the large trees' energy, against
+        // the closed form's.
+        let (t_links, t_closed) = (value(s.kinetic), value(d.full.energies.kinetic));
+        assert!(
+            (t_links - t_closed).abs() < 1e-12 * (1.0 + t_closed.abs()),
+            "T: {t_links} vs {t_closed}"
+        );
         for i in 0..l {
             for j in 0..l {
                 let (a, b) = (value(s.mass[i * l + j]), value(mass[i * l + j]));
