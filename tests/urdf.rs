@@ -180,6 +180,7 @@ fn a_mimic_joint_is_a_dependent_coordinate_tied_by_a_constraint() {
     assert_eq!(info.speeds.len(), 8);
     assert!(info.inputs.contains(&"tau_panda_finger_joint1"));
     assert!(!info.inputs.contains(&"tau_panda_finger_joint2"));
+    assert!(info.form.starts_with("structured"), "{}", info.form);
     // The rhs agrees with the multiplier oracle, which takes the
     // constraint's multiplier.
     let model = PandaWithFingers;

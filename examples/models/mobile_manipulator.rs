@@ -19,7 +19,9 @@ use appell::Appell;
 /// The reduced equations keep the arm's six angles and eight speeds (the
 /// wheels' and the arm's): the base's position and heading are cyclic and
 /// the wheel angles ignorable, so they leave the state, and the three
-/// contact rows are eliminated in closed form.
+/// contact rows are eliminated in closed form. M and f come from the
+/// tree's recursions projected onto the eight speeds (`info().form`),
+/// cheaper than Appell's closed form for this mechanism.
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(positive(r, w), gravity(-g * N.z))]
 #[appell(

@@ -165,6 +165,27 @@ pub struct Derivation {
     pub closed_form: bool,
     /// The structured form (a plain tree of joints), or why there is none.
     pub structured: Result<tree::Structured, String>,
+    /// For a tree under constraints, what its projected M and f cost
+    /// against the closed form's; where they cost less, `equations` holds
+    /// them and `closed_form` is false.
+    pub projection: Option<Projection>,
+}
+
+/// The operations per call of a constrained tree's M and f (lower
+/// triangle and f, parameter-only work hoisted), projected and closed.
+#[derive(Clone, Copy, Debug)]
+pub struct Projection {
+    /// The projected tree's.
+    pub ops: usize,
+    /// The closed form's.
+    pub closed_ops: usize,
+}
+
+impl Projection {
+    /// Whether the projected form is used.
+    pub fn chosen(&self) -> bool {
+        self.ops < self.closed_ops
+    }
 }
 
 /// M and the elimination before stage 12 fixed the coordinates they do not
@@ -220,6 +241,15 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
             } else {
                 structured_form(&mut model, &d.reduction.ignorable)
             };
+            if !options.closed_form_only {
+                if let Err(e) = project(&mut model, &mut d) {
+                    cx.error_at(
+                        model.name.span(),
+                        format!("projecting the tree's equations failed: {e}"),
+                    );
+                    return None;
+                }
+            }
             d
         }
         Ok(None) => return None,
@@ -249,8 +279,52 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
 /// there is none.
 fn structured_form(model: &mut Model, ignorable: &[usize]) -> Result<tree::Structured, String> {
     let spec = model.tree.clone()?;
+    spec.plain.clone()?;
     tree::structured(model, &spec, ignorable)
         .map_err(|e| format!("the structured form failed: {e}"))
+}
+
+/// Stage 13 for a tree under constraints (symbolic elimination): M and f
+/// projected from the tree's recursions, the ignorable coordinates at
+/// zero, put in place of the closed form's where they cost less per call.
+fn project(model: &mut Model, d: &mut Derivation) -> Result<(), SymbolicError> {
+    let Ok(spec) = model.tree.clone() else {
+        return Ok(());
+    };
+    if spec.plain.is_ok() || !matches!(d.elimination, Elimination::Symbolic) {
+        return Ok(());
+    }
+    let p = tree::projected::projected(model, &spec, &d.map, &d.reduction.ignorable)?;
+    let cost = |g: &appell_symbolic::Graph, mass: &[Id], forcing: &[Id]| {
+        let l = forcing.len();
+        let mut roots: Vec<Id> = (0..l)
+            .flat_map(|i| (0..=i).map(move |j| (i, j)))
+            .map(|(i, j)| mass[i * l + j])
+            .collect();
+        roots.extend(forcing);
+        let options = appell_symbolic::EmitOptions {
+            fused: true,
+            ..Default::default()
+        };
+        let program = appell_symbolic::Program::lower(g, &roots);
+        program.to_tokens(g, &options).ops.total()
+    };
+    let projection = Projection {
+        ops: cost(&model.g, &p.mass, &p.forcing),
+        closed_ops: cost(&model.g, &d.equations.mass, &d.equations.forcing),
+    };
+    if projection.chosen() {
+        d.equations = Equations {
+            inertial_terms: p.forcing.iter().map(|&f| vec![f]).collect(),
+            load_terms: Vec::new(),
+            mass: p.mass,
+            forcing: p.forcing,
+        };
+        d.closed_form = false;
+    }
+    d.projection = Some(projection);
+    d.text = text::equations_text(model, d);
+    Ok(())
 }
 
 /// The stage outputs before they are bound to the model.
@@ -287,6 +361,7 @@ impl Stages {
             closed_form: self.closed_form,
             text: String::new(),
             structured: Err(String::new()),
+            projection: None,
         };
         d.text = text::equations_text(model, &d);
         d
@@ -328,6 +403,7 @@ fn stages(
     };
     let large_tree = model.tree.as_ref().ok().filter(|spec| {
         !options.closed_form_only
+            && spec.plain.is_ok()
             && matches!(elimination, Elimination::Symbolic)
             && tree::moving_links(spec) >= tree::STRUCTURED_ONLY_LINKS
     });

@@ -99,6 +99,7 @@ fn scene_derivation(
             load_terms: Vec::new(),
         },
         structured: Err("a scene uses the closed form".into()),
+        projection: None,
         closed_form: full.closed_form,
         energies: Energies {
             kinetic: full.energies.kinetic,

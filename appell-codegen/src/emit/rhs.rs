@@ -79,6 +79,15 @@ impl Emitter<'_> {
         }
         let flat = self.flat_rhs(common);
         let flat_total = flat.ops.total() + flat.extra;
+        if let Some(pr) = self.d.projection {
+            let form = if pr.chosen() {
+                format!("structured: M by the composite-rigid-body algorithm and f by recursive Newton–Euler over the joint tree, projected onto the privileged speeds (M = Cᵀ M_q C), {} operations for M and f per call against the closed form's {}", pr.ops, pr.closed_ops)
+            } else {
+                format!("closed form: {} operations for M and f per call against the projected joint tree's {}", pr.closed_ops, pr.ops)
+            };
+            let info = self.info(flat.ops, flat.extra, &form);
+            return RhsParts { info, ..flat };
+        }
         let (chosen, form) = match &self.d.structured {
             Ok(s) if matches!(self.d.elimination, Elimination::Symbolic) => {
                 let structured = self.structured_rhs(common, &s.accelerations);

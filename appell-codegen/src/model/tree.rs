@@ -2,9 +2,13 @@
 //! each joint moves, where its frame sits in the parent link, and the
 //! bodies each link carries, every number still an expression of the
 //! model language. The structured form of the equations
-//! ([`crate::derivation::tree`]) is built from it; a model that is not a
-//! plain tree (a loop, a rolling contact, a load other than gravity and
-//! joint actuation, ...) gets the reason instead, reported in `info()`.
+//! ([`crate::derivation::tree`]) is built from it. A tree under
+//! constraints (rolling contacts, closing rows, dependent joints, speeds
+//! other than the joint rates) is still a tree: its equations are the
+//! tree's projected onto the privileged speeds, and [`TreeSpec::plain`]
+//! says why it is not plain. A model that is not a tree of joints (a
+//! coordinate no joint makes, a load other than gravity and joint
+//! actuation, ...) gets the reason instead, reported in `info()`.
 
 use std::collections::HashMap;
 
@@ -83,6 +87,10 @@ pub struct TreeSpec {
     pub links: Vec<LinkSpec>,
     /// The gravity acceleration as terms along N's axes.
     pub gravity: Vec<Term>,
+    /// Ok for a plain tree, whose privileged speeds are its joint rates
+    /// and which has no constraints; else why not. Moving link k moves
+    /// coordinate k either way.
+    pub plain: Result<(), String>,
 }
 
 /// Where a frame or point sits: its link (None: the ground) and, for a
@@ -114,7 +122,8 @@ pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
         // No reason to give: a model without joints is not a tree of them.
         return Err(String::new());
     }
-    model_level_checks(ast)?;
+    tree_checks(ast)?;
+    let plain = plain_checks(ast);
     let mut frames: HashMap<String, FrameAt> = HashMap::new();
     let mut points: HashMap<String, PointAt> = HashMap::new();
     frames.insert("N".into(), (None, Vec::new()));
@@ -158,11 +167,11 @@ pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
             }
         }
         if let Some(j) = pending.peek() {
-            if let Some(link) = link_of(j, ast, &frames, &points)? {
-                let index = links.len();
+            if let Some(made) = links_of(j, ast, &frames, &points, links.len())? {
+                let index = links.len() + made.len() - 1;
                 frames.insert(j.child.to_string(), (Some(index), Vec::new()));
                 points.insert(format!("{}_origin", j.child), (Some(index), Vec::new()));
-                links.push(link);
+                links.extend(made);
                 pending.next();
                 progress = true;
             }
@@ -195,42 +204,32 @@ pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
         }
         None => Vec::new(),
     };
-    Ok(TreeSpec { links, gravity })
+    Ok(TreeSpec {
+        links,
+        gravity,
+        plain,
+    })
 }
 
-/// What a tree may not have: constraints, rolling, scenes, inputs and
-/// loads other than the joints' own, speeds other than the joint rates.
-fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
-    if !ast.holonomic.is_empty() || !ast.nonholonomic.is_empty() {
-        return Err("the model has constraints".into());
-    }
-    if !ast.rolls.is_empty() {
-        return Err("the model has rolling contacts".into());
-    }
+/// What a tree of joints may not have: scenes, coordinates no joint
+/// makes, inputs and loads other than the joints' own.
+fn tree_checks(ast: &ModelAst) -> Result<(), String> {
     if !ast.scenes.is_empty() {
         return Err("the model declares scenes".into());
     }
     let mut expected_loads = 0;
     let mut inputs = Vec::new();
-    let mut coordinates = Vec::new();
     for j in &ast.joints {
         match j.kind {
-            JointKind::Revolute(_) | JointKind::Prismatic(_) => {
-                coordinates.push(j.name.to_string())
-            }
-            JointKind::Weld => {}
+            JointKind::Revolute(_) | JointKind::Prismatic(_) | JointKind::Weld => {}
+            JointKind::Planar(_) if !j.actuated => {}
+            JointKind::Planar(_) => return Err(format!("planar joint `{}` is actuated", j.name)),
             _ => {
                 return Err(format!(
-                    "joint `{}` is not revolute, prismatic or fixed",
+                    "joint `{}` is not revolute, prismatic, planar or fixed",
                     j.name
                 ))
             }
-        }
-        if j.dependent {
-            return Err(format!("joint `{}` is dependent", j.name));
-        }
-        if j.at.is_some() {
-            return Err(format!("joint `{}` is placed with `at`", j.name));
         }
         if j.actuated {
             inputs.push(format!("tau_{}", j.name));
@@ -238,18 +237,8 @@ fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
         }
     }
     let declared: Vec<String> = ast.coordinates.iter().map(|c| c.to_string()).collect();
-    if declared != coordinates {
+    if declared != joint_coordinates(ast) {
         return Err("the model has coordinates no joint makes".into());
-    }
-    let speeds_match = ast.speeds.as_ref().is_some_and(|(list, _)| {
-        list.len() == coordinates.len()
-            && list
-                .iter()
-                .zip(&coordinates)
-                .all(|(s, q)| s.definition.is_none() && s.name == q)
-    });
-    if !speeds_match && !coordinates.is_empty() {
-        return Err("the privileged speeds are not the joint rates in joint order".into());
     }
     let declared_inputs: Vec<String> = ast.inputs.iter().map(|i| i.to_string()).collect();
     if declared_inputs != inputs {
@@ -260,6 +249,47 @@ fn model_level_checks(ast: &ModelAst) -> Result<(), String> {
         return Err("the model has loads other than gravity and joint actuation".into());
     }
     Ok(())
+}
+
+/// What a plain tree may not have besides: constraints, rolling contacts,
+/// dependent joints, speeds other than the joint rates.
+fn plain_checks(ast: &ModelAst) -> Result<(), String> {
+    if !ast.holonomic.is_empty() || !ast.nonholonomic.is_empty() {
+        return Err("the model has constraints".into());
+    }
+    if !ast.rolls.is_empty() {
+        return Err("the model has rolling contacts".into());
+    }
+    if let Some(j) = ast.joints.iter().find(|j| j.dependent) {
+        return Err(format!("joint `{}` is dependent", j.name));
+    }
+    let coordinates = joint_coordinates(ast);
+    let speeds_match = ast.speeds.as_ref().is_some_and(|(list, _)| {
+        list.len() == coordinates.len()
+            && list
+                .iter()
+                .zip(&coordinates)
+                .all(|(s, q)| s.definition.is_none() && s.name == q)
+    });
+    if !speeds_match && !coordinates.is_empty() {
+        return Err("the privileged speeds are not the joint rates in joint order".into());
+    }
+    Ok(())
+}
+
+/// The coordinates the joints make, in order (a planar joint's three).
+fn joint_coordinates(ast: &ModelAst) -> Vec<String> {
+    let mut out = Vec::new();
+    for j in &ast.joints {
+        match j.kind {
+            JointKind::Planar(_) => {
+                out.extend(["_x", "_y", "_angle"].map(|s| format!("{}{s}", j.name)))
+            }
+            JointKind::Weld => {}
+            _ => out.push(j.name.to_string()),
+        }
+    }
+    out
 }
 
 /// The names that vary: coordinates, inputs and time.
@@ -300,24 +330,27 @@ fn frame_at(
     Ok(Some((link, turns)))
 }
 
-/// The link a joint makes, placed in its parent frame; None while the
-/// parent frame or its origin is not resolved.
-fn link_of(
+/// The links a joint makes, placed in its parent frame (a planar joint's
+/// three: two massless slides and the turn that carries the child, the
+/// first at index `first`); None while the parent frame or its origin is
+/// not resolved.
+fn links_of(
     j: &JointDef,
     ast: &ModelAst,
     frames: &HashMap<String, FrameAt>,
     points: &HashMap<String, PointAt>,
-) -> Result<Option<LinkSpec>, String> {
+    first: usize,
+) -> Result<Option<Vec<LinkSpec>>, String> {
     let Some((parent, parent_turns)) = frames.get(&j.parent.to_string()).cloned() else {
         return Ok(None);
     };
-    let origin = if j.parent == "N" {
-        "O".to_string()
-    } else {
-        match ast.origins.iter().find(|(f, _)| *f == j.parent) {
+    let origin = match (&j.at, j.parent == "N") {
+        (Some(p), _) => p.to_string(),
+        (None, true) => "O".to_string(),
+        (None, false) => match ast.origins.iter().find(|(f, _)| *f == j.parent) {
             Some((_, p)) => p.to_string(),
             None => return Ok(None),
-        }
+        },
     };
     let Some((origin_link, parent_origin)) = points.get(&origin).cloned() else {
         return Ok(None);
@@ -328,21 +361,42 @@ fn link_of(
             j.name
         ));
     }
-    let motion = match &j.kind {
-        JointKind::Revolute(a) => Some(Motion::Revolute(a.clone())),
-        JointKind::Prismatic(a) => Some(Motion::Prismatic(a.clone())),
-        _ => None,
-    };
-    Ok(Some(LinkSpec {
-        joint: j.name.to_string(),
+    let link = |joint: String, motion: Option<Motion>| LinkSpec {
+        joint,
         parent,
-        parent_turns,
-        parent_origin,
+        parent_turns: parent_turns.clone(),
+        parent_origin: parent_origin.clone(),
         xyz: j.xyz.clone(),
         rpy: j.rpy.clone(),
         motion,
         actuated: j.actuated,
         bodies: Vec::new(),
+    };
+    let name = j.name.to_string();
+    Ok(Some(match &j.kind {
+        JointKind::Revolute(a) => vec![link(name, Some(Motion::Revolute(a.clone())))],
+        JointKind::Prismatic(a) => vec![link(name, Some(Motion::Prismatic(a.clone())))],
+        JointKind::Planar(k) => {
+            let slide = |i: usize| Some(Motion::Prismatic(JointAxis::Unit((k + i) % 3, false)));
+            let next = |joint: String, parent: usize, motion: Option<Motion>| LinkSpec {
+                joint,
+                parent: Some(parent),
+                parent_turns: Vec::new(),
+                parent_origin: Vec::new(),
+                xyz: None,
+                rpy: None,
+                motion,
+                actuated: false,
+                bodies: Vec::new(),
+            };
+            let turn = Some(Motion::Revolute(JointAxis::Unit(*k, false)));
+            vec![
+                link(format!("{name}_x"), slide(1)),
+                next(format!("{name}_y"), first, slide(2)),
+                next(format!("{name}_angle"), first + 1, turn),
+            ]
+        }
+        _ => vec![link(name, None)],
     }))
 }
 

@@ -8,10 +8,14 @@
 //! by its children, so the form grows linearly with the links where the
 //! closed form of Appell's equations grows like n³.
 //!
+//! A tree under constraints gets M and f projected onto its privileged
+//! speeds instead ([`projected`]).
+//!
 //! Input: the model's [`TreeSpec`]; output: [`Structured`].
 
 pub mod equations;
 mod links;
+pub mod projected;
 mod recursions;
 pub mod spatial;
 

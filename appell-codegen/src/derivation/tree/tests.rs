@@ -1,9 +1,9 @@
 //! The structured form against the closed form of the same model: M, the
 //! bias, inverse dynamics and ÿ agree at random states.
 
-use super::structured;
+use super::{projected::projected, structured};
 use crate::derivation::testing::kinematics;
-use crate::derivation::{derive, Derived};
+use crate::derivation::{derive, derive_with, Derived, Options};
 
 /// Every kind of link the tree takes: revolute joints about coordinate
 /// and skew axes, a prismatic joint, a weld carrying a body, rpy
@@ -43,7 +43,11 @@ fn state(d: &Derived, seed: u64) -> Vec<(String, f64)> {
         (x % 20000) as f64 / 10000.0 - 1.0
     };
     let g = &d.model.g;
-    let mut out = vec![("m".to_string(), 1.7)];
+    let mut out = vec![
+        ("m".to_string(), 1.7),
+        ("r".to_string(), 0.1),
+        ("w".to_string(), 0.25),
+    ];
     for (q, c) in &d.model.coords {
         out.push((q.to_string(), 3.0 * next()));
         out.push((g.symbol_name(c.rate).to_string(), next()));
@@ -147,4 +151,71 @@ fn lookup(at: &[(&str, f64)], name: &str) -> f64 {
         .find(|(n, _)| *n == name)
         .map(|(_, v)| *v)
         .expect("bound")
+}
+
+/// A differential-drive base (a dependent planar joint, two rolling
+/// wheels) carrying a two-link arm placed with `at`.
+const ON_WHEELS: &str = r#"
+    #[appell(positive(r, w), gravity(-9.81 * N.z))]
+    #[appell(joint(base, planar(z), parent = N, child = c, xyz = [0, 0, r], dependent),
+             joint(left, revolute(y), parent = c, child = lw, xyz = [0, w, 0], actuated),
+             joint(right, revolute(y), parent = c, child = rw, xyz = [0, -w, 0], actuated),
+             point(mount = c_origin + 0.1 * c.x + 0.3 * c.z),
+             joint(j_1, revolute(z), parent = c, child = a_1, at = mount, actuated),
+             joint(j_2, revolute(-y), parent = a_1, child = a_2, xyz = [0, 0.05, 0.2], rpy = [0.2, 0, 0.1], actuated),
+             point(lp = lw_origin - r * N.z), point(rp = rw_origin - r * N.z))]
+    #[appell(body(chassis, center = c_origin - 0.1 * c.x + 0.05 * c.z, frame = c, mass = m,
+                  inertia = principal(1.0, 1.5, 2.0)),
+             body(left_wheel, center = lw_origin, frame = lw, mass = 2, inertia = principal(0.005, 0.01, 0.005)),
+             body(right_wheel, center = rw_origin, frame = rw, mass = 2, inertia = principal(0.005, 0.01, 0.005)),
+             body(b_1, frame = a_1, mass = 1.3, center = origin(a_1) + 0.02 * a_1.x + 0.1 * a_1.z,
+                  inertia = matrix(0.02, 0.03, 0.01, 0.001, 0.0015, -0.002)),
+             body(b_2, frame = a_2, mass = 0.8, center = origin(a_2) + 0.2 * a_2.x + 0.03 * a_2.y,
+                  inertia = principal(0.01, 0.02, 0.015)),
+             rolls(left_wheel, contact = lp, along = [c.x, c.y]),
+             rolls(right_wheel, contact = rp, along = [c.x]))]
+    struct OnWheels { m: f64, r: f64, w: f64 }
+"#;
+
+#[test]
+fn the_projected_tree_agrees_with_the_closed_form() {
+    let cx = crate::ctxt::Ctxt::new();
+    let options = Options {
+        closed_form_only: true,
+        ..Options::default()
+    };
+    let mut d = derive_with(&cx, kinematics(ON_WHEELS), &options).expect("derived");
+    cx.check().expect("no errors");
+    let spec = d.model.tree.clone().expect("a tree");
+    assert_eq!(
+        spec.plain.as_ref().unwrap_err(),
+        "the model has rolling contacts"
+    );
+    // The planar joint's three links, two wheels, two arm links.
+    assert_eq!(spec.links.len(), 7);
+    let l = d.full.l;
+    assert_eq!(l, 4);
+    let (map, fixed) = (d.full.map.clone(), d.full.reduction.ignorable.clone());
+    assert_eq!(fixed.len(), 5, "the base's pose and the wheels' angles");
+    let p = projected(&mut d.model, &spec, &map, &fixed).expect("projected");
+    let (mass, forcing) = (&d.full.equations.mass, &d.full.equations.forcing);
+    for seed in 1..6 {
+        let values = state(&d, seed * 104_729);
+        let at: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+        let value = |e| d.model.g.eval_named(e, &at).expect("evaluates");
+        for k in 0..l * l {
+            let (a, b) = (value(p.mass[k]), value(mass[k]));
+            assert!(
+                (a - b).abs() < 1e-12 * (1.0 + b.abs()),
+                "M[{k}]: {a} vs {b}"
+            );
+        }
+        for k in 0..l {
+            let (a, b) = (value(p.forcing[k]), value(forcing[k]));
+            assert!(
+                (a - b).abs() < 1e-11 * (1.0 + b.abs()),
+                "f[{k}]: {a} vs {b}"
+            );
+        }
+    }
 }
