@@ -76,3 +76,25 @@ pub use appell_runtime::*;
 /// The symbolic engine (interned expressions, differentiation, CSE, emission).
 #[cfg(feature = "std")]
 pub use appell_symbolic as symbolic;
+
+/// The task guides of `docs/guide/`, compiled here so that `cargo test`
+/// runs every code block on those pages.
+#[cfg(doctest)]
+pub mod guide {
+    #[doc = include_str!("../docs/guide/writing-a-model.md")]
+    pub struct WritingAModel;
+    #[doc = include_str!("../docs/guide/joints-and-urdf.md")]
+    pub struct JointsAndUrdf;
+    #[doc = include_str!("../docs/guide/scenes.md")]
+    pub struct Scenes;
+    #[doc = include_str!("../docs/guide/integrators.md")]
+    pub struct Integrators;
+    #[doc = include_str!("../docs/guide/constraint-forces.md")]
+    pub struct ConstraintForces;
+    #[doc = include_str!("../docs/guide/linearization-and-control.md")]
+    pub struct LinearizationAndControl;
+    #[doc = include_str!("../docs/guide/command-line.md")]
+    pub struct CommandLine;
+    #[doc = include_str!("../docs/guide/compile-errors.md")]
+    pub struct CompileErrors;
+}
