@@ -81,6 +81,8 @@ pub use appell_symbolic as symbolic;
 /// runs every code block on those pages.
 #[cfg(doctest)]
 pub mod guide {
+    #[doc = include_str!("../README.md")]
+    pub struct Readme;
     #[doc = include_str!("../docs/guide/writing-a-model.md")]
     pub struct WritingAModel;
     #[doc = include_str!("../docs/guide/joints-and-urdf.md")]
