@@ -99,4 +99,6 @@ pub mod guide {
     pub struct CommandLine;
     #[doc = include_str!("../docs/guide/compile-errors.md")]
     pub struct CompileErrors;
+    #[doc = include_str!("../docs/guide/pictures.md")]
+    pub struct Pictures;
 }

@@ -15,6 +15,8 @@
 #[cfg(feature = "std")]
 pub mod accuracy;
 #[cfg(feature = "std")]
+pub mod animate;
+#[cfg(feature = "std")]
 pub mod augmented;
 #[cfg(feature = "std")]
 pub mod cli;
