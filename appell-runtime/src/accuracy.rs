@@ -12,10 +12,11 @@
 
 use std::time::Instant;
 
+use crate::dynamic::{DynRhs, Prepared};
 use crate::integrate::{
-    heun_step, midpoint_step, rk4_step, Dop853, Dopri5, IntegrateError, TrBdf2,
+    heun_step_fn, midpoint_step_fn, rk4_step_fn, Dop853, Dopri5, IntegrateError, TrBdf2,
 };
-use crate::model::Model;
+use crate::model::{Model, ModelError};
 
 /// An integrator and its setting.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -101,14 +102,7 @@ impl<M: Model, const S: usize> Problem<'_, M, S> {
     /// 1e-14).
     #[allow(clippy::type_complexity)] // (states at the checkpoints, error estimate)
     pub fn reference(&self) -> Result<(Vec<[f64; S]>, f64), IntegrateError> {
-        let tight = integrate(self, Method::Dop853(1e-15))?.0;
-        let loose = integrate(self, Method::Dop853(1e-14))?.0;
-        let estimate = tight
-            .iter()
-            .zip(&loose)
-            .map(|(a, b)| relative_error(a, b))
-            .fold(0.0, f64::max);
-        Ok((tight, estimate))
+        self.run().reference(&Prepared::new(self.model))
     }
 
     /// Runs every method against `reference`; the wall time is the median
@@ -120,18 +114,73 @@ impl<M: Model, const S: usize> Problem<'_, M, S> {
         reference: &[[f64; S]],
         methods: &[Method],
         repeats: usize,
+        progress: impl FnMut(usize, usize),
+    ) -> Vec<Point> {
+        self.run().sweep(
+            &Prepared::new(self.model),
+            reference,
+            methods,
+            repeats,
+            progress,
+        )
+    }
+
+    fn run(&self) -> Run<'_, S> {
+        Run {
+            x0: self.x0,
+            t_end: self.t_end,
+            inputs: self.inputs,
+            checkpoints: self.checkpoints,
+        }
+    }
+}
+
+/// A [`Problem`] without its model: what [`Problem::reference`] and
+/// [`Problem::sweep`] run on a prepared rhs (the command line's sweep runs
+/// it on a `dyn DynRhs`, compiled once).
+pub(crate) struct Run<'a, const S: usize> {
+    pub(crate) x0: [f64; S],
+    pub(crate) t_end: f64,
+    pub(crate) inputs: &'a [f64],
+    pub(crate) checkpoints: usize,
+}
+
+impl<const S: usize> Run<'_, S> {
+    /// [`Problem::reference`].
+    #[allow(clippy::type_complexity)] // (states at the checkpoints, error estimate)
+    pub(crate) fn reference<R: DynRhs + ?Sized>(
+        &self,
+        rhs: &R,
+    ) -> Result<(Vec<[f64; S]>, f64), IntegrateError> {
+        let tight = integrate(rhs, self, Method::Dop853(1e-15))?.0;
+        let loose = integrate(rhs, self, Method::Dop853(1e-14))?.0;
+        let estimate = tight
+            .iter()
+            .zip(&loose)
+            .map(|(a, b)| relative_error(a, b))
+            .fold(0.0, f64::max);
+        Ok((tight, estimate))
+    }
+
+    /// [`Problem::sweep`].
+    pub(crate) fn sweep<R: DynRhs + ?Sized>(
+        &self,
+        rhs: &R,
+        reference: &[[f64; S]],
+        methods: &[Method],
+        repeats: usize,
         mut progress: impl FnMut(usize, usize),
     ) -> Vec<Point> {
         let mut points = Vec::with_capacity(methods.len());
         for (i, &method) in methods.iter().enumerate() {
             progress(i, methods.len());
-            let Ok((states, rhs_calls, steps)) = integrate(self, method) else {
+            let Ok((states, rhs_calls, steps)) = integrate(rhs, self, method) else {
                 continue;
             };
             let mut times = Vec::with_capacity(repeats.max(1));
             for _ in 0..repeats.max(1) {
                 let start = Instant::now();
-                let r = integrate(self, method);
+                let r = integrate(rhs, self, method);
                 times.push(start.elapsed().as_secs_f64());
                 std::hint::black_box(r.ok());
             }
@@ -164,12 +213,22 @@ fn relative_error<const S: usize>(x: &[f64; S], reference: &[f64; S]) -> f64 {
 
 /// One integration with `method`: the states at the checkpoints, the number
 /// of rhs calls and the number of steps.
-fn integrate<M: Model, const S: usize>(
-    pb: &Problem<'_, M, S>,
+fn integrate<R: DynRhs + ?Sized, const S: usize>(
+    rhs: &R,
+    pb: &Run<'_, S>,
     method: Method,
 ) -> Result<(Vec<[f64; S]>, u64, u64), IntegrateError> {
-    let (model, inputs, checkpoints, t_end) =
-        (pb.model, pb.inputs, pb.checkpoints.max(1), pb.t_end);
+    let (inputs, checkpoints, t_end) = (pb.inputs, pb.checkpoints.max(1), pb.t_end);
+    let expected = rhs.state_len();
+    if S != expected {
+        return Err(ModelError::Length {
+            argument: "state",
+            expected,
+            found: S,
+        }
+        .into());
+    }
+    let mut f = |t: f64, x: &[f64; S], dx: &mut [f64; S]| rhs.rhs(t, x, inputs, dx);
     match method {
         Method::Dopri5(tol) | Method::Dop853(tol) => {
             let mut out: Vec<(f64, [f64; S])> = (1..=checkpoints)
@@ -178,14 +237,10 @@ fn integrate<M: Model, const S: usize>(
             let (rtol, atol, max_steps) = (tol, tol * 1e-2, 10_000_000);
             let stats = if let Method::Dopri5(_) = method {
                 let solver = Dopri5::new().rtol(rtol).atol(atol).max_steps(max_steps);
-                solver
-                    .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?
-                    .stats
+                solver.solve_at(f, 0.0, &pb.x0, &mut out)?.stats
             } else {
                 let solver = Dop853::new().rtol(rtol).atol(atol).max_steps(max_steps);
-                solver
-                    .solve_model_at(model, inputs, 0.0, &pb.x0, &mut out)?
-                    .stats
+                solver.solve_at(f, 0.0, &pb.x0, &mut out)?.stats
             };
             Ok((
                 out.into_iter().map(|(_, x)| x).collect(),
@@ -201,7 +256,7 @@ fn integrate<M: Model, const S: usize>(
                 .rtol(tol)
                 .atol(tol * 1e-2)
                 .max_steps(10_000_000)
-                .solve_model_at(model, 0.0, &pb.x0, &mut out, inputs)?;
+                .solve_prepared_at(rhs, 0.0, &pb.x0, &mut out, inputs)?;
             let states = out
                 .iter()
                 .map(|(_, x)| {
@@ -217,7 +272,6 @@ fn integrate<M: Model, const S: usize>(
             ))
         }
         Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => {
-            let prepared = model.prepare::<f64>();
             // Round the step count up to a multiple of the checkpoints.
             let per = n.div_ceil(checkpoints).max(1);
             let steps = per * checkpoints;
@@ -231,9 +285,9 @@ fn integrate<M: Model, const S: usize>(
             for k in 0..steps {
                 let t = k as f64 * h;
                 x = match method {
-                    Method::Rk4(_) => rk4_step(model, &prepared, t, h, &x, inputs)?,
-                    Method::Heun(_) => heun_step(model, &prepared, t, h, &x, inputs)?,
-                    _ => midpoint_step(model, &prepared, t, h, &x, inputs)?,
+                    Method::Rk4(_) => rk4_step_fn(&mut f, t, h, &x)?,
+                    Method::Heun(_) => heun_step_fn(&mut f, t, h, &x)?,
+                    _ => midpoint_step_fn(&mut f, t, h, &x)?,
                 };
                 if (k + 1) % per == 0 {
                     out.push(x);

@@ -43,6 +43,7 @@
 //!
 //! Anything else is reported as [`Normal::Unavailable`], never guessed.
 
+use crate::dynamic::DynModel;
 use crate::model::{Model, ModelInfo, RowSource};
 use crate::oracle::{self, finite_all as finite, mul, mul_bt, vee, OracleError};
 use crate::scalar::Scalar;
@@ -248,14 +249,14 @@ pub(crate) struct BodyMotion {
     pub alpha: Vec<[f64; 3]>,
 }
 
-pub(crate) fn body_motion<M: Model>(
-    model: &M,
+pub(crate) fn body_motion<K: DynModel + ?Sized>(
+    model: &K,
     t: f64,
     q: &[f64],
     qdot: &[f64],
     qddot: &[f64],
 ) -> Result<BodyMotion, OracleError> {
-    let nb = M::info().bodies.len();
+    let nb = model.dyn_info().bodies.len();
     let path: Vec<Dual2_64> = q
         .iter()
         .zip(qdot)
@@ -264,7 +265,7 @@ pub(crate) fn body_motion<M: Model>(
         .collect();
     let mut pos = vec![[Dual2_64::zero(); 3]; nb];
     let mut rot = vec![[Dual2_64::zero(); 9]; nb];
-    model.body_poses(Dual2_64::new(t, 1.0, 0.0), &path, &mut pos, &mut rot)?;
+    model.dyn_body_poses_dual2(Dual2_64::new(t, 1.0, 0.0), &path, &mut pos, &mut rot)?;
     let mut m = BodyMotion {
         position: Vec::with_capacity(nb),
         rotation: Vec::with_capacity(nb),
@@ -319,7 +320,18 @@ pub fn contact_forces<M: Model>(
     u: &[f64],
     inputs: &[f64],
 ) -> Result<ConstraintForces, OracleError> {
-    let info = M::info();
+    contact_forces_dyn(model, t, q, u, inputs)
+}
+
+/// [`contact_forces`] of any [`DynModel`] (compiled once for `dyn DynModel`).
+pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+) -> Result<ConstraintForces, OracleError> {
+    let info = model.dyn_info();
     let (n, m) = (info.coordinates.len(), info.constraints);
     if info.row_sources.len() != m {
         return Err(OracleError::InvalidInfo(format!(
@@ -327,11 +339,11 @@ pub fn contact_forces<M: Model>(
             info.row_sources.len()
         )));
     }
-    let qdot = oracle::coordinate_rates(model, t, q, u)?;
-    let sol = oracle::accelerations(model, t, q, &qdot, inputs)?;
+    let qdot = oracle::coordinate_rates_dyn(model, t, q, u)?;
+    let sol = oracle::accelerations_dyn(model, t, q, &qdot, inputs)?;
     let mut dmat = vec![0.0; m * n];
     let mut d0 = vec![0.0; m];
-    model.constraint_rows(t, q, &mut dmat, &mut d0)?;
+    model.dyn_constraint_rows(t, q, &mut dmat, &mut d0)?;
     let rows: Vec<RowReaction> = (0..m)
         .map(|s| RowReaction {
             source: info.row_sources[s],
@@ -346,7 +358,7 @@ pub fn contact_forces<M: Model>(
     let nc = info.contacts.len();
     let mut points = vec![[0.0; 3]; nc];
     let mut directions = vec![[0.0; 3]; m];
-    model.contact_geometry(t, q, &mut points, &mut directions)?;
+    model.dyn_contact_geometry(t, q, &mut points, &mut directions)?;
     finite(
         points.iter().chain(&directions).flatten().copied(),
         "the contact geometry",
@@ -512,8 +524,8 @@ pub fn contact_forces<M: Model>(
 
 /// For every contact, ∂v_P/∂q̇_r (r < n) and the time part (r = n) of the
 /// velocity of the body's material point at the contact.
-fn point_jacobians<M: Model>(
-    model: &M,
+fn point_jacobians<K: DynModel + ?Sized>(
+    model: &K,
     info: &ModelInfo,
     t: f64,
     q: &[f64],
@@ -522,7 +534,7 @@ fn point_jacobians<M: Model>(
     let (n, nb) = (q.len(), info.bodies.len());
     let mut pos0 = vec![[0.0; 3]; nb];
     let mut rot0 = vec![[0.0; 9]; nb];
-    model.body_poses(t, q, &mut pos0, &mut rot0)?;
+    model.dyn_body_poses(t, q, &mut pos0, &mut rot0)?;
     let mut out = vec![vec![[0.0; 3]; n + 1]; points.len()];
     let mut qd: Vec<Dual64> = q.iter().map(|&x| Dual64::new(x, 0.0)).collect();
     let mut pos = vec![[Dual64::zero(); 3]; nb];
@@ -534,7 +546,7 @@ fn point_jacobians<M: Model>(
             qd[r].eps = 1.0;
             Dual64::new(t, 0.0)
         };
-        model.body_poses(td, &qd, &mut pos, &mut rot)?;
+        model.dyn_body_poses_dual(td, &qd, &mut pos, &mut rot)?;
         if r < n {
             qd[r].eps = 0.0;
         }
@@ -553,8 +565,8 @@ fn point_jacobians<M: Model>(
 /// linear and angular momentum balances, or `None` when they do not close
 /// or do not determine them.
 #[allow(clippy::too_many_arguments)] // one internal step of `contact_forces`
-fn balance_normals<M: Model>(
-    model: &M,
+fn balance_normals<K: DynModel + ?Sized>(
+    model: &K,
     t: f64,
     q: &[f64],
     qdot: &[f64],
@@ -564,18 +576,18 @@ fn balance_normals<M: Model>(
     unknown: &[usize],
     normals: &[Option<[f64; 3]>],
 ) -> Result<Option<Vec<f64>>, OracleError> {
-    let info = M::info();
+    let info = model.dyn_info();
     let nb = info.bodies.len();
     let mut masses = vec![0.0; nb];
     let mut inertias = vec![[0.0; 9]; nb];
-    model.mass_properties(&mut masses, &mut inertias)?;
+    model.dyn_mass_properties(&mut masses, &mut inertias)?;
     let (nf, nt) = (info.force_points, info.torques);
     let mut fpoints = vec![[0.0; 3]; nf];
     let mut frames = vec![[0.0; 9]; nt];
-    model.load_geometry(t, q, &mut fpoints, &mut frames)?;
+    model.dyn_load_geometry(t, q, &mut fpoints, &mut frames)?;
     let mut forces = vec![[0.0; 3]; nf];
     let mut torques = vec![[0.0; 3]; nt];
-    model.load_values(t, q, qdot, inputs, &mut forces, &mut torques)?;
+    model.dyn_load_values(t, q, qdot, inputs, &mut forces, &mut torques)?;
     // Moments about the first unknown contact keep the numbers small.
     let o = contacts[unknown[0]].position;
     let mut lin = [0.0; 3];

@@ -9,6 +9,7 @@
 //! other load left out of V (friction, damping, a motor without an input),
 //! and on a scene it shows what the chosen effects put in.
 
+use crate::dynamic::DynModel;
 use crate::model::{Model, ModelError};
 use crate::motion::first_rates;
 use num_dual::Dual64;
@@ -96,15 +97,26 @@ pub fn energies<M: Model>(
     u: &[f64],
     inputs: &[f64],
 ) -> Result<Energies, ModelError> {
+    energies_dyn(model, t, q, u, inputs)
+}
+
+/// [`energies`] of any [`DynModel`] (compiled once for `dyn DynModel`).
+pub(crate) fn energies_dyn<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+) -> Result<Energies, ModelError> {
     let (qdot, udot) = first_rates(model, t, q, u, inputs, "energy arguments")?;
 
     let seeded = |x: &[f64], dx: &[f64]| -> Vec<Dual64> {
         x.iter().zip(dx).map(|(&v, &d)| Dual64::new(v, d)).collect()
     };
     let (td, qd, ud) = (Dual64::new(t, 1.0), seeded(q, &qdot), seeded(u, &udot));
-    let kinetic = model.kinetic_energy(td, &qd, &ud)?;
-    let potential = model.potential_energy(td, &qd)?;
-    let input_power = model.input_power(t, q, u, inputs)?;
+    let kinetic = model.dyn_kinetic_energy_dual(td, &qd, &ud)?;
+    let potential = model.dyn_potential_energy_dual(td, &qd)?;
+    let input_power = model.dyn_input_power(t, q, u, inputs)?;
     let e = Energies {
         kinetic: kinetic.re,
         potential: potential.re,

@@ -23,6 +23,8 @@ pub mod cli;
 #[cfg(feature = "std")]
 pub mod constraint_forces;
 #[cfg(feature = "std")]
+pub mod dynamic;
+#[cfg(feature = "std")]
 pub mod energy;
 pub mod integrate;
 pub mod linalg;
@@ -41,6 +43,9 @@ pub use model::{
     SceneVisitor,
 };
 pub use scalar::Scalar;
+
+#[cfg(feature = "std")]
+pub use dynamic::{DynModel, DynRhs};
 
 /// nalgebra, the matrices of [`linearize`] and of the oracle, re-exported so
 /// that a user needs no dependency line of their own (nor to match its

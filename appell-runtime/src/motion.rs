@@ -6,6 +6,7 @@
 //! motion (eq. 31 differentiated: C u̇ + Ċ u + ċ), from one evaluation of
 //! `coordinate_rates` in [`Dual64`] numbers seeded with ṫ = 1, q̇ and u̇.
 
+use crate::dynamic::DynModel;
 use crate::model::{check_len, Model, ModelError};
 use num_dual::Dual64;
 
@@ -107,15 +108,15 @@ pub fn rates<M: Model>(
 
 /// q̇ and u̇ at a full state, its arguments checked first (`what` names
 /// them in the non-finite error).
-pub(crate) fn first_rates<M: Model>(
-    model: &M,
+pub(crate) fn first_rates<K: DynModel + ?Sized>(
+    model: &K,
     t: f64,
     q: &[f64],
     u: &[f64],
     inputs: &[f64],
     what: &'static str,
 ) -> Result<(Vec<f64>, Vec<f64>), ModelError> {
-    let info = M::info();
+    let info = model.dyn_info();
     check_len("q", q, info.coordinates.len())?;
     check_len("u", u, info.speeds.len())?;
     check_len("inputs", inputs, info.inputs.len())?;
@@ -132,10 +133,9 @@ pub(crate) fn first_rates<M: Model>(
     }
     state.extend_from_slice(u);
     let mut dstate = vec![0.0; info.state_len()];
-    let prepared = model.prepare::<f64>();
-    model.rhs(&prepared, t, &state, inputs, &mut dstate)?;
+    model.dyn_rhs(t, &state, inputs, &mut dstate)?;
     let udot = dstate[info.retained.len()..].to_vec();
     let mut qdot = vec![0.0; q.len()];
-    model.coordinate_rates(t, q, u, &mut qdot)?;
+    model.dyn_coordinate_rates(t, q, u, &mut qdot)?;
     Ok((qdot, udot))
 }

@@ -2,6 +2,7 @@
 
 use super::error::CliError;
 use super::output::finite_or_null;
+use crate::dynamic::DynModel;
 use crate::model::Model;
 use serde_json::{json, Value};
 use std::hint::black_box;
@@ -109,7 +110,12 @@ fn time_per_call(calls: usize, mut pass: impl FnMut()) -> f64 {
 /// states at least); a runnable example would be slow, so see the module
 /// documentation and the crate's tests.
 pub fn bench<M: Model>(model: &M) -> Result<BenchReport, CliError> {
-    let info = M::info();
+    bench_dyn(model)
+}
+
+/// [`bench()`] of any [`DynModel`], compiled once.
+pub(super) fn bench_dyn(model: &dyn DynModel) -> Result<BenchReport, CliError> {
+    let info = model.dyn_info();
     let n = info.coordinates.len();
     let mut retained = Vec::with_capacity(info.retained.len());
     for r in info.retained {
@@ -118,7 +124,7 @@ pub fn bench<M: Model>(model: &M) -> Result<BenchReport, CliError> {
                 .ok_or_else(|| CliError::Bench(format!("retained `{r}` is not a coordinate")))?,
         );
     }
-    let prepared = model.prepare::<f64>();
+    let prepared = model.dyn_prepare();
     let mut rng = SplitMix(BENCH_SEED);
     let mut states = Vec::with_capacity(BENCH_STATES);
     let mut dstate = vec![0.0; info.state_len()];
@@ -129,8 +135,8 @@ pub fn bench<M: Model>(model: &M) -> Result<BenchReport, CliError> {
         let inputs: Vec<f64> = info.inputs.iter().map(|_| rng.symmetric()).collect();
         let mut state: Vec<f64> = retained.iter().map(|&i| q_full[i]).collect();
         state.extend_from_slice(&u);
-        let rhs = model.rhs(&prepared, 0.0, &state, &inputs, &mut dstate);
-        let oracle = crate::oracle::reduced_rhs(model, 0.0, &q_full, &u, &inputs);
+        let rhs = prepared.rhs(0.0, &state, &inputs, &mut dstate);
+        let oracle = crate::oracle::reduced_rhs_dyn(model, 0.0, &q_full, &u, &inputs);
         match (rhs, oracle) {
             (Ok(()), Ok(_)) if dstate.iter().all(|x| x.is_finite()) => states.push(BenchState {
                 q_full,
@@ -149,21 +155,16 @@ pub fn bench<M: Model>(model: &M) -> Result<BenchReport, CliError> {
         )));
     }
 
+    let cases: Vec<(&[f64], &[f64])> = states
+        .iter()
+        .map(|s| (s.state.as_slice(), s.inputs.as_slice()))
+        .collect();
     let rhs_ns = time_per_call(states.len(), || {
-        for s in &states {
-            let r = model.rhs(
-                black_box(&prepared),
-                black_box(0.0),
-                black_box(&s.state),
-                black_box(&s.inputs),
-                black_box(&mut dstate),
-            );
-            let _ = black_box((r, &dstate));
-        }
+        prepared.rhs_pass(0.0, &cases, &mut dstate);
     });
     let oracle_ns = time_per_call(states.len(), || {
         for s in &states {
-            let r = crate::oracle::reduced_rhs(
+            let r = crate::oracle::reduced_rhs_dyn(
                 model,
                 black_box(0.0),
                 black_box(&s.q_full),

@@ -4,7 +4,8 @@
 use super::error::CliError;
 use super::input::{named, number, Point};
 use super::output::{contact_forces_json, finite_or_null, result_number};
-use crate::model::{Model, ModelError, ModelInfo, SceneVisitor};
+use crate::dynamic::DynModel;
+use crate::model::{Model, ModelError, ModelInfo};
 use serde_json::{json, Map, Value};
 use std::io::{BufRead, Write};
 
@@ -18,8 +19,9 @@ const HOLONOMIC_TOLERANCE: f64 = 1e-9;
 use super::run_with;
 
 /// Answers every non-empty line of `stdin` on `stdout`.
-pub(super) fn eval_stream<M: Model>(
-    evaluator: &mut Evaluator<M>,
+pub(super) fn eval_stream(
+    evaluator: &EvalState,
+    model: &mut dyn DynModel,
     stdin: &mut dyn BufRead,
     stdout: &mut dyn Write,
 ) -> Result<(), CliError> {
@@ -31,7 +33,7 @@ pub(super) fn eval_stream<M: Model>(
         }
         let answer = match std::str::from_utf8(&buf) {
             Ok(line) if line.trim().is_empty() => continue,
-            Ok(line) => evaluator.eval_line(line),
+            Ok(line) => evaluator.eval_line(model, line),
             Err(_) => json!({ "error": "the line is not valid UTF-8" }),
         };
         writeln!(stdout, "{answer}")?;
@@ -48,29 +50,59 @@ pub(super) fn eval_stream<M: Model>(
 /// documentation; see [`run_with`] for an example through the command line.
 pub struct Evaluator<M: Model> {
     model: M,
+    state: EvalState,
+}
+
+impl<M: Model> Evaluator<M> {
+    /// Takes the model and records its current parameter values.
+    pub fn new(model: M) -> Result<Self, ModelError> {
+        let state = EvalState::new(&model)?;
+        Ok(Evaluator { model, state })
+    }
+
+    /// An evaluator of the scene named `name` (as in `info`'s `scenes`: the
+    /// part after `::`, or the whole name).
+    pub fn with_scene(model: M, name: &str) -> Result<Self, CliError> {
+        let state = EvalState::with_scene(&model, name)?;
+        Ok(Evaluator { model, state })
+    }
+
+    /// The model (with the parameters of the last evaluated line).
+    pub fn model(&self) -> &M {
+        &self.model
+    }
+
+    /// Answers one line: `{"qdot": {..}, "udot": {..}}` or
+    /// `{"error": ".."}`.
+    pub fn eval_line(&mut self, line: &str) -> Value {
+        self.state.eval_line(&mut self.model, line)
+    }
+}
+
+/// What an [`Evaluator`] keeps besides its model; its methods take the
+/// model as a `&dyn DynModel`, so they are compiled once.
+pub(super) struct EvalState {
     defaults: Vec<f64>,
     scene: Option<usize>,
     /// Answer with the constraint forces instead of the rates (`contacts`).
     pub(super) contacts: bool,
 }
 
-impl<M: Model> Evaluator<M> {
-    /// Takes the model and records its current parameter values.
-    pub fn new(model: M) -> Result<Self, ModelError> {
-        let mut defaults = vec![0.0; M::info().parameters.len()];
-        model.parameter_values(&mut defaults)?;
-        Ok(Evaluator {
-            model,
+impl EvalState {
+    /// Records the model's current parameter values.
+    pub(super) fn new(model: &dyn DynModel) -> Result<Self, ModelError> {
+        let mut defaults = vec![0.0; model.dyn_info().parameters.len()];
+        model.dyn_parameter_values(&mut defaults)?;
+        Ok(EvalState {
             defaults,
             scene: None,
             contacts: false,
         })
     }
 
-    /// An evaluator of the scene named `name` (as in `info`'s `scenes`: the
-    /// part after `::`, or the whole name).
-    pub fn with_scene(model: M, name: &str) -> Result<Self, CliError> {
-        let scenes = M::scene_infos();
+    /// The state of an evaluator of the scene named `name`.
+    pub(super) fn with_scene(model: &dyn DynModel, name: &str) -> Result<Self, CliError> {
+        let scenes = model.dyn_scene_infos();
         let index = scenes
             .iter()
             .position(|s| s.name == name || s.name.rsplit("::").next() == Some(name))
@@ -85,20 +117,15 @@ impl<M: Model> Evaluator<M> {
                     }
                 ))
             })?;
-        let mut e = Evaluator::new(model)?;
+        let mut e = EvalState::new(model)?;
         e.scene = Some(index);
         Ok(e)
     }
 
-    /// The model (with the parameters of the last evaluated line).
-    pub fn model(&self) -> &M {
-        &self.model
-    }
-
     /// Answers one line: `{"qdot": {..}, "udot": {..}}` or
     /// `{"error": ".."}`.
-    pub fn eval_line(&mut self, line: &str) -> Value {
-        match self.try_eval(line) {
+    pub(super) fn eval_line(&self, model: &mut dyn DynModel, line: &str) -> Value {
+        match self.try_eval(model, line) {
             Ok(v) => v,
             Err(message) => json!({ "error": message }),
         }
@@ -106,24 +133,25 @@ impl<M: Model> Evaluator<M> {
 
     /// The info of the model or of the selected scene (a scene has the
     /// model's coordinates, speeds and parameters but its own reduced state).
-    fn info(&self) -> &'static ModelInfo {
+    fn info(&self, model: &dyn DynModel) -> &'static ModelInfo {
         match self.scene {
-            Some(i) => M::scene_infos()[i],
-            None => M::info(),
+            Some(i) => model.dyn_scene_infos()[i],
+            None => model.dyn_info(),
         }
     }
 
-    fn try_eval(&mut self, line: &str) -> Result<Value, String> {
-        let info = self.info();
+    fn try_eval(&self, model: &mut dyn DynModel, line: &str) -> Result<Value, String> {
+        let info = self.info(model);
         let value: Value =
             serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
         let Value::Object(obj) = value else {
             return Err("expected a JSON object".to_string());
         };
-        let point = self.parse_point(&obj, &[])?;
+        let point = self.parse_point(model, &obj, &[])?;
+        let model: &dyn DynModel = model;
         let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);
         let outputs = |energies: bool, contacts: bool| {
-            let visitor = Outputs {
+            let outputs = Outputs {
                 t,
                 q: &q,
                 u: &u,
@@ -132,11 +160,14 @@ impl<M: Model> Evaluator<M> {
                 contacts,
             };
             match self.scene {
-                Some(i) => self
-                    .model
-                    .visit_scene(i, visitor)
-                    .map_err(|e| e.to_string())?,
-                None => visitor.visit(&self.model),
+                Some(i) => {
+                    let mut result = None;
+                    model
+                        .dyn_visit_scene(i, &mut |scene| result = Some(outputs.of(scene)))
+                        .map_err(|e| e.to_string())?;
+                    result.unwrap_or_else(|| Err(ModelError::UnknownScene { index: i }.to_string()))
+                }
+                None => outputs.of(model),
             }
         };
         if self.contacts {
@@ -145,16 +176,13 @@ impl<M: Model> Evaluator<M> {
         }
         let mut dstate = vec![0.0; info.state_len()];
         match self.scene {
-            Some(i) => self.model.scene_rhs(i, t, &state, &inputs, &mut dstate),
-            None => {
-                let prepared = self.model.prepare::<f64>();
-                self.model.rhs(&prepared, t, &state, &inputs, &mut dstate)
-            }
+            Some(i) => model.dyn_scene_rhs(i, t, &state, &inputs, &mut dstate),
+            None => model.dyn_rhs(t, &state, &inputs, &mut dstate),
         }
         .map_err(|e| e.to_string())?;
         let mut qdot = vec![0.0; info.coordinates.len()];
-        self.model
-            .coordinate_rates(t, &q, &u, &mut qdot)
+        model
+            .dyn_coordinate_rates(t, &q, &u, &mut qdot)
             .map_err(|e| e.to_string())?;
 
         let mut qdot_out = Map::new();
@@ -169,7 +197,7 @@ impl<M: Model> Evaluator<M> {
         let mut answer = Map::new();
         answer.insert("qdot".into(), Value::Object(qdot_out));
         answer.insert("udot".into(), Value::Object(udot_out));
-        if let Some(warning) = self.holonomic_warning(info, t, &q, &qdot)? {
+        if let Some(warning) = holonomic_warning(model, info, t, &q, &qdot)? {
             answer.insert("warning".into(), warning);
         }
         let (energies, contacts) = (
@@ -182,52 +210,16 @@ impl<M: Model> Evaluator<M> {
         Ok(Value::Object(answer))
     }
 
-    /// A warning when `q` is off a holonomic constraint by more than
-    /// [`HOLONOMIC_TOLERANCE`] × (1 + max |q|): the rates are still those
-    /// of the equations at `q`, but of a state the mechanism cannot take.
-    fn holonomic_warning(
-        &self,
-        info: &ModelInfo,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-    ) -> Result<Option<Value>, String> {
-        if info.holonomic == 0 {
-            return Ok(None);
-        }
-        let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
-        self.model
-            .constraint_residuals(t, q, qdot, &mut h, &mut v)
-            .map_err(|e| e.to_string())?;
-        let scale = 1.0 + q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-        let tolerance = HOLONOMIC_TOLERANCE * scale;
-        let worst = h
-            .iter()
-            .enumerate()
-            .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
-        Ok(match worst {
-            // A NaN residual warns too.
-            Some((index, &residual)) if residual.is_nan() || residual.abs() > tolerance => {
-                Some(json!({
-                    "message": format!(
-                        "the coordinates violate holonomic constraint {index} by {residual:e} (tolerance {tolerance:e}): the rates are those of a state the mechanism cannot take; solve for a dependent coordinate first (appell::linearize::solve_holonomic)"
-                    ),
-                    "holonomic_residuals": h,
-                }))
-            }
-            _ => None,
-        })
-    }
-
     /// Reads `t`, `params`, `q`, `u` and `inputs` of a JSON object (fields
     /// in `extra` are allowed and left to the caller), sets the parameters
     /// and assembles the reduced state.
     pub(super) fn parse_point(
-        &mut self,
+        &self,
+        model: &mut dyn DynModel,
         obj: &Map<String, Value>,
         extra: &[&str],
     ) -> Result<Point, String> {
-        let info = self.info();
+        let info = self.info(model);
         for key in obj.keys() {
             if !["t", "params", "q", "u", "inputs"].contains(&key.as_str())
                 && !extra.contains(&key.as_str())
@@ -251,7 +243,7 @@ impl<M: Model> Evaluator<M> {
 
         for (i, name) in info.parameters.iter().enumerate() {
             let value = params[i].unwrap_or(self.defaults[i]);
-            if !self.model.set_parameter(name, value) {
+            if !model.dyn_set_parameter(name, value) {
                 return Err(format!("the model does not accept parameter `{name}`"));
             }
         }
@@ -292,7 +284,7 @@ impl<M: Model> Evaluator<M> {
 }
 
 /// The outputs a scene asks for (or the `contacts` answer), computed on
-/// the scene's own type.
+/// the scene's own model.
 struct Outputs<'a> {
     t: f64,
     q: &'a [f64],
@@ -302,13 +294,11 @@ struct Outputs<'a> {
     contacts: bool,
 }
 
-impl SceneVisitor for Outputs<'_> {
-    type Output = Result<Map<String, Value>, String>;
-
-    fn visit<S: Model>(self, model: &S) -> Self::Output {
+impl Outputs<'_> {
+    fn of(&self, model: &dyn DynModel) -> Result<Map<String, Value>, String> {
         let mut out = Map::new();
         if self.energies {
-            let e = crate::energy::energies(model, self.t, self.q, self.u, self.inputs)
+            let e = crate::energy::energies_dyn(model, self.t, self.q, self.u, self.inputs)
                 .map_err(|e| e.to_string())?;
             out.insert(
                 "energies".into(),
@@ -328,4 +318,41 @@ impl SceneVisitor for Outputs<'_> {
         }
         Ok(out)
     }
+}
+
+/// A warning when `q` is off a holonomic constraint by more than
+/// [`HOLONOMIC_TOLERANCE`] × (1 + max |q|): the rates are still those
+/// of the equations at `q`, but of a state the mechanism cannot take.
+fn holonomic_warning(
+    model: &dyn DynModel,
+    info: &ModelInfo,
+    t: f64,
+    q: &[f64],
+    qdot: &[f64],
+) -> Result<Option<Value>, String> {
+    if info.holonomic == 0 {
+        return Ok(None);
+    }
+    let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
+    model
+        .dyn_constraint_residuals(t, q, qdot, &mut h, &mut v)
+        .map_err(|e| e.to_string())?;
+    let scale = 1.0 + q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let tolerance = HOLONOMIC_TOLERANCE * scale;
+    let worst = h
+        .iter()
+        .enumerate()
+        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
+    Ok(match worst {
+        // A NaN residual warns too.
+        Some((index, &residual)) if residual.is_nan() || residual.abs() > tolerance => {
+            Some(json!({
+                "message": format!(
+                    "the coordinates violate holonomic constraint {index} by {residual:e} (tolerance {tolerance:e}): the rates are those of a state the mechanism cannot take; solve for a dependent coordinate first (appell::linearize::solve_holonomic)"
+                ),
+                "holonomic_residuals": h,
+            }))
+        }
+        _ => None,
+    })
 }

@@ -1,6 +1,7 @@
 //! The `info` subcommand: the model's metadata as JSON.
 
 use super::output::finite_or_null;
+use crate::dynamic::DynModel;
 use crate::model::{Model, ModelError};
 use serde_json::{json, Value};
 
@@ -47,9 +48,14 @@ use serde_json::{json, Value};
 /// assert_eq!(info["rhs_ops"]["other"], 0);
 /// ```
 pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
-    let info = M::info();
+    info_json_dyn(model)
+}
+
+/// [`info_json`] of any [`DynModel`], compiled once.
+pub(super) fn info_json_dyn(model: &dyn DynModel) -> Result<Value, ModelError> {
+    let info = model.dyn_info();
     let mut values = vec![0.0; info.parameters.len()];
-    model.parameter_values(&mut values)?;
+    model.dyn_parameter_values(&mut values)?;
     let parameters: Vec<Value> = info
         .parameters
         .iter()
@@ -68,7 +74,8 @@ pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
         .map(|b| json!({ "name": b.name, "rigid": b.rigid }))
         .collect();
     let ops = info.rhs_ops;
-    let scenes: Vec<Value> = M::scene_infos()
+    let scenes: Vec<Value> = model
+        .dyn_scene_infos()
         .iter()
         .map(|s| {
             json!({

@@ -1,8 +1,9 @@
 //! Writing JSON output: numbers that may not be finite, and the constraint
 //! forces `contacts` answers.
 
-use crate::constraint_forces::{contact_forces, Friction, Normal, NormalSource};
-use crate::model::{Model, RowSource};
+use crate::constraint_forces::{contact_forces_dyn, Friction, Normal, NormalSource};
+use crate::dynamic::DynModel;
+use crate::model::RowSource;
 use serde_json::{json, Value};
 
 /// A JSON number, or `null` for a value JSON cannot hold.
@@ -19,15 +20,15 @@ pub(super) fn result_number(x: f64, name: &str) -> Result<Value, String> {
 
 /// `{"multipliers": [..], "rows": [{"source", "multiplier"}], "contacts":
 /// [{"point", "body", "position", "force", "normal", "friction"}]}`.
-pub(super) fn contact_forces_json<S: Model>(
-    model: &S,
+pub(super) fn contact_forces_json(
+    model: &dyn DynModel,
     t: f64,
     q: &[f64],
     u: &[f64],
     inputs: &[f64],
 ) -> Result<Value, String> {
-    let info = S::info();
-    let f = contact_forces(model, t, q, u, inputs).map_err(|e| e.to_string())?;
+    let info = model.dyn_info();
+    let f = contact_forces_dyn(model, t, q, u, inputs).map_err(|e| e.to_string())?;
     let v3 = |v: [f64; 3]| {
         json!([
             finite_or_null(v[0]),

@@ -1,11 +1,12 @@
 //! The entry points: the usage text, reading the arguments and dispatching
 //! to the subcommand.
 
-use super::bench::bench;
+use super::bench::bench_dyn;
 use super::error::CliError;
-use super::eval::{eval_stream, Evaluator};
-use super::info::info_json;
-use super::sweep::accuracy;
+use super::eval::{eval_stream, EvalState};
+use super::info::info_json_dyn;
+use super::sweep::accuracy_dyn;
+use crate::dynamic::DynModel;
 use crate::model::{Model, ModelInfo};
 use serde_json::json;
 use std::error::Error;
@@ -150,24 +151,47 @@ pub fn run<M: Model>(
 /// assert!(matches!(err, Err(CliError::Usage(_))));
 /// ```
 pub fn run_with<M: Model>(
-    model: M,
+    mut model: M,
     args: &[String],
     stdin: &mut dyn BufRead,
     stdout: &mut dyn Write,
     default_action: impl FnOnce(&M) -> Result<(), Box<dyn Error>>,
 ) -> Result<(), CliError> {
-    let info = M::info();
+    match dispatch(&mut model, args, stdin, stdout)? {
+        Dispatched::Done => Ok(()),
+        Dispatched::Default => default_action(&model).map_err(CliError::Action),
+    }
+}
+
+/// What [`dispatch`] did.
+enum Dispatched {
+    /// Ran a subcommand.
+    Done,
+    /// There was no subcommand: the caller runs its default action.
+    Default,
+}
+
+/// [`run_with`] but the default action, over a `dyn DynModel`: every
+/// subcommand is compiled once here, not once per model.
+fn dispatch(
+    model: &mut dyn DynModel,
+    args: &[String],
+    stdin: &mut dyn BufRead,
+    stdout: &mut dyn Write,
+) -> Result<Dispatched, CliError> {
+    let info = model.dyn_info();
     let program = args.first().map(String::as_str).unwrap_or(info.name);
     let rest = args.get(1..).unwrap_or(&[]);
     if let [command, flag, name] = rest {
         if (command == "eval" || command == "contacts") && flag == "--scene" {
-            let mut evaluator = Evaluator::with_scene(model, name)?;
+            let mut evaluator = EvalState::with_scene(model, name)?;
             evaluator.contacts = command == "contacts";
-            return eval_stream(&mut evaluator, stdin, stdout);
+            eval_stream(&evaluator, model, stdin, stdout)?;
+            return Ok(Dispatched::Done);
         }
     }
     let command = match rest {
-        [] => return default_action(&model).map_err(CliError::Action),
+        [] => return Ok(Dispatched::Default),
         [command] => command.as_str(),
         [command, extra, ..] => {
             return Err(CliError::Usage(format!(
@@ -178,17 +202,17 @@ pub fn run_with<M: Model>(
     };
     match command {
         "eval" => {
-            let mut evaluator = Evaluator::new(model)?;
-            eval_stream(&mut evaluator, stdin, stdout)
+            let evaluator = EvalState::new(model)?;
+            eval_stream(&evaluator, model, stdin, stdout)?;
         }
         "contacts" => {
-            let mut evaluator = Evaluator::new(model)?;
+            let mut evaluator = EvalState::new(model)?;
             evaluator.contacts = true;
-            eval_stream(&mut evaluator, stdin, stdout)
+            eval_stream(&evaluator, model, stdin, stdout)?;
         }
         "info" => {
-            writeln!(stdout, "{}", info_json(&model)?)?;
-            Ok(stdout.flush()?)
+            writeln!(stdout, "{}", info_json_dyn(model)?)?;
+            stdout.flush()?;
         }
         "equations" => {
             let eq = info.equations;
@@ -197,41 +221,44 @@ pub fn run_with<M: Model>(
             } else {
                 writeln!(stdout, "{eq}")?;
             }
-            Ok(stdout.flush()?)
+            stdout.flush()?;
         }
-        "bench" => match bench(&model) {
+        "bench" => match bench_dyn(model) {
             Ok(report) => {
                 writeln!(stdout, "{}", report.to_json())?;
-                Ok(stdout.flush()?)
+                stdout.flush()?;
             }
             Err(e) => {
                 writeln!(stdout, "{}", json!({ "error": e.to_string() }))?;
                 stdout.flush()?;
-                Err(e)
+                return Err(e);
             }
         },
         "accuracy" => {
             let mut text = String::new();
             stdin.read_to_string(&mut text)?;
-            match accuracy(model, &text) {
+            match accuracy_dyn(model, &text) {
                 Ok(report) => {
                     writeln!(stdout, "{report}")?;
-                    Ok(stdout.flush()?)
+                    stdout.flush()?;
                 }
                 Err(why) => {
                     writeln!(stdout, "{}", json!({ "error": why }))?;
                     stdout.flush()?;
-                    Err(CliError::Accuracy(why))
+                    return Err(CliError::Accuracy(why));
                 }
             }
         }
         "help" | "-h" | "--help" => {
             write!(stdout, "{}", usage(program, info))?;
-            Ok(stdout.flush()?)
+            stdout.flush()?;
         }
-        other => Err(CliError::Usage(format!(
-            "unknown command `{other}`\n{}",
-            usage(program, info)
-        ))),
+        other => {
+            return Err(CliError::Usage(format!(
+                "unknown command `{other}`\n{}",
+                usage(program, info)
+            )))
+        }
     }
+    Ok(Dispatched::Done)
 }

@@ -1,9 +1,10 @@
 //! The `accuracy` subcommand: a work-precision sweep of every integrator.
 
-use super::eval::Evaluator;
+use super::eval::EvalState;
 use super::input::{number, Point};
 use super::output::finite_or_null;
-use crate::accuracy::{standard_methods, Problem};
+use crate::accuracy::{standard_methods, Run};
+use crate::dynamic::{DynModel, DynRhs};
 use crate::model::Model;
 use serde_json::{json, Value};
 
@@ -14,21 +15,26 @@ pub const ACCURACY_MAX_STATE: usize = 16;
 /// The `accuracy` subcommand: parses one problem (an `eval` object plus
 /// `t_end`, and optionally `checkpoints` (default 10), `levels` (default 4)
 /// and `repeats` (default 3)), computes the reference and runs
-/// [`standard_methods`]`(100, levels)` over it ([`Problem::sweep`]). Returns
+/// [`standard_methods`]`(100, levels)` over it ([`Problem::sweep`](crate::accuracy::Problem::sweep)). Returns
 /// the report as one JSON object, or why it could not.
 ///
 /// The report: `{"t_end", "checkpoints", "reference_error", "points": [{"method",
 /// "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}, ..]}`
 /// with the fields of [`crate::accuracy::Point`]; methods that fail (a
 /// step-size underflow, say) are left out.
-pub fn accuracy<M: Model>(model: M, text: &str) -> Result<Value, String> {
+pub fn accuracy<M: Model>(mut model: M, text: &str) -> Result<Value, String> {
+    accuracy_dyn(&mut model, text)
+}
+
+/// [`accuracy()`] of any [`DynModel`], compiled once.
+pub(super) fn accuracy_dyn(model: &mut dyn DynModel, text: &str) -> Result<Value, String> {
     let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
     let Value::Object(obj) = value else {
         return Err("expected a JSON object".to_string());
     };
-    let mut evaluator = Evaluator::new(model).map_err(|e| e.to_string())?;
+    let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let extra = ["t_end", "checkpoints", "levels", "repeats"];
-    let point = evaluator.parse_point(&obj, &extra)?;
+    let point = evaluator.parse_point(model, &obj, &extra)?;
     if point.t != 0.0 {
         return Err("`t` must be 0 (or omitted): a sweep starts at t = 0".to_string());
     }
@@ -53,11 +59,11 @@ pub fn accuracy<M: Model>(model: M, text: &str) -> Result<Value, String> {
     let checkpoints = count("checkpoints", 10, 1000)?;
     let levels = count("levels", 4, 10)?;
     let repeats = count("repeats", 3, 100)?;
-    let model = evaluator.model();
+    let rhs = model.dyn_prepare();
     macro_rules! sizes {
         ($($n:literal)*) => {
             match point.state.len() {
-                $($n => sweep_report::<M, $n>(model, &point, t_end, checkpoints, levels, repeats),)*
+                $($n => sweep_report::<$n>(&*rhs, &point, t_end, checkpoints, levels, repeats),)*
                 n => Err(format!(
                     "the reduced state has {n} entries; `accuracy` handles up to {ACCURACY_MAX_STATE}"
                 )),
@@ -67,8 +73,8 @@ pub fn accuracy<M: Model>(model: M, text: &str) -> Result<Value, String> {
     sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
 }
 
-fn sweep_report<M: Model, const S: usize>(
-    model: &M,
+fn sweep_report<const S: usize>(
+    rhs: &dyn DynRhs,
     point: &Point,
     t_end: f64,
     checkpoints: usize,
@@ -77,17 +83,17 @@ fn sweep_report<M: Model, const S: usize>(
 ) -> Result<Value, String> {
     let mut x0 = [0.0; S];
     x0.copy_from_slice(&point.state);
-    let problem = Problem {
-        model,
+    let problem = Run {
         x0,
         t_end,
         inputs: &point.inputs,
         checkpoints,
     };
     let (reference, estimate) = problem
-        .reference()
+        .reference(rhs)
         .map_err(|e| format!("the reference integration failed: {e}"))?;
     let points = problem.sweep(
+        rhs,
         &reference,
         &standard_methods(100, levels),
         repeats,

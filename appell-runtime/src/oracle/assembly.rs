@@ -5,6 +5,7 @@
 use super::error::OracleError;
 use super::layout::{finite_all, Geometry, Layout};
 use super::vec3::{cross, dot, map3, mat_vec, mul, mul_bt, vee};
+use crate::dynamic::DynModel;
 use crate::model::{check_len, Model, ModelInfo};
 use crate::scalar::Scalar;
 use num_dual::{Dual2_64, Dual64};
@@ -55,8 +56,8 @@ pub fn full_dynamics<M: Model>(
     full_dynamics_with(model, &lay, t, q, qdot, inputs)
 }
 
-pub(super) fn full_dynamics_with<M: Model>(
-    model: &M,
+pub(super) fn full_dynamics_with<K: DynModel + ?Sized>(
+    model: &K,
     lay: &Layout,
     t: f64,
     q: &[f64],
@@ -72,10 +73,10 @@ pub(super) fn full_dynamics_with<M: Model>(
     finite_all(qdot.iter().copied(), "qdot")?;
     finite_all(inputs.iter().copied(), "inputs")?;
 
-    let info = M::info();
+    let info = model.dyn_info();
     let mut masses = vec![0.0; lay.bodies];
     let mut inertias = vec![[0.0; 9]; lay.bodies];
-    model.mass_properties(&mut masses, &mut inertias)?;
+    model.dyn_mass_properties(&mut masses, &mut inertias)?;
     finite_all(masses.iter().copied(), "a body mass")?;
     finite_all(inertias.iter().flatten().copied(), "a body inertia")?;
 
@@ -96,7 +97,7 @@ pub(super) fn full_dynamics_with<M: Model>(
         .collect();
     let mut pos2 = vec![[Dual2_64::zero(); 3]; lay.bodies];
     let mut rot2 = vec![[Dual2_64::zero(); 9]; lay.bodies];
-    model.body_poses(Dual2_64::new(t, 1.0, 0.0), &q2, &mut pos2, &mut rot2)?;
+    model.dyn_body_poses_dual2(Dual2_64::new(t, 1.0, 0.0), &q2, &mut pos2, &mut rot2)?;
 
     // Constraint rows, their rate along the motion, and load point velocities.
     let q1: Vec<Dual64> = q
@@ -107,12 +108,12 @@ pub(super) fn full_dynamics_with<M: Model>(
     let t1 = Dual64::new(t, 1.0);
     let mut dmat = vec![Dual64::zero(); m * n];
     let mut doff = vec![Dual64::zero(); m];
-    model.constraint_rows(t1, &q1, &mut dmat, &mut doff)?;
+    model.dyn_constraint_rows_dual(t1, &q1, &mut dmat, &mut doff)?;
     let g1 = Geometry::<Dual64>::eval(model, lay, t1, &q1)?;
 
     let mut forces = vec![[0.0; 3]; lay.points];
     let mut torques = vec![[0.0; 3]; lay.frames];
-    model.load_values(t, q, qdot, inputs, &mut forces, &mut torques)?;
+    model.dyn_load_values(t, q, qdot, inputs, &mut forces, &mut torques)?;
     finite_all(forces.iter().flatten().copied(), "a force")?;
     finite_all(torques.iter().flatten().copied(), "a torque")?;
 
@@ -168,8 +169,8 @@ impl Jacobians {
     /// Evaluates the geometry with a [`Dual64`] seed on one coordinate at a
     /// time; `g0` is the geometry at `(q, t)` (the angular columns are
     /// vee((∂R/∂q_r) Rᵀ)).
-    fn eval<M: Model>(
-        model: &M,
+    fn eval<K: DynModel + ?Sized>(
+        model: &K,
         lay: &Layout,
         t: f64,
         q: &[f64],

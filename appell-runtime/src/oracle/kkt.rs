@@ -4,6 +4,7 @@
 use super::assembly::{full_dynamics_with, FullDynamics};
 use super::error::OracleError;
 use super::layout::{finite_all, Layout};
+use crate::dynamic::DynModel;
 use crate::model::Model;
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
@@ -110,12 +111,23 @@ pub fn accelerations<M: Model>(
     qdot: &[f64],
     inputs: &[f64],
 ) -> Result<OracleSolution, OracleError> {
-    let lay = Layout::new(M::info())?;
+    accelerations_dyn(model, t, q, qdot, inputs)
+}
+
+/// [`accelerations`] of any [`DynModel`] (compiled once for `dyn DynModel`).
+pub(crate) fn accelerations_dyn<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q: &[f64],
+    qdot: &[f64],
+    inputs: &[f64],
+) -> Result<OracleSolution, OracleError> {
+    let lay = Layout::new(model.dyn_info())?;
     accelerations_with(model, &lay, t, q, qdot, inputs)
 }
 
-pub(super) fn accelerations_with<M: Model>(
-    model: &M,
+pub(super) fn accelerations_with<K: DynModel + ?Sized>(
+    model: &K,
     lay: &Layout,
     t: f64,
     q: &[f64],
@@ -129,7 +141,7 @@ pub(super) fn accelerations_with<M: Model>(
     let (n, l) = (lay.n, lay.l);
     let mut w = vec![0.0; l * n];
     let mut w0 = vec![0.0; l];
-    model.speed_definitions(t, q, &mut w, &mut w0)?;
+    model.dyn_speed_definitions(t, q, &mut w, &mut w0)?;
     let qd: Vec<Dual64> = q
         .iter()
         .zip(qdot)
@@ -137,7 +149,7 @@ pub(super) fn accelerations_with<M: Model>(
         .collect();
     let mut wd = vec![Dual64::from(0.0); l * n];
     let mut w0d = vec![Dual64::from(0.0); l];
-    model.speed_definitions(Dual64::new(t, 1.0), &qd, &mut wd, &mut w0d)?;
+    model.dyn_speed_definitions_dual(Dual64::new(t, 1.0), &qd, &mut wd, &mut w0d)?;
     let privileged: Vec<f64> = (0..l)
         .map(|k| {
             let mut acc = w0d[k].eps;

@@ -3,8 +3,10 @@
 //! checks.
 
 use super::error::OracleError;
-use crate::model::{Model, ModelError, ModelInfo};
+use crate::dynamic::DynModel;
+use crate::model::{ModelError, ModelInfo};
 use crate::scalar::Scalar;
+use num_dual::Dual64;
 
 /// Coordinate index sets derived from a validated [`ModelInfo`].
 pub(super) struct Layout {
@@ -67,9 +69,73 @@ pub(super) struct Geometry<T> {
     pub(super) frames: Vec<[T; 9]>,
 }
 
-impl<T: Scalar> Geometry<T> {
-    pub(super) fn eval<M: Model>(
-        model: &M,
+/// The scalars the oracle evaluates the geometry in, each with the
+/// [`DynModel`] methods of its own.
+pub(super) trait GeometryScalar: Scalar {
+    fn body_poses<K: DynModel + ?Sized>(
+        model: &K,
+        t: Self,
+        q: &[Self],
+        positions: &mut [[Self; 3]],
+        rotations: &mut [[Self; 9]],
+    ) -> Result<(), ModelError>;
+
+    fn load_geometry<K: DynModel + ?Sized>(
+        model: &K,
+        t: Self,
+        q: &[Self],
+        points: &mut [[Self; 3]],
+        frames: &mut [[Self; 9]],
+    ) -> Result<(), ModelError>;
+}
+
+impl GeometryScalar for f64 {
+    fn body_poses<K: DynModel + ?Sized>(
+        model: &K,
+        t: f64,
+        q: &[f64],
+        positions: &mut [[f64; 3]],
+        rotations: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        model.dyn_body_poses(t, q, positions, rotations)
+    }
+
+    fn load_geometry<K: DynModel + ?Sized>(
+        model: &K,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+        frames: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        model.dyn_load_geometry(t, q, points, frames)
+    }
+}
+
+impl GeometryScalar for Dual64 {
+    fn body_poses<K: DynModel + ?Sized>(
+        model: &K,
+        t: Dual64,
+        q: &[Dual64],
+        positions: &mut [[Dual64; 3]],
+        rotations: &mut [[Dual64; 9]],
+    ) -> Result<(), ModelError> {
+        model.dyn_body_poses_dual(t, q, positions, rotations)
+    }
+
+    fn load_geometry<K: DynModel + ?Sized>(
+        model: &K,
+        t: Dual64,
+        q: &[Dual64],
+        points: &mut [[Dual64; 3]],
+        frames: &mut [[Dual64; 9]],
+    ) -> Result<(), ModelError> {
+        model.dyn_load_geometry_dual(t, q, points, frames)
+    }
+}
+
+impl<T: GeometryScalar> Geometry<T> {
+    pub(super) fn eval<K: DynModel + ?Sized>(
+        model: &K,
         lay: &Layout,
         t: T,
         q: &[T],
@@ -80,8 +146,8 @@ impl<T: Scalar> Geometry<T> {
             points: vec![[T::zero(); 3]; lay.points],
             frames: vec![[T::zero(); 9]; lay.frames],
         };
-        model.body_poses(t, q, &mut g.positions, &mut g.rotations)?;
-        model.load_geometry(t, q, &mut g.points, &mut g.frames)?;
+        T::body_poses(model, t, q, &mut g.positions, &mut g.rotations)?;
+        T::load_geometry(model, t, q, &mut g.points, &mut g.frames)?;
         Ok(g)
     }
 }

@@ -4,6 +4,7 @@
 use super::error::OracleError;
 use super::kkt::{accelerations_with, lu_solve_checked};
 use super::layout::{finite_all, Layout};
+use crate::dynamic::DynModel;
 use crate::model::{check_len, Model};
 use nalgebra::{DMatrix, DVector};
 
@@ -29,12 +30,22 @@ pub fn coordinate_rates<M: Model>(
     q_full: &[f64],
     u: &[f64],
 ) -> Result<Vec<f64>, OracleError> {
-    let lay = Layout::new(M::info())?;
+    coordinate_rates_dyn(model, t, q_full, u)
+}
+
+/// [`coordinate_rates`] of any [`DynModel`] (compiled once for `dyn DynModel`).
+pub(crate) fn coordinate_rates_dyn<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q_full: &[f64],
+    u: &[f64],
+) -> Result<Vec<f64>, OracleError> {
+    let lay = Layout::new(model.dyn_info())?;
     coordinate_rates_with(model, &lay, t, q_full, u)
 }
 
-fn coordinate_rates_with<M: Model>(
-    model: &M,
+fn coordinate_rates_with<K: DynModel + ?Sized>(
+    model: &K,
     lay: &Layout,
     t: f64,
     q_full: &[f64],
@@ -48,11 +59,11 @@ fn coordinate_rates_with<M: Model>(
     finite_all(u.iter().copied(), "u")?;
     let mut dmat = vec![0.0; m * n];
     let mut doff = vec![0.0; m];
-    model.constraint_rows(t, q_full, &mut dmat, &mut doff)?;
+    model.dyn_constraint_rows(t, q_full, &mut dmat, &mut doff)?;
     finite_all(dmat.iter().chain(&doff).copied(), "the constraint rows")?;
     let mut w = vec![0.0; l * n];
     let mut w0 = vec![0.0; l];
-    model.speed_definitions(t, q_full, &mut w, &mut w0)?;
+    model.dyn_speed_definitions(t, q_full, &mut w, &mut w0)?;
     finite_all(w.iter().chain(&w0).copied(), "the speed definitions")?;
     // [D; W] q̇ = [−d; u − w]
     let mut a = DMatrix::<f64>::zeros(n, n);
@@ -69,7 +80,7 @@ fn coordinate_rates_with<M: Model>(
         }
         b[m + k] = u[k] - w0[k];
     }
-    let info = M::info();
+    let info = model.dyn_info();
     // Measured against the whole system: a column can be negligible only
     // relative to the rows it belongs to.
     let scale = dmat.iter().chain(&w).fold(0.0_f64, |s, x| s.max(x.abs()));
@@ -99,7 +110,18 @@ pub fn reduced_rhs<M: Model>(
     u: &[f64],
     inputs: &[f64],
 ) -> Result<Vec<f64>, OracleError> {
-    let lay = Layout::new(M::info())?;
+    reduced_rhs_dyn(model, t, q_full, u, inputs)
+}
+
+/// [`reduced_rhs`] of any [`DynModel`] (compiled once for `dyn DynModel`).
+pub(crate) fn reduced_rhs_dyn<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q_full: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+) -> Result<Vec<f64>, OracleError> {
+    let lay = Layout::new(model.dyn_info())?;
     let qdot = coordinate_rates_with(model, &lay, t, q_full, u)?;
     let sol = accelerations_with(model, &lay, t, q_full, &qdot, inputs)?;
     let mut out = Vec::with_capacity(lay.retained.len() + lay.l);

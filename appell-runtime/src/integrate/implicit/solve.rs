@@ -4,6 +4,7 @@
 use super::dense::EventG;
 use super::settings::TrBdf2;
 use super::stats::TrBdf2Solution;
+use crate::dynamic::{DynRhs, Prepared};
 use crate::integrate::solution::IntegrateError;
 use crate::model::{check_len, Model, ModelError};
 use num_dual::Dual64;
@@ -302,14 +303,41 @@ impl TrBdf2 {
         out: &mut [(f64, Vec<f64>)],
         event: Option<&mut EventG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError> {
-        let n = M::info().state_len();
+        check_len("state", x0, M::info().state_len())?;
+        self.run_prepared(&Prepared::new(model), t0, x0, t_end, inputs, out, event)
+    }
+
+    /// [`TrBdf2::solve_model_at`] of a prepared rhs (compiled once for
+    /// `dyn DynRhs`).
+    pub(crate) fn solve_prepared_at<R: DynRhs + ?Sized>(
+        &self,
+        rhs: &R,
+        t0: f64,
+        x0: &[f64],
+        out: &mut [(f64, Vec<f64>)],
+        inputs: &[f64],
+    ) -> Result<TrBdf2Solution, IntegrateError> {
+        let t_end = out.last().map_or(t0, |o| o.0);
+        self.run_prepared(rhs, t0, x0, t_end, inputs, out, None)
+    }
+
+    #[allow(clippy::too_many_arguments)]
+    fn run_prepared<R: DynRhs + ?Sized>(
+        &self,
+        rhs: &R,
+        t0: f64,
+        x0: &[f64],
+        t_end: f64,
+        inputs: &[f64],
+        out: &mut [(f64, Vec<f64>)],
+        event: Option<&mut EventG<'_>>,
+    ) -> Result<TrBdf2Solution, IntegrateError> {
+        let n = rhs.state_len();
         check_len("state", x0, n)?;
-        let p = model.prepare::<f64>();
-        let pd = model.prepare::<Dual64>();
         let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
         let mut xd = vec![Dual64::from_re(0.0); n];
         let mut outd = vec![Dual64::from_re(0.0); n];
-        let f = |t: f64, x: &[f64], dx: &mut [f64]| model.rhs(&p, t, x, inputs, dx);
+        let f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, inputs, dx);
         let jac = |t: f64, x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
             let td = Dual64::from_re(t);
             for (d, &v) in xd.iter_mut().zip(x) {
@@ -317,7 +345,7 @@ impl TrBdf2 {
             }
             for col in 0..n {
                 xd[col].eps = 1.0;
-                let r = model.rhs(&pd, td, &xd, &inputs_d, &mut outd);
+                let r = rhs.rhs_dual(td, &xd, &inputs_d, &mut outd);
                 xd[col].eps = 0.0;
                 r?;
                 for (row, o) in outd.iter().enumerate() {

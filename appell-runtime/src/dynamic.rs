@@ -1,0 +1,645 @@
+//! [`DynModel`]: a [`Model`] behind an object-safe interface, in `f64` and
+//! the dual numbers the oracle needs, so that tools written against it (the
+//! command line, the oracle, the contact forces, the accuracy sweep) are
+//! compiled once in this crate instead of once per model.
+//!
+//! [`Model`]'s methods are generic over the [`Scalar`](crate::Scalar), which
+//! keeps a `Model` out of a trait object and makes every generic function
+//! that takes one compile again for every model (and every scene) a program
+//! uses: the command line's integrators, JSON and oracle were most of a
+//! model program's build. Every `Model` is a `DynModel` (a blanket
+//! implementation in which each method is one call of the model's); a tool
+//! that takes `&dyn DynModel` is compiled once and only these small
+//! forwarding methods are compiled per model.
+//!
+//! The methods are prefixed `dyn_` so that both traits can be in scope
+//! together without making calls such as `model.rhs(..)` ambiguous.
+
+use crate::model::{Model, ModelError, ModelInfo, SceneVisitor};
+use num_dual::{Dual2_64, Dual64};
+use std::hint::black_box;
+
+mod sealed {
+    /// Keeps [`DynModel`](super::DynModel) implemented only by the blanket
+    /// implementation, so methods can be added to it.
+    pub trait Sealed {}
+    impl<M: crate::Model> Sealed for M {}
+}
+
+/// A model's reduced rhs with its parameter-only work
+/// ([`Model::prepare`]) done once, in `f64` and in [`Dual64`] (for
+/// Jacobians): what integrators driven through a [`DynModel`] call. Made by
+/// [`DynModel::dyn_prepare`]; it borrows the model, so the parameters cannot
+/// change under it.
+///
+/// ```
+/// use appell_runtime::DynModel;
+/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Oscillator { w: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
+/// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+/// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+/// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
+/// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+/// #     equations: "x'' = -w^2 x",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Oscillator {
+/// #     type Prepared<T: Scalar> = T;
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
+/// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
+/// #         appell_runtime::check_len("state", s, 2)?;
+/// #         appell_runtime::check_len("dstate", ds, 2)?;
+/// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
+/// #     }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// use appell_runtime::integrate::rk4_step_fn;
+/// use appell_runtime::num_dual::Dual64;
+///
+/// // x'' = −w² x as a trait object, integrated by a closure over it.
+/// let model: &dyn DynModel = &Oscillator { w: 2.0 };
+/// let rhs = model.dyn_prepare();
+/// assert_eq!(rhs.state_len(), 2);
+/// let mut f = |t: f64, x: &[f64; 2], dx: &mut [f64; 2]| rhs.rhs(t, x, &[], dx);
+/// let x = rk4_step_fn(&mut f, 0.0, 1e-3, &[1.0, 0.0]).unwrap();
+/// assert!((x[0] - 2e-3f64.cos()).abs() < 1e-12);
+///
+/// // ∂ẋ₂/∂x₁ = −w² by a dual number.
+/// let mut d = [Dual64::from(0.0); 2];
+/// rhs.rhs_dual(Dual64::from(0.0), &[Dual64::new(1.0, 1.0), Dual64::from(0.0)], &[], &mut d)
+///     .unwrap();
+/// assert_eq!(d[1].eps, -4.0);
+/// ```
+pub trait DynRhs {
+    /// The length of the reduced state ([`ModelInfo::state_len`]).
+    fn state_len(&self) -> usize;
+
+    /// [`Model::rhs`] in `f64`.
+    fn rhs(
+        &self,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::rhs`] in [`Dual64`] (a column of the Jacobian per seed).
+    fn rhs_dual(
+        &self,
+        t: Dual64,
+        state: &[Dual64],
+        inputs: &[Dual64],
+        dstate: &mut [Dual64],
+    ) -> Result<(), ModelError>;
+
+    /// Calls [`DynRhs::rhs`] at `t` on every `(state, inputs)` of `cases`
+    /// into `dstate`, every argument and result through
+    /// [`black_box`], results dropped: one pass of a timing loop, whose
+    /// calls stay direct calls of the generated code.
+    fn rhs_pass(&self, t: f64, cases: &[(&[f64], &[f64])], dstate: &mut [f64]);
+}
+
+/// A model and its prepared values: the [`DynRhs`] of every [`Model`].
+pub(crate) struct Prepared<'a, M: Model> {
+    model: &'a M,
+    real: M::Prepared<f64>,
+    dual: M::Prepared<Dual64>,
+}
+
+impl<'a, M: Model> Prepared<'a, M> {
+    /// Prepares `model` in `f64` and [`Dual64`].
+    pub(crate) fn new(model: &'a M) -> Self {
+        Prepared {
+            model,
+            real: model.prepare::<f64>(),
+            dual: model.prepare::<Dual64>(),
+        }
+    }
+}
+
+impl<M: Model> DynRhs for Prepared<'_, M> {
+    fn state_len(&self) -> usize {
+        M::info().state_len()
+    }
+
+    fn rhs(
+        &self,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.model.rhs(&self.real, t, state, inputs, dstate)
+    }
+
+    fn rhs_dual(
+        &self,
+        t: Dual64,
+        state: &[Dual64],
+        inputs: &[Dual64],
+        dstate: &mut [Dual64],
+    ) -> Result<(), ModelError> {
+        self.model.rhs(&self.dual, t, state, inputs, dstate)
+    }
+
+    fn rhs_pass(&self, t: f64, cases: &[(&[f64], &[f64])], dstate: &mut [f64]) {
+        for (state, inputs) in cases {
+            let r = self.model.rhs(
+                black_box(&self.real),
+                black_box(t),
+                black_box(state),
+                black_box(inputs),
+                black_box(&mut *dstate),
+            );
+            let _ = black_box((r, &*dstate));
+        }
+    }
+}
+
+/// The object-safe face of a [`Model`]: its metadata, parameters, reduced
+/// equations and kinematic description in `f64`, and the few methods the
+/// oracle evaluates in dual numbers ([`Dual64`], [`Dual2_64`]). Each method
+/// is the `Model` method of the same name without the `dyn_` prefix, at the
+/// scalar its suffix names (none: `f64`).
+///
+/// Implemented for every [`Model`] (and only for them); a `&M` coerces to
+/// `&dyn DynModel`, so one function over `&dyn DynModel` serves every model
+/// and is compiled once. The command line ([`crate::cli`]) is written this
+/// way.
+///
+/// ```
+/// use appell_runtime::DynModel;
+/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Oscillator { w: f64 }
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
+/// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+/// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+/// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
+/// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+/// #     equations: "x'' = -w^2 x",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Oscillator {
+/// #     type Prepared<T: Scalar> = T;
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
+/// #     fn set_parameter(&mut self, name: &str, v: f64) -> bool { if name == "w" { self.w = v; true } else { false } }
+/// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
+/// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
+/// #         appell_runtime::check_len("state", s, 2)?;
+/// #         appell_runtime::check_len("dstate", ds, 2)?;
+/// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
+/// #     }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// // A function compiled once, whatever the model.
+/// fn period_guess(model: &mut dyn DynModel, w: f64) -> Result<f64, ModelError> {
+///     assert!(model.dyn_set_parameter("w", w));
+///     let mut d = vec![0.0; model.dyn_info().state_len()];
+///     model.dyn_rhs(0.0, &[1.0, 0.0], &[], &mut d)?;
+///     Ok(2.0 * std::f64::consts::PI / (-d[1]).sqrt())
+/// }
+///
+/// let mut model = Oscillator { w: 1.0 };
+/// assert!((period_guess(&mut model, 2.0).unwrap() - std::f64::consts::PI).abs() < 1e-12);
+/// assert_eq!(model.w, 2.0);
+/// ```
+pub trait DynModel: sealed::Sealed {
+    /// [`Model::info`].
+    fn dyn_info(&self) -> &'static ModelInfo;
+
+    /// [`Model::scene_infos`].
+    fn dyn_scene_infos(&self) -> &'static [&'static ModelInfo];
+
+    /// [`Model::parameter_values`].
+    fn dyn_parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError>;
+
+    /// [`Model::set_parameter`].
+    fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool;
+
+    /// The reduced rhs with [`Model::prepare`] done once, in `f64` and
+    /// [`Dual64`].
+    fn dyn_prepare(&self) -> Box<dyn DynRhs + '_>;
+
+    /// [`Model::rhs`] after [`Model::prepare`], in `f64`.
+    fn dyn_rhs(
+        &self,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::scene_rhs`].
+    fn dyn_scene_rhs(
+        &self,
+        scene: usize,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// Calls `visit` with scene `scene` as a `DynModel` ([`Model::visit_scene`]).
+    fn dyn_visit_scene(
+        &self,
+        scene: usize,
+        visit: &mut dyn FnMut(&dyn DynModel),
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::coordinate_rates`].
+    fn dyn_coordinate_rates(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        qdot: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::constraint_residuals`].
+    fn dyn_constraint_residuals(
+        &self,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+        holonomic: &mut [f64],
+        velocity: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::speed_definitions`].
+    fn dyn_speed_definitions(
+        &self,
+        t: f64,
+        q: &[f64],
+        w: &mut [f64],
+        w0: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::speed_definitions`] in [`Dual64`].
+    fn dyn_speed_definitions_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        w: &mut [Dual64],
+        w0: &mut [Dual64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::kinetic_energy`] in [`Dual64`].
+    fn dyn_kinetic_energy_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        u: &[Dual64],
+    ) -> Result<Dual64, ModelError>;
+
+    /// [`Model::potential_energy`] in [`Dual64`].
+    fn dyn_potential_energy_dual(&self, t: Dual64, q: &[Dual64]) -> Result<Dual64, ModelError>;
+
+    /// [`Model::input_power`].
+    fn dyn_input_power(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+    ) -> Result<f64, ModelError>;
+
+    /// [`Model::mass_properties`].
+    fn dyn_mass_properties(
+        &self,
+        masses: &mut [f64],
+        inertias: &mut [[f64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::body_poses`].
+    fn dyn_body_poses(
+        &self,
+        t: f64,
+        q: &[f64],
+        positions: &mut [[f64; 3]],
+        rotations: &mut [[f64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::body_poses`] in [`Dual64`].
+    fn dyn_body_poses_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        positions: &mut [[Dual64; 3]],
+        rotations: &mut [[Dual64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::body_poses`] in [`Dual2_64`].
+    fn dyn_body_poses_dual2(
+        &self,
+        t: Dual2_64,
+        q: &[Dual2_64],
+        positions: &mut [[Dual2_64; 3]],
+        rotations: &mut [[Dual2_64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::constraint_rows`].
+    fn dyn_constraint_rows(
+        &self,
+        t: f64,
+        q: &[f64],
+        d: &mut [f64],
+        d0: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::constraint_rows`] in [`Dual64`].
+    fn dyn_constraint_rows_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        d: &mut [Dual64],
+        d0: &mut [Dual64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::load_geometry`].
+    fn dyn_load_geometry(
+        &self,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+        frames: &mut [[f64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::load_geometry`] in [`Dual64`].
+    fn dyn_load_geometry_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        points: &mut [[Dual64; 3]],
+        frames: &mut [[Dual64; 9]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::contact_geometry`].
+    fn dyn_contact_geometry(
+        &self,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+        directions: &mut [[f64; 3]],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::load_values`].
+    fn dyn_load_values(
+        &self,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+        inputs: &[f64],
+        forces: &mut [[f64; 3]],
+        torques: &mut [[f64; 3]],
+    ) -> Result<(), ModelError>;
+}
+
+/// Passes a scene to a `dyn` callback.
+struct Visit<'a, 'b>(&'a mut (dyn FnMut(&dyn DynModel) + 'b));
+
+impl SceneVisitor for Visit<'_, '_> {
+    type Output = ();
+    fn visit<S: Model>(self, scene: &S) {
+        (self.0)(scene)
+    }
+}
+
+impl<M: Model> DynModel for M {
+    fn dyn_info(&self) -> &'static ModelInfo {
+        M::info()
+    }
+
+    fn dyn_scene_infos(&self) -> &'static [&'static ModelInfo] {
+        M::scene_infos()
+    }
+
+    fn dyn_parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
+        self.parameter_values(out)
+    }
+
+    fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool {
+        self.set_parameter(name, value)
+    }
+
+    fn dyn_prepare(&self) -> Box<dyn DynRhs + '_> {
+        Box::new(Prepared::new(self))
+    }
+
+    fn dyn_rhs(
+        &self,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.rhs(&self.prepare::<f64>(), t, state, inputs, dstate)
+    }
+
+    fn dyn_scene_rhs(
+        &self,
+        scene: usize,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        dstate: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.scene_rhs(scene, t, state, inputs, dstate)
+    }
+
+    fn dyn_visit_scene(
+        &self,
+        scene: usize,
+        visit: &mut dyn FnMut(&dyn DynModel),
+    ) -> Result<(), ModelError> {
+        self.visit_scene(scene, Visit(visit))
+    }
+
+    fn dyn_coordinate_rates(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        qdot: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.coordinate_rates(t, q, u, qdot)
+    }
+
+    fn dyn_constraint_residuals(
+        &self,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+        holonomic: &mut [f64],
+        velocity: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.constraint_residuals(t, q, qdot, holonomic, velocity)
+    }
+
+    fn dyn_speed_definitions(
+        &self,
+        t: f64,
+        q: &[f64],
+        w: &mut [f64],
+        w0: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.speed_definitions(t, q, w, w0)
+    }
+
+    fn dyn_speed_definitions_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        w: &mut [Dual64],
+        w0: &mut [Dual64],
+    ) -> Result<(), ModelError> {
+        self.speed_definitions(t, q, w, w0)
+    }
+
+    fn dyn_kinetic_energy_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        u: &[Dual64],
+    ) -> Result<Dual64, ModelError> {
+        self.kinetic_energy(t, q, u)
+    }
+
+    fn dyn_potential_energy_dual(&self, t: Dual64, q: &[Dual64]) -> Result<Dual64, ModelError> {
+        self.potential_energy(t, q)
+    }
+
+    fn dyn_input_power(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+    ) -> Result<f64, ModelError> {
+        self.input_power(t, q, u, inputs)
+    }
+
+    fn dyn_mass_properties(
+        &self,
+        masses: &mut [f64],
+        inertias: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        self.mass_properties(masses, inertias)
+    }
+
+    fn dyn_body_poses(
+        &self,
+        t: f64,
+        q: &[f64],
+        positions: &mut [[f64; 3]],
+        rotations: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        self.body_poses(t, q, positions, rotations)
+    }
+
+    fn dyn_body_poses_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        positions: &mut [[Dual64; 3]],
+        rotations: &mut [[Dual64; 9]],
+    ) -> Result<(), ModelError> {
+        self.body_poses(t, q, positions, rotations)
+    }
+
+    fn dyn_body_poses_dual2(
+        &self,
+        t: Dual2_64,
+        q: &[Dual2_64],
+        positions: &mut [[Dual2_64; 3]],
+        rotations: &mut [[Dual2_64; 9]],
+    ) -> Result<(), ModelError> {
+        self.body_poses(t, q, positions, rotations)
+    }
+
+    fn dyn_constraint_rows(
+        &self,
+        t: f64,
+        q: &[f64],
+        d: &mut [f64],
+        d0: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.constraint_rows(t, q, d, d0)
+    }
+
+    fn dyn_constraint_rows_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        d: &mut [Dual64],
+        d0: &mut [Dual64],
+    ) -> Result<(), ModelError> {
+        self.constraint_rows(t, q, d, d0)
+    }
+
+    fn dyn_load_geometry(
+        &self,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+        frames: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        self.load_geometry(t, q, points, frames)
+    }
+
+    fn dyn_load_geometry_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        points: &mut [[Dual64; 3]],
+        frames: &mut [[Dual64; 9]],
+    ) -> Result<(), ModelError> {
+        self.load_geometry(t, q, points, frames)
+    }
+
+    fn dyn_contact_geometry(
+        &self,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+        directions: &mut [[f64; 3]],
+    ) -> Result<(), ModelError> {
+        self.contact_geometry(t, q, points, directions)
+    }
+
+    fn dyn_load_values(
+        &self,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+        inputs: &[f64],
+        forces: &mut [[f64; 3]],
+        torques: &mut [[f64; 3]],
+    ) -> Result<(), ModelError> {
+        self.load_values(t, q, qdot, inputs, forces, torques)
+    }
+}
