@@ -101,4 +101,6 @@ pub mod guide {
     pub struct CompileErrors;
     #[doc = include_str!("../docs/guide/pictures.md")]
     pub struct Pictures;
+    #[doc = include_str!("../docs/guide/building.md")]
+    pub struct Building;
 }

@@ -3,6 +3,7 @@
 //! The macro is a thin shell: all work happens in `appell-codegen`, where it
 //! can be unit-tested.
 
+use appell_codegen::emit::{unoptimised_hint, DeriveBuild};
 use proc_macro::TokenStream;
 
 /// Derives Appell's equations of motion for the model described by the
@@ -13,8 +14,18 @@ pub fn derive_appell(input: TokenStream) -> TokenStream {
     // A bug in the derivation must not crash the user's build with a bare
     // panic: report it as a compile error on the struct.
     let span = input.ident.span();
+    let start = std::time::Instant::now();
     match std::panic::catch_unwind(|| appell_codegen::expand(&input)) {
-        Ok(tokens) => tokens.into(),
+        Ok(mut tokens) => {
+            let build = DeriveBuild {
+                opt_level: env!("APPELL_DERIVE_OPT_LEVEL"),
+                profile: env!("APPELL_DERIVE_PROFILE"),
+            };
+            let seconds = start.elapsed().as_secs_f64();
+            let model = input.ident.to_string();
+            tokens.extend(unoptimised_hint(&model, seconds, build, span));
+            tokens.into()
+        }
         Err(payload) => {
             let what = payload
                 .downcast_ref::<&str>()

@@ -10,6 +10,7 @@
 //! `::appell::__private`; everything is wrapped in `const _: () = { ... };`,
 //! beside the scene newtypes (`scenes.rs`). On errors, [`stub`] stands in.
 
+mod build_hint;
 mod code;
 mod controller;
 mod functions;
@@ -27,6 +28,7 @@ use crate::derivation::{Derivation, Derived};
 use crate::model::{Load, Model, Scene};
 use scenes::{info_static, newtype, scene_dispatch};
 
+pub use build_hint::{unoptimised_hint, DeriveBuild, SLOW_EXPANSION_SECONDS};
 pub use stub::stub;
 
 /// The runtime's items, as the generated code reaches them.
