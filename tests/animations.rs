@@ -100,6 +100,97 @@ fn bad_arguments_are_typed_errors() {
     assert!(svg(&model, &frames, &oblique).is_ok());
 }
 
+/// `animate` on the command line, with `problem` on stdin.
+fn animate(problem: &str) -> Result<String, appell::cli::CliError> {
+    let args = ["swing".to_string(), "animate".to_string()];
+    let mut out = Vec::new();
+    appell::cli::run_with(
+        Swing { l: 1.0 },
+        &args,
+        &mut problem.as_bytes(),
+        &mut out,
+        |_| Ok(()),
+    )?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+#[test]
+fn the_command_line_animates_a_state() {
+    let picture = animate(
+        r#"{"q": {"a": -1.0, "b": -0.5}, "u": {"a": 0, "b": 0}, "t_end": 2, "frames": 20,
+            "title": "swing", "view": "z", "connectors": [["O", "rod"], ["rod", "disc"]],
+            "traces": ["disc"]}"#,
+    )
+    .unwrap();
+    assert!(picture.starts_with("<svg") && picture.trim_end().ends_with("</svg>"));
+    assert!(picture.contains(">swing<"), "the title");
+    let moves = translations(&picture);
+    assert_eq!(moves.len(), 2);
+    assert_eq!(moves[1].len(), 21, "21 frames");
+    assert_ne!(moves[1][0], moves[1][10], "the disc moves");
+    // The same motion as the library draws.
+    let frames = simulate(
+        &Swing { l: 1.0 },
+        0.0,
+        &[-1.0, -0.5],
+        &[0.0, 0.0],
+        &[],
+        2.0,
+        20,
+    )
+    .unwrap();
+    let options = SvgOptions {
+        title: "swing".into(),
+        view: View::Along(2),
+        connectors: vec![(None, Some(0)), (Some(0), Some(1))],
+        traces: vec![1],
+        ..SvgOptions::default()
+    };
+    assert_eq!(picture, svg(&Swing { l: 1.0 }, &frames, &options).unwrap());
+}
+
+#[test]
+fn the_command_line_names_what_is_wrong_with_a_problem() {
+    let cases = [
+        (
+            r#"{"q": {"a": 0}, "u": {"a": 0, "b": 0}}"#,
+            "missing field `t_end`",
+        ),
+        (
+            r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 0}"#,
+            "must be after `t`",
+        ),
+        (
+            r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1, "traces": ["wheel"]}"#,
+            "unknown body `wheel` in `traces` (bodies: rod, disc",
+        ),
+        (
+            r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1, "view": "top"}"#,
+            "`view` must be",
+        ),
+        (
+            r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1, "frames": 0}"#,
+            "`frames` must be an integer from 1",
+        ),
+        (
+            r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1, "colour": "red"}"#,
+            "unknown field `colour`",
+        ),
+        (
+            r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0}, "t_end": 1}"#,
+            "missing privileged speed `b`",
+        ),
+    ];
+    for (problem, expected) in cases {
+        match animate(problem) {
+            Err(appell::cli::CliError::Animate(why)) => {
+                assert!(why.contains(expected), "{problem}: {why}")
+            }
+            other => panic!("{problem}: {other:?}"),
+        }
+    }
+}
+
 /// A screenshot of `file` after `millis` of virtual time.
 fn screenshot(file: &Path, millis: u32, out: &Path) -> Vec<u8> {
     let profile =

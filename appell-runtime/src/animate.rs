@@ -64,7 +64,8 @@ mod plot;
 pub use draw::{svg, SvgOptions, View};
 pub use plot::{line_plot, Curve};
 
-use crate::model::{check_len, Model, ModelError};
+use crate::dynamic::{DynModel, DynRhs};
+use crate::model::{check_len, ModelError};
 
 /// One instant of a motion: the time and every coordinate.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,8 +92,8 @@ pub const MAX_STEP: f64 = 1e-3;
 /// Errors: wrong lengths, `frames == 0`, a non-finite argument or
 /// `t_end <= t0` (as [`ModelError::NonFinite`] naming it), and any error of
 /// the model along the way (a singular configuration reached).
-pub fn simulate<M: Model>(
-    model: &M,
+pub fn simulate<K: DynModel + ?Sized>(
+    model: &K,
     t0: f64,
     q0: &[f64],
     u0: &[f64],
@@ -100,7 +101,7 @@ pub fn simulate<M: Model>(
     t_end: f64,
     frames: usize,
 ) -> Result<Vec<Frame>, ModelError> {
-    let info = M::info();
+    let info = model.dyn_info();
     let (n, l) = (info.coordinates.len(), info.speeds.len());
     check_len("q", q0, n)?;
     check_len("u", u0, l)?;
@@ -140,17 +141,17 @@ pub fn simulate<M: Model>(
 }
 
 /// q̇ and u̇ of the full state x = (q, u), the model prepared once.
-struct FullRates<'m, M: Model> {
-    model: &'m M,
-    prepared: M::Prepared<f64>,
+struct FullRates<'m, K: DynModel + ?Sized> {
+    model: &'m K,
+    rhs: Box<dyn DynRhs + 'm>,
     inputs: &'m [f64],
     retained: Vec<usize>,
     n: usize,
 }
 
-impl<'m, M: Model> FullRates<'m, M> {
-    fn new(model: &'m M, inputs: &'m [f64]) -> Result<Self, ModelError> {
-        let info = M::info();
+impl<'m, K: DynModel + ?Sized> FullRates<'m, K> {
+    fn new(model: &'m K, inputs: &'m [f64]) -> Result<Self, ModelError> {
+        let info = model.dyn_info();
         let retained = info
             .retained
             .iter()
@@ -162,7 +163,7 @@ impl<'m, M: Model> FullRates<'m, M> {
             .collect::<Result<_, _>>()?;
         Ok(FullRates {
             model,
-            prepared: model.prepare::<f64>(),
+            rhs: model.dyn_prepare(),
             inputs,
             retained,
             n: info.coordinates.len(),
@@ -174,10 +175,10 @@ impl<'m, M: Model> FullRates<'m, M> {
         let mut state: Vec<f64> = self.retained.iter().map(|&i| q[i]).collect();
         state.extend_from_slice(u);
         let mut dstate = vec![0.0; state.len()];
-        self.model
-            .rhs(&self.prepared, t, &state, self.inputs, &mut dstate)?;
+        self.rhs.rhs(t, &state, self.inputs, &mut dstate)?;
         let mut dx = vec![0.0; x.len()];
-        self.model.coordinate_rates(t, q, u, &mut dx[..self.n])?;
+        self.model
+            .dyn_coordinate_rates(t, q, u, &mut dx[..self.n])?;
         dx[self.n..].copy_from_slice(&dstate[self.retained.len()..]);
         Ok(dx)
     }

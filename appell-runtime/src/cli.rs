@@ -11,6 +11,7 @@
 //! <program> equations    the derived reduced equations, as text
 //! <program> bench        time the generated rhs against the oracle, as JSON
 //! <program> accuracy     a work-precision sweep of every integrator, as JSON
+//! <program> animate      one simulated motion as an animated SVG
 //! <program> help         usage (also -h, --help)
 //! ```
 //!
@@ -123,10 +124,33 @@
 //! A problem it cannot run is answered with `{"error": ".."}` and exit
 //! status 1. States up to [`ACCURACY_MAX_STATE`] entries. See [`accuracy()`].
 
+//! # `animate`
+//!
+//! Reads one JSON object from stdin: an `eval` state plus `t_end` (when the
+//! motion ends, required) and, optionally, `frames` (default 200),
+//! `playback` (seconds of motion per second, default 1), `width` and
+//! `height` (default 640 × 480), `title` (default the model's name), `view`
+//! (`"auto"`, `"oblique"`, `"x"`, `"y"` or `"z"`: looking along N's axis),
+//! `up` (three numbers, for the oblique view), `follow` (keep the bodies
+//! in the middle), `connectors` (pairs of body names, `"O"` for the
+//! origin: lines drawn between them), `traces` and `dots` (body names: a
+//! centre's path drawn; a body drawn as a dot), for example
+//!
+//! ```text
+//! {"q": {"phi": 0.3}, "u": {"phi": 0.2, "psi1": 1.0}, "inputs": {"tau": 0.4}, "t_end": 5, "view": "z"}
+//! ```
+//!
+//! simulates it ([`crate::animate::simulate`]: RK4 on every coordinate) and
+//! prints the SVG ([`crate::animate::svg`]). Every coordinate is taken from
+//! `q` as given (0 when omitted): give dependent coordinates on their
+//! constraints. A problem it cannot run is reported on stderr with exit
+//! status 1 and nothing on stdout.
+
 // Items the documentation links to.
 #[cfg(doc)]
 use crate::model::{Model, ModelError, ModelInfo};
 
+mod animate;
 mod bench;
 mod error;
 mod eval;

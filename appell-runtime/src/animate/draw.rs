@@ -6,7 +6,8 @@ use std::fmt::Write;
 
 use super::geometry::{self, Pose, Projection, Scene};
 use super::Frame;
-use crate::model::{Model, ModelError};
+use crate::dynamic::DynModel;
+use crate::model::ModelError;
 
 /// How the motion is looked at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -81,8 +82,8 @@ const MARGIN: f64 = 24.0;
 /// Errors: fewer than two frames or times not increasing
 /// ([`ModelError::NonFinite`] naming them), wrong coordinate lengths, and
 /// any error of the model's geometry functions.
-pub fn svg<M: Model>(
-    model: &M,
+pub fn svg<K: DynModel + ?Sized>(
+    model: &K,
     frames: &[Frame],
     options: &SvgOptions,
 ) -> Result<String, ModelError> {

@@ -5,7 +5,8 @@
 use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
 
 use super::Frame;
-use crate::model::{Model, ModelError};
+use crate::dynamic::DynModel;
+use crate::model::ModelError;
 
 /// A body at one frame, in N.
 #[derive(Clone, Copy, Debug)]
@@ -51,12 +52,15 @@ pub(super) fn ellipsoid(m: f64, inertia: &[f64; 9]) -> Matrix3<f64> {
 }
 
 /// Evaluates the model's geometry at every frame.
-pub(super) fn scene<M: Model>(model: &M, frames: &[Frame]) -> Result<Scene, ModelError> {
-    let info = M::info();
+pub(super) fn scene<K: DynModel + ?Sized>(
+    model: &K,
+    frames: &[Frame],
+) -> Result<Scene, ModelError> {
+    let info = model.dyn_info();
     let nb = info.bodies.len();
     let mut masses = vec![0.0; nb];
     let mut inertias = vec![[0.0; 9]; nb];
-    model.mass_properties(&mut masses, &mut inertias)?;
+    model.dyn_mass_properties(&mut masses, &mut inertias)?;
     let rigid: Vec<bool> = info.bodies.iter().map(|b| b.rigid).collect();
     let mut shapes: Vec<Matrix3<f64>> = (0..nb)
         .map(|b| match rigid[b] {
@@ -73,8 +77,8 @@ pub(super) fn scene<M: Model>(model: &M, frames: &[Frame]) -> Result<Scene, Mode
     // A rolling body's size is its rolling radius (the centre's distance
     // from the contact): the inertia says only how the mass spreads.
     if let (Some(f), false) = (frames.first(), points.is_empty()) {
-        model.body_poses(f.t, &f.q, &mut positions, &mut rotations)?;
-        model.contact_geometry(f.t, &f.q, &mut points, &mut directions)?;
+        model.dyn_body_poses(f.t, &f.q, &mut positions, &mut rotations)?;
+        model.dyn_contact_geometry(f.t, &f.q, &mut points, &mut directions)?;
         for (c, contact) in info.contacts.iter().enumerate() {
             let b = contact.body;
             let radius = distance(&points[c], &positions[b]);
@@ -87,7 +91,7 @@ pub(super) fn scene<M: Model>(model: &M, frames: &[Frame]) -> Result<Scene, Mode
         }
     }
     for f in frames {
-        model.body_poses(f.t, &f.q, &mut positions, &mut rotations)?;
+        model.dyn_body_poses(f.t, &f.q, &mut positions, &mut rotations)?;
         let at: Vec<Pose> = (0..nb)
             .map(|b| Pose {
                 centre: positions[b],
@@ -96,7 +100,7 @@ pub(super) fn scene<M: Model>(model: &M, frames: &[Frame]) -> Result<Scene, Mode
             .collect();
         poses.push(at);
         if !points.is_empty() {
-            model.contact_geometry(f.t, &f.q, &mut points, &mut directions)?;
+            model.dyn_contact_geometry(f.t, &f.q, &mut points, &mut directions)?;
         }
         contacts.push(points.clone());
     }

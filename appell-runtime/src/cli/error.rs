@@ -16,6 +16,8 @@ pub enum CliError {
     Bench(String),
     /// `accuracy` could not read its problem or compute the reference.
     Accuracy(String),
+    /// `animate` could not read its problem or simulate it.
+    Animate(String),
     /// The example's default action failed.
     Action(Box<dyn Error>),
 }
@@ -28,6 +30,7 @@ impl core::fmt::Display for CliError {
             CliError::Model(e) => write!(f, "{e}"),
             CliError::Bench(why) => write!(f, "bench: {why}"),
             CliError::Accuracy(why) => write!(f, "accuracy: {why}"),
+            CliError::Animate(why) => write!(f, "animate: {why}"),
             CliError::Action(e) => write!(f, "{e}"),
         }
     }
@@ -39,7 +42,10 @@ impl Error for CliError {
             CliError::Io(e) => Some(e),
             CliError::Model(e) => Some(e),
             CliError::Action(e) => Some(e.as_ref()),
-            CliError::Usage(_) | CliError::Bench(_) | CliError::Accuracy(_) => None,
+            CliError::Usage(_)
+            | CliError::Bench(_)
+            | CliError::Accuracy(_)
+            | CliError::Animate(_) => None,
         }
     }
 }

@@ -1,6 +1,7 @@
 //! The entry points: the usage text, reading the arguments and dispatching
 //! to the subcommand.
 
+use super::animate::animate_dyn;
 use super::bench::bench_dyn;
 use super::error::CliError;
 use super::eval::{eval_stream, EvalState};
@@ -29,7 +30,7 @@ use std::process::ExitCode;
 /// ```
 pub fn usage(program: &str, info: &ModelInfo) -> String {
     format!(
-        "usage: {program} [eval|contacts|info|equations|bench|accuracy|help]\n\
+        "usage: {program} [eval|contacts|info|equations|bench|accuracy|animate|help]\n\
          \n\
          Model `{name}`.\n\
          \n\
@@ -48,6 +49,9 @@ pub fn usage(program: &str, info: &ModelInfo) -> String {
          \x20 accuracy    read one JSON problem from stdin (an `eval` state plus\n\
          \x20             \"t_end\", optional \"checkpoints\", \"levels\", \"repeats\") and\n\
          \x20             print the work-precision sweep of every integrator as JSON\n\
+         \x20 animate     read one JSON problem from stdin (an `eval` state plus \"t_end\",\n\
+         \x20             optional \"frames\", \"playback\", \"view\", ..) and print an\n\
+         \x20             animated SVG of the simulated motion\n\
          \x20 help        print this text (also -h, --help)\n",
         name = info.name
     )
@@ -247,6 +251,17 @@ fn dispatch(
                     stdout.flush()?;
                     return Err(CliError::Accuracy(why));
                 }
+            }
+        }
+        "animate" => {
+            let mut text = String::new();
+            stdin.read_to_string(&mut text)?;
+            match animate_dyn(model, &text) {
+                Ok(picture) => {
+                    write!(stdout, "{picture}")?;
+                    stdout.flush()?;
+                }
+                Err(why) => return Err(CliError::Animate(why)),
             }
         }
         "help" | "-h" | "--help" => {
