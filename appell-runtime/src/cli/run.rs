@@ -25,7 +25,7 @@ use std::process::ExitCode;
 /// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
 /// # };
 /// let text = appell_runtime::cli::usage("pendulum", &info);
-/// assert!(text.starts_with("usage: pendulum [eval|contacts|info|equations|bench|accuracy|help]"));
+/// assert!(text.starts_with("usage: pendulum [eval|contacts|info|equations|bench|accuracy|animate|help]"));
 /// assert!(text.contains("Pendulum"));
 /// ```
 pub fn usage(program: &str, info: &ModelInfo) -> String {
