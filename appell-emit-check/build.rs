@@ -52,7 +52,7 @@ fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
         let a2 = g.powi(a, 2).unwrap();
         g.add(one, a2).unwrap()
     };
-    match rng.below(15) {
+    match rng.below(24) {
         0 | 1 => {
             let (a, b) = (sub(g, rng), sub(g, rng));
             g.add(a, b).unwrap()
@@ -105,10 +105,62 @@ fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
             let d = safe(g, rng);
             g.atan2(a, d).unwrap()
         }
-        _ => {
+        14 => {
             // A large power, emitted as powi.
             let d = safe(g, rng);
             g.powi(d, -(65 + rng.below(3) as i64)).unwrap()
+        }
+        15 => {
+            let a = sub(g, rng);
+            g.tanh(a).unwrap()
+        }
+        16 => {
+            let a = sub(g, rng);
+            let s = g.sin(a).unwrap();
+            if rng.below(2) == 0 {
+                g.sinh(s).unwrap()
+            } else {
+                g.cosh(s).unwrap()
+            }
+        }
+        17 => {
+            // asin and acos of sin(a)/2, inside their domain.
+            let a = sub(g, rng);
+            let s = g.sin(a).unwrap();
+            let half = g.rational(1, 2).unwrap();
+            let h = g.mul(half, s).unwrap();
+            if rng.below(2) == 0 {
+                g.asin(h).unwrap()
+            } else {
+                g.acos(h).unwrap()
+            }
+        }
+        18 => {
+            let a = sub(g, rng);
+            g.atan(a).unwrap()
+        }
+        19 => {
+            let d = safe(g, rng);
+            let b = sub(g, rng);
+            let s = g.sin(b).unwrap();
+            g.powf(d, s).unwrap()
+        }
+        20 => {
+            let (c, a, b) = (sub(g, rng), sub(g, rng), sub(g, rng));
+            g.select(c, a, b).unwrap()
+        }
+        21 => {
+            let (a, b) = (sub(g, rng), sub(g, rng));
+            if rng.below(2) == 0 {
+                g.min(a, b).unwrap()
+            } else {
+                g.max(a, b).unwrap()
+            }
+        }
+        _ => {
+            let (a, b) = (sub(g, rng), sub(g, rng));
+            let s = g.signum(a).unwrap();
+            g.mul(s, b).unwrap()
         }
     }
 }

@@ -13,8 +13,9 @@ pub enum Expr {
     Float(f64, Span),
     /// A name: parameter, coordinate, input, `t`, point or frame.
     Name(Ident),
-    /// `f(args)`: `dt`, `sin`, `cos`, `tan`, `exp`, `ln`, `sqrt`, `abs`,
-    /// `atan2`, `powi`, `dot`, `cross`, `norm`, `unit`.
+    /// `f(args)`: `dt`, the elementary functions, `atan2`, `powi`, `powf`,
+    /// `min`, `max`, `select` (also written `if a > b { x } else { y }`),
+    /// `dot`, `cross`, `norm`, `unit`, `omega`, `velocity`, `origin`.
     Call(Ident, Vec<Expr>, Span),
     /// `A.x`, `A.y`, `A.z`: a unit vector of frame `A`.
     Axis(Ident, usize, Span),

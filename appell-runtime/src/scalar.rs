@@ -87,6 +87,80 @@ pub trait Scalar:
     fn fma(self, a: Self, b: Self) -> Self {
         self.fused_mul_add(a, b)
     }
+    /// Hyperbolic sine.
+    fn sinh(self) -> Self {
+        let e = self.exp();
+        (e - Self::one() / e) * Self::from_f64(0.5)
+    }
+    /// Hyperbolic cosine.
+    fn cosh(self) -> Self {
+        let e = self.exp();
+        (e + Self::one() / e) * Self::from_f64(0.5)
+    }
+    /// Hyperbolic tangent (no overflow for large arguments).
+    fn tanh(self) -> Self {
+        let e = (Self::from_f64(-2.0) * self.abs()).exp();
+        let t = (Self::one() - e) / (Self::one() + e);
+        if self.re() < 0.0 {
+            -t
+        } else {
+            t
+        }
+    }
+    /// Arcsine, in [−π/2, π/2].
+    fn asin(self) -> Self {
+        let c = ((Self::one() - self) * (Self::one() + self)).sqrt();
+        self.atan2(c)
+    }
+    /// Arccosine, in [0, π].
+    fn acos(self) -> Self {
+        let s = ((Self::one() - self) * (Self::one() + self)).sqrt();
+        s.atan2(self)
+    }
+    /// Arctangent, in (−π/2, π/2).
+    fn atan(self) -> Self {
+        self.atan2(Self::one())
+    }
+    /// `self` to the real power `y` (NaN for a negative base, as `f64::powf`
+    /// gives for a non-integer power).
+    fn powf(self, y: Self) -> Self {
+        (y * self.ln()).exp()
+    }
+    /// The sign as the generated code takes it: 1 above zero, −1 below, 0 at
+    /// zero (not `f64::signum`, which is 1 at +0). A constant: its derivative
+    /// is zero.
+    ///
+    /// ```
+    /// use appell_runtime::Scalar;
+    /// assert_eq!([(-2.0_f64).sign(), 0.0.sign(), 3.0.sign()], [-1.0, 0.0, 1.0]);
+    /// ```
+    fn sign(self) -> Self {
+        let r = self.re();
+        Self::from_f64(if r > 0.0 {
+            1.0
+        } else if r < 0.0 {
+            -1.0
+        } else {
+            r * 0.0
+        })
+    }
+    /// `a` where `self > 0`, else `b`: the generated code's conditional
+    /// (`if c > 0 { a } else { b }`, `min`, `max`). For dual numbers the
+    /// derivative is that of the branch taken.
+    ///
+    /// ```
+    /// use appell_runtime::Scalar;
+    /// assert_eq!(0.5_f64.select(1.0, 2.0), 1.0);
+    /// assert_eq!(0.0_f64.select(1.0, 2.0), 2.0);
+    /// ```
+    #[inline(always)]
+    fn select(self, a: Self, b: Self) -> Self {
+        if self.re() > 0.0 {
+            a
+        } else {
+            b
+        }
+    }
     /// Zero.
     fn zero() -> Self {
         Self::from_f64(0.0)
@@ -182,6 +256,49 @@ macro_rules! float_scalar {
                     libm::Libm::<$t>::atan2(self, x)
                 }
             }
+            #[inline(always)]
+            fn sinh(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, sinh, self)
+            }
+            #[inline(always)]
+            fn cosh(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, cosh, self)
+            }
+            #[inline(always)]
+            fn tanh(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, tanh, self)
+            }
+            #[inline(always)]
+            fn asin(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, asin, self)
+            }
+            #[inline(always)]
+            fn acos(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, acos, self)
+            }
+            #[inline(always)]
+            fn atan(self) -> Self {
+                float_scalar!(@call $t, $libm_suffix, atan, self)
+            }
+            #[inline(always)]
+            fn powf(self, y: Self) -> Self {
+                #[cfg(feature = "std")]
+                {
+                    <$t>::powf(self, y)
+                }
+                #[cfg(not(feature = "std"))]
+                {
+                    libm::Libm::<$t>::pow(self, y)
+                }
+            }
+            #[inline(always)]
+            fn select(self, a: Self, b: Self) -> Self {
+                if self > 0.0 {
+                    a
+                } else {
+                    b
+                }
+            }
         }
     };
     (@call $t:ty, $s:ident, $f:ident, $x:expr) => {{
@@ -254,6 +371,34 @@ mod dual {
                 #[inline(always)]
                 fn atan2(self, x: Self) -> Self {
                     DualNum::atan2(&self, x)
+                }
+                #[inline(always)]
+                fn sinh(self) -> Self {
+                    DualNum::sinh(&self)
+                }
+                #[inline(always)]
+                fn cosh(self) -> Self {
+                    DualNum::cosh(&self)
+                }
+                #[inline(always)]
+                fn tanh(self) -> Self {
+                    DualNum::tanh(&self)
+                }
+                #[inline(always)]
+                fn asin(self) -> Self {
+                    DualNum::asin(&self)
+                }
+                #[inline(always)]
+                fn acos(self) -> Self {
+                    DualNum::acos(&self)
+                }
+                #[inline(always)]
+                fn atan(self) -> Self {
+                    DualNum::atan(&self)
+                }
+                #[inline(always)]
+                fn powf(self, y: Self) -> Self {
+                    DualNum::powd(&self, y)
                 }
             }
         };

@@ -555,15 +555,30 @@ impl Graph {
             }
         }
         match f {
-            Func::Sin | Func::Tan => {
+            Func::Sin | Func::Tan | Func::Sinh | Func::Tanh | Func::Asin | Func::Atan => {
                 if let Some(p) = self.negated(a)? {
                     let inner = self.func(f, p)?;
                     return self.neg(inner);
                 }
             }
-            Func::Cos => {
+            Func::Cos | Func::Cosh => {
                 if let Some(p) = self.negated(a)? {
                     return self.func(f, p);
+                }
+            }
+            Func::Acos => {}
+            Func::Sign => {
+                if let Some(p) = self.negated(a)? {
+                    let inner = self.func(f, p)?;
+                    return self.neg(inner);
+                }
+                if let Node::Fun(Func::Sign, _) = self.node(a) {
+                    return Ok(a);
+                }
+                match self.sign(a, &crate::Assumptions::new()) {
+                    crate::Sign::Positive => return self.int(1),
+                    crate::Sign::Negative => return self.int(-1),
+                    _ => {}
                 }
             }
             Func::Abs => {
@@ -625,6 +640,11 @@ impl Graph {
             Func::Ln if n.is_one() && !n.is_float() => Some(Number::ZERO),
             Func::Abs => Some(n.abs()),
             Func::Sqrt => n.exact_sqrt(),
+            Func::Sinh | Func::Tanh | Func::Asin | Func::Atan if n.is_zero() => Some(Number::ZERO),
+            Func::Cosh if n.is_zero() => Some(Number::ONE),
+            Func::Acos if n.is_one() && !n.is_float() => Some(Number::ZERO),
+            Func::Sign if n.is_zero() => Some(Number::ZERO),
+            Func::Sign => Some(Number::int(if n.is_negative() { -1 } else { 1 })),
             _ => None,
         };
         if let Some(v) = exact {
@@ -632,6 +652,9 @@ impl Graph {
         }
         if matches!(f, Func::Ln | Func::Sqrt) && (n.is_negative() || (f == Func::Ln && n.is_zero()))
         {
+            return Err(SymbolicError::NonFiniteConstant);
+        }
+        if matches!(f, Func::Asin | Func::Acos) && n.to_f64().abs() > 1.0 {
             return Err(SymbolicError::NonFiniteConstant);
         }
         if n.is_float() {
@@ -667,6 +690,126 @@ impl Graph {
     /// `√a`.
     pub fn sqrt(&mut self, a: Id) -> Result<Id> {
         self.func(Func::Sqrt, a)
+    }
+
+    /// `sinh(a)`.
+    pub fn sinh(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Sinh, a)
+    }
+    /// `cosh(a)`.
+    pub fn cosh(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Cosh, a)
+    }
+    /// `tanh(a)`.
+    pub fn tanh(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Tanh, a)
+    }
+    /// `asin(a)`.
+    pub fn asin(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Asin, a)
+    }
+    /// `acos(a)`.
+    pub fn acos(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Acos, a)
+    }
+    /// `atan(a)`.
+    pub fn atan(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Atan, a)
+    }
+    /// `sign(a)`: 1, −1, or 0 at zero ([`Func::Sign`]).
+    pub fn signum(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Sign, a)
+    }
+
+    /// `powf(x, y)`, `x` to the power `y`. An integer exponent (exact, or a
+    /// float with an integral value up to 64 in magnitude) is [`Graph::powi`],
+    /// an exponent of one half [`Graph::sqrt`]; constants fold.
+    ///
+    /// ```
+    /// use appell_symbolic::Graph;
+    /// let mut g = Graph::new();
+    /// let e = g.parse("powf(x, 2.0) - x^2 + powf(y, 0.5) - sqrt(y)").unwrap();
+    /// assert!(g.is_zero(e));
+    /// let p = g.parse("powf(x, a)").unwrap();
+    /// assert_eq!(g.display(p).to_string(), "powf(x, a)");
+    /// ```
+    pub fn powf(&mut self, x: Id, y: Id) -> Result<Id> {
+        if let Some(n) = self.as_number(y) {
+            let v = n.to_f64();
+            let integral = match n.as_integer() {
+                Some(k) => k.abs() <= i32::MAX as i128,
+                None => n.is_float() && v.fract() == 0.0 && v.abs() <= 64.0,
+            };
+            if integral {
+                return self.powi(x, v as i64);
+            }
+            if v == 0.5 {
+                return self.sqrt(x);
+            }
+            if let Some(m) = self.as_number(x) {
+                let r = m.to_f64().powf(v);
+                if !r.is_finite() {
+                    return Err(SymbolicError::NonFiniteConstant);
+                }
+                return self.float(r);
+            }
+        }
+        if let Some(m) = self.as_number(x) {
+            if m.is_one() {
+                return self.int(1);
+            }
+        }
+        self.intern(Node::Powf(x, y))
+    }
+
+    /// `select(c, a, b)`: `a` where `c > 0`, else `b`. Collapses when both
+    /// branches are equal or the sign of `c` is known.
+    ///
+    /// ```
+    /// use appell_symbolic::Graph;
+    /// let mut g = Graph::new();
+    /// let e = g.parse("select(x, y, y)").unwrap();
+    /// let y = g.parse("y").unwrap();
+    /// assert_eq!(e, y);
+    /// let two = g.parse("select(2, a, b)").unwrap();
+    /// assert_eq!(g.display(two).to_string(), "a");
+    /// ```
+    pub fn select(&mut self, c: Id, a: Id, b: Id) -> Result<Id> {
+        if a == b {
+            return Ok(a);
+        }
+        match self.sign(c, &crate::Assumptions::new()) {
+            crate::Sign::Positive => return Ok(a),
+            crate::Sign::Negative => return Ok(b),
+            _ if self.is_zero(c) => return Ok(b),
+            _ => {}
+        }
+        // select(c, select(c, a, _), b) = select(c, a, b), and the same
+        // in the other branch.
+        let a = match *self.node(a) {
+            Node::Select(c2, inner, _) if c2 == c => inner,
+            _ => a,
+        };
+        let b = match *self.node(b) {
+            Node::Select(c2, _, inner) if c2 == c => inner,
+            _ => b,
+        };
+        if a == b {
+            return Ok(a);
+        }
+        self.intern(Node::Select(c, a, b))
+    }
+
+    /// `min(a, b)`, as `select(b − a, a, b)`.
+    pub fn min(&mut self, a: Id, b: Id) -> Result<Id> {
+        let c = self.sub(b, a)?;
+        self.select(c, a, b)
+    }
+
+    /// `max(a, b)`, as `select(a − b, a, b)`.
+    pub fn max(&mut self, a: Id, b: Id) -> Result<Id> {
+        let c = self.sub(a, b)?;
+        self.select(c, a, b)
     }
 
     /// `atan2(y, x)`, the angle of the point `(x, y)`.

@@ -225,8 +225,46 @@ impl Graph {
                     Func::Sqrt => {
                         self.power_product(Number::ratio(1, 2).expect("1/2"), [(id, -1)])?
                     }
+                    Func::Sinh => self.cosh(a)?,
+                    Func::Cosh => self.sinh(a)?,
+                    Func::Tanh => {
+                        // 1 − tanh²
+                        let t2 = self.powi(id, 2)?;
+                        self.linear_combination(Number::ONE, [(t2, Number::int(-1))])?
+                    }
+                    Func::Asin | Func::Acos => {
+                        // ±1/√(1 − a²)
+                        let a2 = self.powi(a, 2)?;
+                        let r = self.linear_combination(Number::ONE, [(a2, Number::int(-1))])?;
+                        let root = self.sqrt(r)?;
+                        let k = if func == Func::Asin { 1 } else { -1 };
+                        self.power_product(Number::int(k), [(root, -1)])?
+                    }
+                    Func::Atan => {
+                        let a2 = self.powi(a, 2)?;
+                        let r = self.linear_combination(Number::ONE, [(a2, Number::ONE)])?;
+                        self.recip(r)?
+                    }
+                    // Piecewise constant: zero away from 0.
+                    Func::Sign => return self.int(0),
                 };
                 self.mul(outer, da)
+            }
+            Node::Powf(x, y) => {
+                // d x^y = x^y (y' ln x + y x'/x)
+                let (dx, dy) = (memo[&x], memo[&y]);
+                let mut inner = self.power_product(Number::ONE, [(y, 1), (dx, 1), (x, -1)])?;
+                if !self.is_zero(dy) {
+                    let ln = self.ln(x)?;
+                    let a = self.mul(dy, ln)?;
+                    inner = self.add(a, inner)?;
+                }
+                self.mul(id, inner)
+            }
+            Node::Select(c, a, b) => {
+                // Differentiated branch by branch.
+                let (da, db) = (memo[&a], memo[&b]);
+                self.select(c, da, db)
             }
             Node::Atan2(y, x) => {
                 // d atan2(y, x) = (x y' − y x') / (x² + y²)
@@ -269,6 +307,31 @@ mod tests {
         );
     }
 
+    #[test]
+    fn hyperbolic_and_inverse_functions() {
+        same("sinh(x)", "x", "cosh(x)");
+        same("cosh(2*x)", "x", "2*sinh(2*x)");
+        same("tanh(x)", "x", "1 - tanh(x)^2");
+        same("asin(x)", "x", "1/sqrt(1 - x^2)");
+        same("acos(x)", "x", "-1/sqrt(1 - x^2)");
+        same("atan(x)", "x", "1/(1 + x^2)");
+    }
+    #[test]
+    fn real_powers() {
+        // d x^a = a x^a / x; d a^x = a^x ln a.
+        same("powf(x, a)", "x", "a*powf(x, a)/x");
+        same("powf(a, x)", "x", "powf(a, x)*ln(a)");
+        same("powf(x, x)", "x", "powf(x, x)*(ln(x) + 1)");
+    }
+    #[test]
+    fn piecewise_functions_are_differentiated_piecewise() {
+        same("sign(x)", "x", "0");
+        same("y*sign(x)", "x", "0");
+        same("select(x - y, x^2, 3*x)", "x", "select(x - y, 2*x, 3)");
+        // min(a, b) = select(b − a, a, b)
+        same("min(x^2, y)", "x", "select(y - x^2, 2*x, 0)");
+        same("max(x, 2*x)", "x", "select(-x, 1, 2)");
+    }
     #[test]
     fn power_rule() {
         same("x^5", "x", "5*x^4");

@@ -113,11 +113,25 @@ fn write_expr(g: &Graph, id: Id, min: Prec, f: &mut dyn Write) -> fmt::Result {
             write_expr(g, *a, Prec::Sum, f)?;
             f.write_char(')')
         }
-        Node::Atan2(y, x) => {
-            f.write_str("atan2(")?;
+        Node::Atan2(y, x) | Node::Powf(y, x) => {
+            let name = if matches!(g.node(id), Node::Atan2(..)) {
+                "atan2("
+            } else {
+                "powf("
+            };
+            f.write_str(name)?;
             write_expr(g, *y, Prec::Sum, f)?;
             f.write_str(", ")?;
             write_expr(g, *x, Prec::Sum, f)?;
+            f.write_char(')')
+        }
+        Node::Select(c, a, b) => {
+            f.write_str("select(")?;
+            write_expr(g, *c, Prec::Sum, f)?;
+            f.write_str(", ")?;
+            write_expr(g, *a, Prec::Sum, f)?;
+            f.write_str(", ")?;
+            write_expr(g, *b, Prec::Sum, f)?;
             f.write_char(')')
         }
     }
@@ -143,7 +157,7 @@ fn write_product(g: &Graph, k: Number, factors: &[(Id, i32)], f: &mut dyn Write)
             .map(|(b, e)| {
                 let class = match g.node(b) {
                     Node::Sym(_) => 0,
-                    Node::Fun(..) | Node::Atan2(..) => 1,
+                    Node::Fun(..) | Node::Atan2(..) | Node::Powf(..) | Node::Select(..) => 1,
                     _ => 2,
                 };
                 let mut t = String::new();

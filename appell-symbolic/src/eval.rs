@@ -30,6 +30,8 @@ pub trait Value:
     fn apply(self, f: Func) -> Self;
     /// `atan2(self, x)`.
     fn atan2(self, x: Self) -> Self;
+    /// `self ^ y` for a real exponent.
+    fn powf(self, y: Self) -> Self;
 }
 
 impl Value for f64 {
@@ -48,6 +50,9 @@ impl Value for f64 {
     fn atan2(self, x: f64) -> f64 {
         f64::atan2(self, x)
     }
+    fn powf(self, y: f64) -> f64 {
+        f64::powf(self, y)
+    }
 }
 
 #[derive(Clone, Debug)]
@@ -58,6 +63,8 @@ enum Step {
     Mul(f64, Vec<(u32, i32)>),
     Fun(Func, u32),
     Atan2(u32, u32),
+    Powf(u32, u32),
+    Select(u32, u32, u32),
 }
 
 /// The nodes reachable from some roots, ready to evaluate repeatedly.
@@ -106,6 +113,10 @@ impl Tape {
                 ),
                 Node::Fun(f, a) => Step::Fun(*f, slot[a.index()]),
                 Node::Atan2(y, x) => Step::Atan2(slot[y.index()], slot[x.index()]),
+                Node::Powf(x, y) => Step::Powf(slot[x.index()], slot[y.index()]),
+                Node::Select(c, a, b) => {
+                    Step::Select(slot[c.index()], slot[a.index()], slot[b.index()])
+                }
             })
             .collect();
         let outputs = roots.iter().map(|r| slot[r.index()]).collect();
@@ -173,6 +184,14 @@ impl Tape {
                 }
                 Step::Fun(f, a) => vals[*a as usize].apply(*f),
                 Step::Atan2(y, x) => vals[*y as usize].atan2(vals[*x as usize]),
+                Step::Powf(x, y) => vals[*x as usize].powf(vals[*y as usize]),
+                Step::Select(c, a, b) => {
+                    if vals[*c as usize].real() > 0.0 {
+                        vals[*a as usize]
+                    } else {
+                        vals[*b as usize]
+                    }
+                }
             };
             if !v.real().is_finite() {
                 return Err(SymbolicError::NonFiniteValue {

@@ -60,6 +60,21 @@ pub enum Func {
     Abs,
     /// Square root.
     Sqrt,
+    /// Hyperbolic sine.
+    Sinh,
+    /// Hyperbolic cosine.
+    Cosh,
+    /// Hyperbolic tangent.
+    Tanh,
+    /// Arcsine (principal value, in [−π/2, π/2]).
+    Asin,
+    /// Arccosine (principal value, in [0, π]).
+    Acos,
+    /// Arctangent (principal value, in (−π/2, π/2)).
+    Atan,
+    /// The sign: 1 above zero, −1 below, 0 at zero. Piecewise constant: its
+    /// derivative is zero away from 0 (and taken as zero there).
+    Sign,
 }
 
 impl Func {
@@ -73,6 +88,13 @@ impl Func {
             Func::Ln => "ln",
             Func::Abs => "abs",
             Func::Sqrt => "sqrt",
+            Func::Sinh => "sinh",
+            Func::Cosh => "cosh",
+            Func::Tanh => "tanh",
+            Func::Asin => "asin",
+            Func::Acos => "acos",
+            Func::Atan => "atan",
+            Func::Sign => "sign",
         }
     }
 
@@ -86,6 +108,13 @@ impl Func {
             "ln" => Func::Ln,
             "abs" => Func::Abs,
             "sqrt" => Func::Sqrt,
+            "sinh" => Func::Sinh,
+            "cosh" => Func::Cosh,
+            "tanh" => Func::Tanh,
+            "asin" => Func::Asin,
+            "acos" => Func::Acos,
+            "atan" => Func::Atan,
+            "sign" => Func::Sign,
             _ => return None,
         })
     }
@@ -102,7 +131,26 @@ impl Func {
             Func::Ln => x.ln(),
             Func::Abs => x.abs(),
             Func::Sqrt => x.sqrt(),
+            Func::Sinh => x.sinh(),
+            Func::Cosh => x.cosh(),
+            Func::Tanh => x.tanh(),
+            Func::Asin => x.asin(),
+            Func::Acos => x.acos(),
+            Func::Atan => x.atan(),
+            Func::Sign => sign(x),
         }
+    }
+}
+
+/// The sign of `x` as the engine and the generated code take it: 1, −1,
+/// or 0 at zero (and NaN for NaN).
+pub fn sign(x: f64) -> f64 {
+    if x > 0.0 {
+        1.0
+    } else if x < 0.0 {
+        -1.0
+    } else {
+        x * 0.0
     }
 }
 
@@ -139,6 +187,11 @@ pub enum Node {
     Fun(Func, Id),
     /// `atan2(y, x)`.
     Atan2(Id, Id),
+    /// `powf(x, y)`: x to a power that is not an integer constant.
+    Powf(Id, Id),
+    /// `select(c, a, b)`: `a` where `c > 0`, else `b` (a conditional, and
+    /// `min` and `max`).
+    Select(Id, Id, Id),
 }
 
 impl Node {
@@ -149,7 +202,8 @@ impl Node {
             Node::Add { terms, .. } => terms.iter().map(|t| t.0).collect(),
             Node::Mul { factors, .. } => factors.iter().map(|f| f.0).collect(),
             Node::Fun(_, a) => vec![*a],
-            Node::Atan2(y, x) => vec![*y, *x],
+            Node::Atan2(y, x) | Node::Powf(y, x) => vec![*y, *x],
+            Node::Select(c, a, b) => vec![*c, *a, *b],
         }
     }
 
@@ -159,9 +213,14 @@ impl Node {
             Node::Add { terms, .. } => terms.iter().for_each(|t| f(t.0)),
             Node::Mul { factors, .. } => factors.iter().for_each(|t| f(t.0)),
             Node::Fun(_, a) => f(*a),
-            Node::Atan2(y, x) => {
+            Node::Atan2(y, x) | Node::Powf(y, x) => {
                 f(*y);
                 f(*x)
+            }
+            Node::Select(c, a, b) => {
+                f(*c);
+                f(*a);
+                f(*b)
             }
         }
     }

@@ -547,7 +547,13 @@ impl Graph {
                     _ => Sign::Unknown,
                 }
             }
-            Node::Fun(Func::Exp, _) => Sign::Positive,
+            Node::Fun(Func::Exp | Func::Cosh, _) => Sign::Positive,
+            Node::Select(_, a, b) => match (self.sign(*a, assumptions), self.sign(*b, assumptions))
+            {
+                (Sign::Positive, Sign::Positive) => Sign::Positive,
+                (Sign::Negative, Sign::Negative) => Sign::Negative,
+                _ => Sign::Unknown,
+            },
             Node::Fun(Func::Sqrt, a) => match self.sign(*a, assumptions) {
                 Sign::Positive => Sign::Positive,
                 _ => Sign::Unknown,

@@ -251,11 +251,15 @@ impl Parser<'_, '_> {
                 position: start,
                 message: format!("`{name}` takes {n} argument(s)"),
             };
-            if name == "atan2" {
-                if args.len() != 2 {
-                    return Err(arity_error(2));
-                }
-                return self.graph.atan2(args[0], args[1]);
+            match (name, args.len()) {
+                ("atan2", 2) => return self.graph.atan2(args[0], args[1]),
+                ("powf", 2) => return self.graph.powf(args[0], args[1]),
+                ("min", 2) => return self.graph.min(args[0], args[1]),
+                ("max", 2) => return self.graph.max(args[0], args[1]),
+                ("select", 3) => return self.graph.select(args[0], args[1], args[2]),
+                ("atan2" | "powf" | "min" | "max", _) => return Err(arity_error(2)),
+                ("select", _) => return Err(arity_error(3)),
+                _ => {}
             }
             let Some(func) = Func::from_name(name) else {
                 return Err(SymbolicError::Parse {

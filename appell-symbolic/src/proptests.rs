@@ -123,8 +123,39 @@ impl Value for Bounded {
                     self.e / (2.0 * room.sqrt()) + ulp
                 }
             }
+            Func::Sinh | Func::Cosh => (self.v.abs() + self.e).cosh() * self.e + ulp,
+            Func::Tanh | Func::Atan => self.e + ulp,
+            Func::Asin | Func::Acos => {
+                let reach = self.v.abs() + self.e;
+                if reach >= 1.0 {
+                    f64::INFINITY
+                } else {
+                    self.e / (1.0 - reach * reach).sqrt() + ulp
+                }
+            }
+            Func::Sign => {
+                if self.v.abs() > self.e {
+                    0.0
+                } else {
+                    2.0
+                }
+            }
         };
         Bounded::new(v, e)
+    }
+    fn powf(self, y: Bounded) -> Bounded {
+        let v = self.v.powf(y.v);
+        if self.v - self.e <= 0.0 {
+            return Bounded::new(v, f64::INFINITY);
+        }
+        // Monotone in each argument on a positive base: the corners bound it.
+        let mut e: f64 = 0.0;
+        for bx in [self.v - self.e, self.v + self.e] {
+            for by in [y.v - y.e, y.v + y.e] {
+                e = e.max((bx.powf(by) - v).abs());
+            }
+        }
+        Bounded::new(v, e * (1.0 + 1e-12) + 8.0 * EPS * v.abs())
     }
     fn atan2(self, x: Bounded) -> Bounded {
         let v = self.v.atan2(x.v);
@@ -160,10 +191,20 @@ impl Value for Dual64 {
                 }
             }
             Func::Sqrt => self.sqrt(),
+            Func::Sinh => self.sinh(),
+            Func::Cosh => self.cosh(),
+            Func::Tanh => self.tanh(),
+            Func::Asin => self.asin(),
+            Func::Acos => self.acos(),
+            Func::Atan => self.atan(),
+            Func::Sign => Dual64::from(crate::graph::sign(self.re)),
         }
     }
     fn atan2(self, x: Dual64) -> Dual64 {
         DualNum::atan2(&self, x)
+    }
+    fn powf(self, y: Dual64) -> Dual64 {
+        DualNum::powd(&self, y)
     }
 }
 
@@ -200,6 +241,10 @@ enum E {
     Atan2(Box<E>, Box<E>),
     /// b sin²a + b cos²a
     Pythagoras(Box<E>, Box<E>),
+    /// tanh a, atan a, sinh(sin a), cosh(sin a), asin(sin(a)/2), acos(sin(a)/2)
+    Unary(Func, Box<E>),
+    /// powf(1 + a², sin b)
+    Powf(Box<E>, Box<E>),
 }
 
 fn leaf() -> impl Strategy<Value = E> {
@@ -239,7 +284,20 @@ fn expr_depth(depth: u32) -> BoxedStrategy<E> {
         1 => b(i.clone()).prop_map(E::Sqrt),
         1 => b(i.clone()).prop_map(E::Abs),
         1 => (b(i.clone()), b(i.clone())).prop_map(|(a, c)| E::Atan2(a, c)),
-        1 => (b(i.clone()), b(i)).prop_map(|(a, c)| E::Pythagoras(a, c)),
+        1 => (b(i.clone()), b(i.clone())).prop_map(|(a, c)| E::Pythagoras(a, c)),
+        1 => (
+            prop_oneof![
+                Just(Func::Tanh),
+                Just(Func::Atan),
+                Just(Func::Sinh),
+                Just(Func::Cosh),
+                Just(Func::Asin),
+                Just(Func::Acos)
+            ],
+            b(i.clone())
+        )
+            .prop_map(|(f, a)| E::Unary(f, a)),
+        1 => (b(i.clone()), b(i)).prop_map(|(a, c)| E::Powf(a, c)),
     ];
     prop_oneof![1 => leaf(), 6 => branch].boxed()
 }
@@ -252,6 +310,7 @@ fn size(e: &E) -> usize {
         | E::Mul(a, b)
         | E::Div(a, b)
         | E::Atan2(a, b)
+        | E::Powf(a, b)
         | E::Pythagoras(a, b) => 1 + size(a) + size(b),
         E::Pow(a, _)
         | E::InvPow(a, _)
@@ -262,6 +321,7 @@ fn size(e: &E) -> usize {
         | E::Exp(a)
         | E::Ln(a)
         | E::Sqrt(a)
+        | E::Unary(_, a)
         | E::Abs(a) => 1 + size(a),
     }
 }
@@ -349,6 +409,25 @@ fn build(g: &mut Graph, e: &E) -> Id {
             let d = safe(g, b);
             g.atan2(a, d).unwrap()
         }
+        E::Unary(f, a) => {
+            let a = build(g, a);
+            let arg = match f {
+                Func::Tanh | Func::Atan => a,
+                Func::Sinh | Func::Cosh => g.sin(a).unwrap(),
+                _ => {
+                    let s = g.sin(a).unwrap();
+                    let half = g.rational(1, 2).unwrap();
+                    g.mul(half, s).unwrap()
+                }
+            };
+            g.func(*f, arg).unwrap()
+        }
+        E::Powf(a, b) => {
+            let (a, b) = (build(g, a), build(g, b));
+            let base = safe(g, a);
+            let s = g.sin(b).unwrap();
+            g.powf(base, s).unwrap()
+        }
         E::Pythagoras(a, b) => {
             let (a, b) = (build(g, a), build(g, b));
             let s = g.sin(a).unwrap();
@@ -371,6 +450,7 @@ fn has_float(e: &E) -> bool {
         | E::Mul(a, b)
         | E::Div(a, b)
         | E::Atan2(a, b)
+        | E::Powf(a, b)
         | E::Pythagoras(a, b) => has_float(a) || has_float(b),
         E::Pow(a, _)
         | E::InvPow(a, _)
@@ -381,6 +461,7 @@ fn has_float(e: &E) -> bool {
         | E::Exp(a)
         | E::Ln(a)
         | E::Sqrt(a)
+        | E::Unary(_, a)
         | E::Abs(a) => has_float(a),
     }
 }
@@ -409,6 +490,16 @@ fn raw<T: Value>(e: &E, x: &[T; 3]) -> T {
         E::Sqrt(a) => safe(raw(a, x)).apply(Func::Sqrt),
         E::Abs(a) => raw(a, x).apply(Func::Abs),
         E::Atan2(a, b) => raw(a, x).atan2(safe(raw(b, x))),
+        E::Unary(f, a) => {
+            let a = raw(a, x);
+            let arg = match f {
+                Func::Tanh | Func::Atan => a,
+                Func::Sinh | Func::Cosh => a.apply(Func::Sin),
+                _ => T::from_f64(0.5) * a.apply(Func::Sin),
+            };
+            arg.apply(*f)
+        }
+        E::Powf(a, b) => safe(raw(a, x)).powf(raw(b, x).apply(Func::Sin)),
         E::Pythagoras(a, b) => {
             let a = raw(a, x);
             let b = raw(b, x);

@@ -178,3 +178,47 @@ fn huge_exponent_overflows_cleanly() {
         crate::SymbolicError::ExponentOverflow
     );
 }
+
+// The functions of friction laws, drives and one-sided contacts.
+rule!(sinh_odd, "sinh(-x)", "-sinh(x)");
+rule!(cosh_even, "cosh(-x)", "cosh(x)");
+rule!(tanh_odd, "tanh(-x)", "-tanh(x)");
+rule!(asin_odd, "asin(-x)", "-asin(x)");
+rule!(atan_odd, "atan(-x)", "-atan(x)");
+rule!(sign_odd, "sign(-x)", "-sign(x)");
+rule!(sign_idempotent, "sign(sign(x))", "sign(x)");
+rule!(sign_of_positive, "sign(exp(x))", "1");
+rule!(sign_of_constants, "sign(-3/2) + 2*sign(0)", "-1");
+rule!(hyperbolic_at_zero, "sinh(0) + tanh(0) + cosh(0)", "1");
+rule!(inverse_at_zero, "asin(0) + atan(0) + acos(1)", "0");
+rule!(powf_integer_exponent, "powf(x, 3)", "x^3");
+rule!(powf_integral_float_exponent, "powf(x, 2.0)", "x^2");
+rule!(powf_half, "powf(x, 1/2)", "sqrt(x)");
+rule!(powf_of_one, "powf(1, x)", "1");
+rule!(select_equal_branches, "select(x, y, y)", "y");
+rule!(
+    select_known_sign,
+    "select(exp(x), y, z) + select(-exp(x), y, z)",
+    "y + z"
+);
+rule!(select_zero_condition, "select(0, y, z)", "z");
+rule!(
+    select_nested_same_condition,
+    "select(x, select(x, y, w), z)",
+    "select(x, y, z)"
+);
+rule!(min_of_equal, "min(x, x)", "x");
+rule!(max_as_select, "max(x, y)", "select(x - y, x, y)");
+
+#[test]
+fn functions_fold_and_reject_constants_outside_their_domain() {
+    let mut g = Graph::new();
+    let e = g
+        .parse("tanh(0.5) + powf(2.0, 0.5) + min(1.5, 2.5)")
+        .unwrap();
+    let expected = 0.5f64.tanh() + 2f64.sqrt() + 1.5;
+    assert_eq!(g.display(e).to_string(), format!("{expected}"));
+    for bad in ["asin(2.0)", "acos(-1.5)", "powf(-8.0, 0.3)"] {
+        assert!(g.parse(bad).is_err(), "{bad}");
+    }
+}

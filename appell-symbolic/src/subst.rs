@@ -102,6 +102,8 @@ impl Graph {
             }
             Node::Fun(f, a) => self.func(*f, map(*a)),
             Node::Atan2(y, x) => self.atan2(map(*y), map(*x)),
+            Node::Powf(x, y) => self.powf(map(*x), map(*y)),
+            Node::Select(c, a, b) => self.select(map(*c), map(*a), map(*b)),
         }
     }
 
@@ -183,7 +185,12 @@ impl Graph {
                 continue;
             }
             if !expanded {
-                if !inside_functions && matches!(self.node(id), Node::Fun(..) | Node::Atan2(..)) {
+                if !inside_functions
+                    && matches!(
+                        self.node(id),
+                        Node::Fun(..) | Node::Atan2(..) | Node::Powf(..) | Node::Select(..)
+                    )
+                {
                     memo.insert(id, id);
                     continue;
                 }

@@ -7,7 +7,7 @@
 use proc_macro2::Span;
 use syn::Ident;
 
-use appell_symbolic::{Graph, Id, Number, SymbolicError};
+use appell_symbolic::{Func, Id, Number, SymbolicError};
 
 use super::builder::{hint, Builder};
 use super::expr::Val;
@@ -167,8 +167,14 @@ impl Builder<'_> {
         let name = f.to_string();
         let Some(&(_, arity)) = FUNCTIONS.iter().find(|(n, _)| *n == name) else {
             let h = hint(&name, FUNCTIONS.iter().map(|(n, _)| n.to_string()));
-            self.cx
-                .error_spanned_by(f, format!("unknown function `{name}`{h}"));
+            let all: Vec<&str> = FUNCTIONS.iter().map(|(n, _)| *n).collect();
+            self.cx.error_spanned_by(
+                f,
+                format!(
+                    "unknown function `{name}`{h} (the functions: {})",
+                    all.join(", ")
+                ),
+            );
             return Ok(None);
         };
         if args.len() != arity {
@@ -187,15 +193,38 @@ impl Builder<'_> {
                 Ok(Some(Val::Scalar(self.g.atan2(y, x)?)))
             }
             "powi" => self.call_powi(args),
+            "powf" | "min" | "max" => {
+                let (Some(a), Some(b)) = (self.scalar(&args[0]), self.scalar(&args[1])) else {
+                    return Ok(None);
+                };
+                let v = match name.as_str() {
+                    "powf" => self.g.powf(a, b)?,
+                    "min" => self.g.min(a, b)?,
+                    _ => self.g.max(a, b)?,
+                };
+                Ok(Some(Val::Scalar(v)))
+            }
+            "select" => {
+                let (Some(c), Some(a), Some(b)) = (
+                    self.scalar(&args[0]),
+                    self.scalar(&args[1]),
+                    self.scalar(&args[2]),
+                ) else {
+                    return Ok(None);
+                };
+                Ok(Some(Val::Scalar(self.g.select(c, a, b)?)))
+            }
             "omega" | "velocity" => self.call_motion(&name, &args[0]),
             "origin" => Ok(self.call_origin(&args[0])),
             "dot" | "cross" => self.call_product(&name, args),
             "norm" | "unit" => self.call_norm(&name, &args[0], span),
             _ => {
-                let Some(x) = self.scalar(&args[0]) else {
+                // The elementary functions of one argument (FUNCTIONS lists
+                // nothing else of arity 1 that reaches here).
+                let (Some(f), Some(x)) = (Func::from_name(&name), self.scalar(&args[0])) else {
                     return Ok(None);
                 };
-                Ok(Some(Val::Scalar(unary(&mut self.g, &name, x)?)))
+                Ok(Some(Val::Scalar(self.g.func(f, x)?)))
             }
         }
     }
@@ -363,8 +392,19 @@ const FUNCTIONS: &[(&str, usize)] = &[
     ("ln", 1),
     ("sqrt", 1),
     ("abs", 1),
+    ("sinh", 1),
+    ("cosh", 1),
+    ("tanh", 1),
+    ("asin", 1),
+    ("acos", 1),
+    ("atan", 1),
+    ("sign", 1),
     ("atan2", 2),
     ("powi", 2),
+    ("powf", 2),
+    ("min", 2),
+    ("max", 2),
+    ("select", 3),
     ("dot", 2),
     ("cross", 2),
     ("norm", 1),
@@ -373,16 +413,3 @@ const FUNCTIONS: &[(&str, usize)] = &[
     ("velocity", 1),
     ("origin", 1),
 ];
-
-/// An elementary function of one argument.
-fn unary(g: &mut Graph, name: &str, x: Id) -> Result<Id, SymbolicError> {
-    match name {
-        "sin" => g.sin(x),
-        "cos" => g.cos(x),
-        "tan" => g.tan(x),
-        "exp" => g.exp(x),
-        "ln" => g.ln(x),
-        "sqrt" => g.sqrt(x),
-        _ => g.abs(x),
-    }
-}

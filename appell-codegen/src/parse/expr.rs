@@ -29,13 +29,30 @@ pub fn convert(e: &syn::Expr) -> syn::Result<Expr> {
                 syn::BinOp::Sub(_) => BinOp::Sub,
                 syn::BinOp::Mul(_) => BinOp::Mul,
                 syn::BinOp::Div(_) => BinOp::Div,
+                syn::BinOp::BitXor(_) => {
+                    return Err(syn::Error::new(
+                        b.op.span(),
+                        "`^` is not a power here: write `powi(x, 3)` for an integer power \
+                         or `powf(x, y)` for a real one",
+                    ))
+                }
                 _ => {
                     return Err(syn::Error::new(
                         b.op.span(),
-                        "only `+ - * /` (and `==` in constraints) are allowed here",
+                        "only `+ - * /` (and `==` in constraints, `>` `<` in an `if`) \
+                         are allowed here",
                     ))
                 }
             };
+            if let syn::Expr::Unary(u) = &*b.right {
+                if matches!(u.op, syn::UnOp::Deref(_)) && matches!(b.op, syn::BinOp::Mul(_)) {
+                    return Err(syn::Error::new(
+                        b.op.span(),
+                        "`**` is not a power here: write `powi(x, 3)` for an integer power \
+                         or `powf(x, y)` for a real one",
+                    ));
+                }
+            }
             Expr::Binary(
                 op,
                 Box::new(convert(&b.left)?),
@@ -84,6 +101,8 @@ pub fn convert(e: &syn::Expr) -> syn::Result<Expr> {
             };
             Expr::Axis(frame, axis, f.span())
         }
+        syn::Expr::If(i) => conditional(i)?,
+        syn::Expr::Block(b) => block_value(&b.block)?,
         other => {
             return Err(syn::Error::new(
                 other.span(),
@@ -91,4 +110,57 @@ pub fn convert(e: &syn::Expr) -> syn::Result<Expr> {
             ))
         }
     })
+}
+
+/// `if a > b { x } else { y }` (also `<`, `>=`, `<=`, and `else if`) as
+/// `select(a − b, x, y)`. `>=` and `<=` are `>` and `<`: at a = b exactly
+/// the `else` branch is taken.
+fn conditional(i: &syn::ExprIf) -> syn::Result<Expr> {
+    let syn::Expr::Binary(cmp) = &*i.cond else {
+        return Err(syn::Error::new(
+            i.cond.span(),
+            "the condition is a comparison: `a > b`, `a < b`, `a >= b` or `a <= b`",
+        ));
+    };
+    let (left, right) = (convert(&cmp.left)?, convert(&cmp.right)?);
+    let span = cmp.span();
+    let difference = match cmp.op {
+        syn::BinOp::Gt(_) | syn::BinOp::Ge(_) => {
+            Expr::Binary(BinOp::Sub, Box::new(left), Box::new(right), span)
+        }
+        syn::BinOp::Lt(_) | syn::BinOp::Le(_) => {
+            Expr::Binary(BinOp::Sub, Box::new(right), Box::new(left), span)
+        }
+        _ => {
+            return Err(syn::Error::new(
+                cmp.op.span(),
+                "the condition is a comparison: `>`, `<`, `>=` or `<=`",
+            ))
+        }
+    };
+    let then = block_value(&i.then_branch)?;
+    let Some((_, otherwise)) = &i.else_branch else {
+        return Err(syn::Error::new(
+            i.span(),
+            "an `if` in an expression needs an `else` branch",
+        ));
+    };
+    let otherwise = convert(otherwise)?;
+    let select = syn::Ident::new("select", i.if_token.span);
+    Ok(Expr::Call(
+        select,
+        vec![difference, then, otherwise],
+        i.span(),
+    ))
+}
+
+/// The value of a block holding one expression.
+fn block_value(b: &syn::Block) -> syn::Result<Expr> {
+    match b.stmts.as_slice() {
+        [syn::Stmt::Expr(e, None)] => convert(e),
+        _ => Err(syn::Error::new(
+            b.span(),
+            "a branch holds one expression, without `;`",
+        )),
+    }
 }

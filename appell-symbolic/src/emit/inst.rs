@@ -33,6 +33,10 @@ pub enum Inst {
     Call(Func, u32),
     /// `atan2(y, x)`.
     Atan2(u32, u32),
+    /// `powf(x, y)`.
+    Powf(u32, u32),
+    /// `select(c, a, b)`: `a` where `c > 0`, else `b`.
+    Select(u32, u32, u32),
 }
 
 impl Inst {
@@ -44,6 +48,8 @@ impl Inst {
             Inst::Mul(a, b) => Inst::Mul(r(a), r(b)),
             Inst::Div(a, b) => Inst::Div(r(a), r(b)),
             Inst::Atan2(a, b) => Inst::Atan2(r(a), r(b)),
+            Inst::Powf(a, b) => Inst::Powf(r(a), r(b)),
+            Inst::Select(c, a, b) => Inst::Select(r(c), r(a), r(b)),
             Inst::Neg(a) => Inst::Neg(r(a)),
             Inst::Powi(a, e) => Inst::Powi(r(a), e),
             Inst::Call(f, a) => Inst::Call(f, r(a)),
@@ -56,7 +62,8 @@ impl Inst {
         match *self {
             Inst::Const(_) | Inst::Symbol(_) => vec![],
             Inst::Add(a, b) | Inst::Sub(a, b) | Inst::Mul(a, b) | Inst::Div(a, b) => vec![a, b],
-            Inst::Atan2(y, x) => vec![y, x],
+            Inst::Atan2(y, x) | Inst::Powf(y, x) => vec![y, x],
+            Inst::Select(c, a, b) => vec![c, a, b],
             Inst::Neg(a) | Inst::Powi(a, _) | Inst::Call(_, a) => vec![a],
         }
     }
@@ -113,7 +120,9 @@ impl OpCount {
             Inst::Div(..) => self.div += times,
             Inst::Neg(_) => self.neg += times,
             Inst::Powi(..) => self.powi += times,
-            Inst::Call(..) | Inst::Atan2(..) => self.calls += times,
+            Inst::Call(..) | Inst::Atan2(..) | Inst::Powf(..) => self.calls += times,
+            // A comparison and a choice, counted with the additions.
+            Inst::Select(..) => self.add += times,
         }
     }
 }

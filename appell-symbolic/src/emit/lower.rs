@@ -553,6 +553,14 @@ impl Lowering<'_> {
                 let (y, x) = (self.memo[y], self.memo[x]);
                 self.push(Inst::Atan2(y, x))
             }
+            Node::Powf(x, y) => {
+                let (x, y) = (self.memo[x], self.memo[y]);
+                self.push(Inst::Powf(x, y))
+            }
+            Node::Select(c, a, b) => {
+                let (c, a, b) = (self.memo[c], self.memo[a], self.memo[b]);
+                self.push(Inst::Select(c, a, b))
+            }
         }
     }
 }

@@ -173,6 +173,14 @@ impl Program {
                 Inst::Powi(a, e) => v[a as usize].powi(e),
                 Inst::Call(f, a) => f.apply(v[a as usize]),
                 Inst::Atan2(y, x) => v[y as usize].atan2(v[x as usize]),
+                Inst::Powf(x, y) => v[x as usize].powf(v[y as usize]),
+                Inst::Select(c, a, b) => {
+                    if v[c as usize] > 0.0 {
+                        v[a as usize]
+                    } else {
+                        v[b as usize]
+                    }
+                }
             };
             v.push(x);
         }

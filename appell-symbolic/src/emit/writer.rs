@@ -551,6 +551,12 @@ impl<'a> Writer<'a> {
             Inst::Powi(a, e) => method(a as usize, "powi", vec![Frag::Int(e)]),
             Inst::Call(f, a) => method(a as usize, f.name(), vec![]),
             Inst::Atan2(y, x) => method(y as usize, "atan2", vec![self.expr(x as usize).0]),
+            Inst::Powf(x, y) => method(x as usize, "powf", vec![self.expr(y as usize).0]),
+            Inst::Select(c, a, b) => method(
+                c as usize,
+                "select",
+                vec![self.expr(a as usize).0, self.expr(b as usize).0],
+            ),
         }
     }
 }

@@ -16,7 +16,8 @@ pub(super) fn latency(inst: &Inst) -> u32 {
         Inst::Div(..) => 14,
         Inst::Call(Func::Sqrt, _) => 20,
         Inst::Powi(..) => 30,
-        Inst::Call(..) | Inst::Atan2(..) => 60,
+        Inst::Select(..) => 4,
+        Inst::Call(..) | Inst::Atan2(..) | Inst::Powf(..) => 60,
     }
 }
 

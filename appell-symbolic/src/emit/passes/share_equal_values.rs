@@ -196,7 +196,9 @@ fn residues(insts: &[Inst]) -> Vec<Option<[u64; VALUE_POINTS]>> {
                     })
                 }),
                 // Other calls and atan2 are variables of their own.
-                Inst::Call(..) | Inst::Atan2(..) => Some(fresh(CALL, i as u64)),
+                Inst::Call(..) | Inst::Atan2(..) | Inst::Powf(..) | Inst::Select(..) => {
+                    Some(fresh(CALL, i as u64))
+                }
             };
             match r {
                 Some(r) => *slot = r,
