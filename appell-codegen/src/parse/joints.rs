@@ -75,6 +75,8 @@ pub struct JointDef {
     /// The joint's rates are not privileged speeds (a joint a loop closure
     /// makes dependent).
     pub dependent: bool,
+    /// Springs, dampers, friction and the motor's saturation on the joint.
+    pub elements: super::elements::JointElements,
     /// The whole item, for errors.
     pub span: Span,
 }
@@ -96,6 +98,7 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
         rpy: None,
         actuated: false,
         dependent: false,
+        elements: Default::default(),
         span,
     };
     let (mut parent, mut child) = (None, None);
@@ -115,6 +118,9 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
         }
         s.parse::<Token![=]>()?;
         let value: syn::Expr = s.parse()?;
+        if joint.elements.set(&key, &value)? {
+            continue;
+        }
         match key.to_string().as_str() {
             "parent" => parent = Some(super::items::expr_ident(&value)?),
             "child" => child = Some(super::items::expr_ident(&value)?),
@@ -139,7 +145,20 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
             ),
         )
     })?;
-    if joint.actuated && !matches!(joint.kind, JointKind::Revolute(_) | JointKind::Prismatic(_)) {
+    let one_axis = matches!(joint.kind, JointKind::Revolute(_) | JointKind::Prismatic(_));
+    if joint.elements.any() && !one_axis {
+        return Err(syn::Error::new(
+            span,
+            "`stiffness`, `damping`, `friction` and `saturation` are for revolute and prismatic joints; load other joints with `torque(...)` and `force(...)`",
+        ));
+    }
+    if joint.elements.saturation.is_some() && !joint.actuated {
+        return Err(syn::Error::new(
+            span,
+            "`saturation` limits the joint's actuation: add the flag `actuated`",
+        ));
+    }
+    if joint.actuated && !one_axis {
         return Err(syn::Error::new(
             span,
             "`actuated` is for revolute and prismatic joints; drive other joints with `torque(...)` and `force(...)`",
@@ -151,7 +170,7 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
 fn unknown_property(key: &Ident, other: &str) -> syn::Error {
     syn::Error::new(
         key.span(),
-        format!("unknown joint property `{other}`; a joint has `parent`, `child`, `xyz`, `rpy`, `at` and the flags `actuated`, `dependent`"),
+        format!("unknown joint property `{other}`; a joint has `parent`, `child`, `xyz`, `rpy`, `at`, the elements `stiffness`, `rest`, `damping`, `friction`, `friction_smoothing`, `saturation` and the flags `actuated`, `dependent`"),
     )
 }
 
@@ -372,7 +391,40 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         location: plus(joint_origin.clone(), slide),
     });
     if j.actuated {
-        actuate(j, &mut out, &origin_name, joint_origin, name("_at"));
+        let tau = Ident::new(&format!("tau_{}", j.name), j.name.span());
+        out.inputs.push(tau.clone());
+        let mut magnitude = Expr::Name(tau);
+        if let Some(limit) = &j.elements.saturation {
+            // max(−limit, min(limit, τ))
+            let span = j.name.span();
+            let call =
+                |f: &str, a: Expr, b: Expr| Expr::Call(Ident::new(f, span), vec![a, b], span);
+            let upper = call("min", limit.clone(), magnitude);
+            magnitude = call("max", Expr::Neg(Box::new(limit.clone()), span), upper);
+        }
+        let effect = Ident::new("actuation", j.name.span());
+        let at = name("_at");
+        along_axis(
+            j,
+            &mut out,
+            magnitude,
+            effect,
+            &origin_name,
+            joint_origin.clone(),
+            at,
+        );
+    }
+    for (magnitude, effect) in j.elements.torques(&j.name) {
+        let at = name(&format!("_{effect}_at"));
+        along_axis(
+            j,
+            &mut out,
+            magnitude,
+            effect,
+            &origin_name,
+            joint_origin.clone(),
+            at,
+        );
     }
     Ok(out)
 }
@@ -419,15 +471,21 @@ fn ball(j: &JointDef, out: &mut Lowered) -> Box<[Expr; 4]> {
     Box::new(e.map(Expr::Name))
 }
 
-/// The input `tau_{joint}` and its loads: a torque about the axis on the
-/// child and its reaction on the parent (revolute), or a force along it
-/// at the child's origin and its reaction at the parent's point there
-/// (prismatic). The parent N takes no reaction: it does not move.
-fn actuate(j: &JointDef, out: &mut Lowered, child_origin: &Ident, joint_origin: Expr, at: Ident) {
+/// A generalized torque (force) `magnitude` on the joint as loads: a torque
+/// about the axis on the child and its reaction on the parent (revolute),
+/// or a force along it at the child's origin and its reaction at the
+/// parent's point there, named `at` (prismatic). The parent N takes no
+/// reaction: it does not move.
+fn along_axis(
+    j: &JointDef,
+    out: &mut Lowered,
+    magnitude: Expr,
+    effect: Ident,
+    child_origin: &Ident,
+    joint_origin: Expr,
+    at: Ident,
+) {
     let span = j.name.span();
-    let tau = Ident::new(&format!("tau_{}", j.name), span);
-    out.inputs.push(tau.clone());
-    let effect = Ident::new("actuation", span);
     let on_parent = j.parent != "N";
     let load = |target: Ident, vector: Expr| LoadDef {
         target,
@@ -436,7 +494,7 @@ fn actuate(j: &JointDef, out: &mut Lowered, child_origin: &Ident, joint_origin: 
     };
     match &j.kind {
         JointKind::Revolute(axis) => {
-            let v = times(Expr::Name(tau), unit_vector(axis, &j.child));
+            let v = times(magnitude, unit_vector(axis, &j.child));
             out.torques.push(load(j.child.clone(), v.clone()));
             if on_parent {
                 out.torques
@@ -444,7 +502,7 @@ fn actuate(j: &JointDef, out: &mut Lowered, child_origin: &Ident, joint_origin: 
             }
         }
         JointKind::Prismatic(axis) => {
-            let v = times(Expr::Name(tau), unit_vector(axis, &j.child));
+            let v = times(magnitude, unit_vector(axis, &j.child));
             out.forces.push(load(child_origin.clone(), v.clone()));
             if on_parent {
                 out.points.push(PointDef {

@@ -9,6 +9,7 @@ use syn::{Ident, Token};
 use crate::ast::*;
 use crate::ctxt::Ctxt;
 
+mod elements;
 mod expr;
 mod items;
 pub mod joints;
@@ -249,6 +250,9 @@ const ITEMS: &[&str] = &[
     "force",
     "torque",
     "gravity",
+    "spring",
+    "damper",
+    "friction",
     "rolls",
     "scene",
     "joint",
@@ -317,6 +321,16 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, manifest_dir: Option<&std
             }
             "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
             "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
+            "spring" | "damper" => {
+                let kind = name.clone();
+                ast.forces.extend(Parser::parse2(
+                    move |s: ParseStream| elements::parse_two_point(s, &kind),
+                    tokens,
+                )?)
+            }
+            "friction" => ast
+                .forces
+                .push(Parser::parse2(elements::parse_friction, tokens)?),
             "scene" => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
             "rolls" => {
                 let at = item.all.clone();

@@ -1,0 +1,273 @@
+//! Force elements: springs, dampers and friction between points or on a
+//! joint, and a motor's saturation, written out as the loads they are
+//! (`force(...)` and `torque(...)` items), each in an effect of its own so
+//! that a scene may leave it out.
+
+use syn::parse::ParseStream;
+use syn::{Ident, Token};
+
+use super::expr::convert;
+use super::items::{expr_ident, key_values};
+use super::joints::{add, times};
+use crate::ast::*;
+
+/// The elements a revolute or prismatic joint may carry (`stiffness`,
+/// `rest`, `damping`, `friction`, `friction_smoothing`, `saturation`).
+#[derive(Clone, Debug, Default)]
+pub struct JointElements {
+    /// k of the spring torque (force) −k (q − rest).
+    pub stiffness: Option<Expr>,
+    /// The spring's rest position (0 when absent).
+    pub rest: Option<Expr>,
+    /// c of the viscous torque (force) −c q̇.
+    pub damping: Option<Expr>,
+    /// The Coulomb friction torque (force) magnitude T of −T q̇ / √(q̇² + ε²).
+    pub friction: Option<Expr>,
+    /// ε of the friction's regularisation (default 1e-3, in the rate's units).
+    pub friction_smoothing: Option<Expr>,
+    /// The actuation input is clamped to ±saturation.
+    pub saturation: Option<Expr>,
+}
+
+impl JointElements {
+    /// Takes `key = value` when it names an element.
+    pub(super) fn set(&mut self, key: &Ident, value: &syn::Expr) -> syn::Result<bool> {
+        let slot = match key.to_string().as_str() {
+            "stiffness" => &mut self.stiffness,
+            "rest" => &mut self.rest,
+            "damping" => &mut self.damping,
+            "friction" => &mut self.friction,
+            "friction_smoothing" => &mut self.friction_smoothing,
+            "saturation" => &mut self.saturation,
+            _ => return Ok(false),
+        };
+        *slot = Some(convert(value)?);
+        Ok(true)
+    }
+
+    /// Whether any element is given.
+    pub fn any(&self) -> bool {
+        self.stiffness.is_some()
+            || self.damping.is_some()
+            || self.friction.is_some()
+            || self.saturation.is_some()
+            || self.rest.is_some()
+            || self.friction_smoothing.is_some()
+    }
+
+    /// The joint's generalized torques (forces), each with its effect: the
+    /// spring `springs`, the damper `dampers`, the friction `friction`.
+    pub(super) fn torques(&self, coordinate: &Ident) -> Vec<(Expr, Ident)> {
+        let span = coordinate.span();
+        let q = Expr::Name(coordinate.clone());
+        let rate = Expr::Call(Ident::new("dt", span), vec![q.clone()], span);
+        let mut out = Vec::new();
+        if let Some(k) = &self.stiffness {
+            let stretch = match &self.rest {
+                Some(r) => sub(q.clone(), r.clone()),
+                None => q.clone(),
+            };
+            out.push((neg(times(k.clone(), stretch)), Ident::new("springs", span)));
+        }
+        if let Some(c) = &self.damping {
+            out.push((
+                neg(times(c.clone(), rate.clone())),
+                Ident::new("dampers", span),
+            ));
+        }
+        if let Some(t) = &self.friction {
+            let eps = self
+                .friction_smoothing
+                .clone()
+                .unwrap_or(Expr::Float(1e-3, span));
+            out.push((
+                neg(times(t.clone(), smoothed_sign(rate, eps))),
+                Ident::new("friction", span),
+            ));
+        }
+        out
+    }
+}
+
+/// v / √(v² + ε²): Coulomb's sign(v), regularised over |v| ≲ ε.
+fn smoothed_sign(v: Expr, eps: Expr) -> Expr {
+    let span = v.span();
+    let sq = |e: Expr| times(e.clone(), e);
+    let root = Expr::Call(
+        Ident::new("sqrt", span),
+        vec![add(sq(v.clone()), sq(eps))],
+        span,
+    );
+    Expr::Binary(BinOp::Div, Box::new(v), Box::new(root), span)
+}
+
+fn neg(e: Expr) -> Expr {
+    let span = e.span();
+    Expr::Neg(Box::new(e), span)
+}
+
+fn sub(a: Expr, b: Expr) -> Expr {
+    let span = a.span();
+    Expr::Binary(BinOp::Sub, Box::new(a), Box::new(b), span)
+}
+
+fn call(name: &str, args: Vec<Expr>, span: proc_macro2::Span) -> Expr {
+    Expr::Call(Ident::new(name, span), args, span)
+}
+
+/// `spring(P, Q, stiffness = k, length = l0)` or `spring(P, Q, tension =
+/// T)`: a tension T (k (|Q − P| − l0) for the linear spring) pulling P and
+/// Q together, effect `springs`. `damper(P, Q, damping = c)`: the tension
+/// c d|Q − P|/dt, effect `dampers`. `effect = name` replaces the effect.
+pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<LoadDef>> {
+    let p: Ident = s.parse()?;
+    s.parse::<Token![,]>()?;
+    let q: Ident = s.parse()?;
+    let span = q.span();
+    let mut values = std::collections::BTreeMap::new();
+    let mut effect = None;
+    for (k, v) in key_values(s)? {
+        let key = k.to_string();
+        let allowed: &[&str] = match kind {
+            "spring" => &["stiffness", "length", "tension"],
+            _ => &["damping"],
+        };
+        if key == "effect" {
+            effect = Some(expr_ident(&v)?);
+        } else if allowed.contains(&key.as_str()) {
+            values.insert(key, (convert(&v)?, k));
+        } else {
+            return Err(syn::Error::new(
+                k.span(),
+                format!("a {kind} takes {} and `effect = name`", list(allowed)),
+            ));
+        }
+    }
+    let d = sub(Expr::Name(q.clone()), Expr::Name(p.clone()));
+    let direction = call("unit", vec![d.clone()], span);
+    let tension = match kind {
+        "spring" => match (values.remove("tension"), values.remove("stiffness"), values.remove("length")) {
+            (Some((t, _)), None, None) => t,
+            (None, Some((k, _)), Some((l0, _))) => {
+                times(k, sub(call("norm", vec![d], span), l0))
+            }
+            (None, Some((k, _)), None) => times(k, call("norm", vec![d], span)),
+            _ => {
+                return Err(syn::Error::new(
+                    span,
+                    "a spring takes `stiffness = k` (and `length = l0`, default 0) or `tension = T`, not both",
+                ))
+            }
+        },
+        _ => {
+            let (c, _) = values.remove("damping").ok_or_else(|| {
+                syn::Error::new(span, "a damper needs `damping = c`")
+            })?;
+            let rate = sub(
+                call("velocity", vec![Expr::Name(q.clone())], span),
+                call("velocity", vec![Expr::Name(p.clone())], span),
+            );
+            times(c, call("dot", vec![rate, direction.clone()], span))
+        }
+    };
+    let effect = effect.unwrap_or_else(|| {
+        Ident::new(
+            if kind == "spring" {
+                "springs"
+            } else {
+                "dampers"
+            },
+            span,
+        )
+    });
+    let pull = times(tension, direction);
+    Ok(vec![
+        LoadDef {
+            target: p,
+            vector: pull.clone(),
+            effect: effect.clone(),
+        },
+        LoadDef {
+            target: q,
+            vector: neg(pull),
+            effect,
+        },
+    ])
+}
+
+/// `friction(P, normal = N, mu = μ, plane = n, smoothing = ε, viscous =
+/// b)`: sliding friction at point P against a fixed surface of unit normal
+/// n (default N.z), −μ N v_t / √(|v_t|² + ε²) − b v_t with v_t the
+/// velocity of P across the surface, effect `friction`. The normal force
+/// N is given (an expression), not computed: a contact whose normal force
+/// the motion decides is a constraint (`rolls`), or a scene switch.
+pub(super) fn parse_friction(s: ParseStream) -> syn::Result<LoadDef> {
+    let p: Ident = s.parse()?;
+    let span = p.span();
+    let mut values = std::collections::BTreeMap::new();
+    let mut effect = None;
+    let allowed = ["normal", "mu", "plane", "smoothing", "viscous"];
+    for (k, v) in key_values(s)? {
+        let key = k.to_string();
+        if key == "effect" {
+            effect = Some(expr_ident(&v)?);
+        } else if allowed.contains(&key.as_str()) {
+            values.insert(key, convert(&v)?);
+        } else {
+            return Err(syn::Error::new(
+                k.span(),
+                format!("friction takes {} and `effect = name`", list(&allowed)),
+            ));
+        }
+    }
+    let n = values
+        .remove("plane")
+        .unwrap_or_else(|| Expr::Axis(Ident::new("N", span), 2, span));
+    let v = call("velocity", vec![Expr::Name(p.clone())], span);
+    let v_t = sub(v.clone(), times(call("dot", vec![v, n.clone()], span), n));
+    let mut force = None;
+    match (values.remove("mu"), values.remove("normal")) {
+        (Some(mu), Some(normal)) => {
+            let eps = values
+                .remove("smoothing")
+                .unwrap_or(Expr::Float(1e-3, span));
+            let speed2 = call("dot", vec![v_t.clone(), v_t.clone()], span);
+            let root = call("sqrt", vec![add(speed2, times(eps.clone(), eps))], span);
+            let scale = Expr::Binary(
+                BinOp::Div,
+                Box::new(times(mu, normal)),
+                Box::new(root),
+                span,
+            );
+            force = Some(neg(times(scale, v_t.clone())));
+        }
+        (None, None) => {}
+        _ => {
+            return Err(syn::Error::new(
+                span,
+                "Coulomb friction needs both `mu = μ` and `normal = N` (the normal force)",
+            ))
+        }
+    }
+    if let Some(b) = values.remove("viscous") {
+        let viscous = neg(times(b, v_t));
+        force = Some(match force {
+            Some(f) => add(f, viscous),
+            None => viscous,
+        });
+    }
+    let vector = force
+        .ok_or_else(|| syn::Error::new(span, "friction needs `mu` and `normal`, or `viscous`"))?;
+    Ok(LoadDef {
+        target: p,
+        vector,
+        effect: effect.unwrap_or_else(|| Ident::new("friction", span)),
+    })
+}
+
+fn list(keys: &[&str]) -> String {
+    keys.iter()
+        .map(|k| format!("`{k}`"))
+        .collect::<Vec<_>>()
+        .join(", ")
+}
