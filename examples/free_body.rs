@@ -69,7 +69,11 @@ fn demonstrate(p: &FreeBody) -> Result<(), Box<dyn Error>> {
     let energy =
         |x: &[f64; 10]| 0.5 * (p.i1 * x[4] * x[4] + p.i2 * x[5] * x[5] + p.i3 * x[6] * x[6]);
     let (e0, h0) = (energy(&x), momentum(p, &x));
-    let mut onto = |t: f64, x: &mut [f64; 10]| project_holonomic(p, t, x, 1e-15, 20).is_ok();
+    let mut onto = |t: f64, x: &mut [f64; 10]| {
+        project_holonomic(p, t, x, 1e-15, 20)
+            .map(|_| ())
+            .map_err(Into::into)
+    };
     let solver = Dop853::new().rtol(1e-13).atol(1e-13);
     let (mut flips, mut sign, mut worst_e, mut worst_h) = (0, 1.0, 0.0f64, 0.0f64);
     let start = std::time::Instant::now();

@@ -103,7 +103,11 @@ fn tumble<M: Model, const S: usize>(
     steps: usize,
     mut each: impl FnMut(&[f64; S]),
 ) {
-    let mut onto = |t: f64, x: &mut [f64; S]| project_holonomic(model, t, x, 1e-15, 20).is_ok();
+    let mut onto = |t: f64, x: &mut [f64; S]| {
+        project_holonomic(model, t, x, 1e-15, 20)
+            .map(|_| ())
+            .map_err(Into::into)
+    };
     let solver = Dop853::new().rtol(1e-13).atol(1e-13);
     let mut x = x0;
     for k in 0..steps {

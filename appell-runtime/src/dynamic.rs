@@ -170,6 +170,36 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
     }
 }
 
+/// The Jacobian `∂f/∂x` of `rhs` (row-major n×n into its last argument)
+/// at `(t, x)` with `inputs` held constant, exactly by forward-mode dual
+/// numbers: one [`DynRhs::rhs_dual`] per state component. What the implicit
+/// integrators use for a model.
+pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
+    rhs: &'a R,
+    inputs: &[f64],
+) -> impl FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError> + 'a {
+    let n = rhs.state_len();
+    let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
+    let mut xd = vec![Dual64::from_re(0.0); n];
+    let mut outd = vec![Dual64::from_re(0.0); n];
+    move |t: f64, x: &[f64], j: &mut [f64]| {
+        let td = Dual64::from_re(t);
+        for (d, &v) in xd.iter_mut().zip(x) {
+            *d = Dual64::from_re(v);
+        }
+        for col in 0..n {
+            xd[col].eps = 1.0;
+            let r = rhs.rhs_dual(td, &xd, &inputs_d, &mut outd);
+            xd[col].eps = 0.0;
+            r?;
+            for (row, o) in outd.iter().enumerate() {
+                j[row * n + col] = o.eps;
+            }
+        }
+        Ok(())
+    }
+}
+
 /// The object-safe face of a [`Model`]: its metadata, parameters, reduced
 /// equations and kinematic description in `f64`, and the few methods the
 /// oracle evaluates in dual numbers ([`Dual64`], [`Dual2_64`]). Each method

@@ -18,7 +18,9 @@
 //! [`Dop853`] is its order-8 sibling (dense output of order 7), the choice
 //! for tight tolerances. With `std`, `TrBdf2` is an L-stable implicit
 //! method of order 2 whose Newton iterations use the Jacobian of the
-//! generated rhs by dual numbers, for stiff models.
+//! generated rhs by dual numbers, for stiff models, and `Radau5` the
+//! L-stable implicit method of order 5 (Radau IIA, as Hairer & Wanner's
+//! RADAU5), the choice for stiff models at tight tolerances.
 //!
 //! Every step checks that the new state is finite (its real part, for dual
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
@@ -33,11 +35,15 @@ mod dopri5;
 mod explicit;
 mod solution;
 pub use dopri5::Dopri5;
-pub use solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
+pub use solution::{EventFn, IntegrateError, ProjectFn, ProjectionFailed, Solution, Stats};
 #[cfg(feature = "std")]
 mod implicit;
 #[cfg(feature = "std")]
 pub use implicit::*;
+#[cfg(feature = "std")]
+mod radau;
+#[cfg(feature = "std")]
+pub use radau::*;
 
 /// One step of Heun's method (the explicit trapezoidal rule, order 2) of
 /// `dx/dt = f(t, x)` of size `h` from `(t, x)`: an Euler predictor

@@ -364,8 +364,8 @@ fn accuracy_sweeps_every_integrator() {
     assert_eq!(v["checkpoints"], 4);
     let points = v["points"].as_array().unwrap();
     // levels = 2: RK4, Heun, midpoint at 2 step counts; both Dormand–Prince
-    // pairs at 4 tolerances; TR-BDF2 at 2.
-    assert_eq!(points.len(), 3 * 2 + 2 * 4 + 2, "{v}");
+    // pairs at 4 tolerances; TR-BDF2 at 2; Radau5 at 4.
+    assert_eq!(points.len(), 3 * 2 + 2 * 4 + 2 + 4, "{v}");
     let error = |method: &str, setting: f64| {
         points
             .iter()
@@ -377,6 +377,7 @@ fn accuracy_sweeps_every_integrator() {
     let ratio = error("rk4", 100.0) / error("rk4", 200.0);
     assert!((10.0..24.0).contains(&ratio), "RK4 ratio {ratio}");
     assert!(error("dop853", 1e-6) < error("dop853", 1e-3));
+    assert!(error("radau5", 1e-6) < error("radau5", 1e-3));
     for p in points {
         assert!(p["seconds"].as_f64().is_some_and(|s| s > 0.0), "{p}");
         assert!(p["rhs_calls"].as_u64().is_some_and(|n| n > 0), "{p}");

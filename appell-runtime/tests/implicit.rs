@@ -3,7 +3,9 @@
 //! typed errors. The models are hand-written `impl Model`s whose only
 //! meaningful methods are `info`, `prepare` and `rhs`.
 
-use appell_runtime::integrate::{Dopri5, IntegrateError, TrBdf2, TrBdf2Stats};
+use appell_runtime::integrate::{
+    Dopri5, IntegrateError, ProjectionFailed, Radau5, TrBdf2, TrBdf2Stats,
+};
 use appell_runtime::{check_len, Model, ModelError, ModelInfo, OpCounts, Scalar};
 
 fn unused() -> Result<(), ModelError> {
@@ -341,7 +343,7 @@ fn trbdf2_stiff(tol: f64) -> (f64, TrBdf2Stats) {
     let sol = TrBdf2::new()
         .rtol(tol)
         .atol(tol)
-        .solve_model(&model, 0.0, &[0.0], 5.0, &[1.0])
+        .solve_model(&model, &[1.0], 0.0, &[0.0], 5.0)
         .unwrap();
     assert_eq!(sol.t, 5.0);
     ((sol.x[0] - stiff_exact(LAMBDA, 5.0)).abs(), sol.stats)
@@ -386,7 +388,7 @@ fn user_jacobian_gives_the_same_trajectory_as_dual_numbers() {
     let solver = TrBdf2::new().rtol(1e-6).atol(1e-6);
     let a = solver.solve(f, jac, 0.0, &[0.0], 5.0).unwrap();
     let b = solver
-        .solve_model(&StiffLinear { lambda: LAMBDA }, 0.0, &[0.0], 5.0, &[1.0])
+        .solve_model(&StiffLinear { lambda: LAMBDA }, &[1.0], 0.0, &[0.0], 5.0)
         .unwrap();
     assert_eq!(a.x, b.x);
     assert_eq!(a.stats.accepted, b.stats.accepted);
@@ -400,7 +402,7 @@ fn inputs_reach_the_model() {
     let sol = TrBdf2::new()
         .rtol(1e-8)
         .atol(1e-8)
-        .solve_model(&StiffLinear { lambda: LAMBDA }, 0.0, &[0.0], 2.0, &[2.0])
+        .solve_model(&StiffLinear { lambda: LAMBDA }, &[2.0], 0.0, &[0.0], 2.0)
         .unwrap();
     assert!((sol.x[0] - 2.0 * stiff_exact(LAMBDA, 2.0)).abs() < 1e-6);
 }
@@ -417,7 +419,7 @@ fn fixed_steps_converge_with_order_two() {
                 .atol(1e-10)
                 .adaptive(false)
                 .h_init(Some(h))
-                .solve_model(&Smooth, 0.0, &[1.0, 1.0, 0.0], t_end, &[])
+                .solve_model(&Smooth, &[], 0.0, &[1.0, 1.0, 0.0], t_end)
                 .unwrap();
             assert_eq!(sol.stats.accepted, n, "{:?}", sol.stats);
             assert_eq!(sol.stats.rejected, 0);
@@ -440,7 +442,7 @@ fn tolerance_sweep_shows_order_two_in_steps() {
             let sol = TrBdf2::new()
                 .rtol(tol)
                 .atol(tol)
-                .solve_model(&Smooth, 0.0, &[1.0, 1.0, 0.0], 10.0, &[])
+                .solve_model(&Smooth, &[], 0.0, &[1.0, 1.0, 0.0], 10.0)
                 .unwrap();
             (max_err(&sol.x, &smooth_exact(10.0)), sol.stats.accepted)
         })
@@ -464,7 +466,7 @@ fn van_der_pol_mu_1000_completes_with_modest_work() {
     let sol = TrBdf2::new()
         .rtol(1e-6)
         .atol(1e-6)
-        .solve_model(&model, 0.0, &[2.0, 0.0], t_end, &[])
+        .solve_model(&model, &[], 0.0, &[2.0, 0.0], t_end)
         .unwrap();
     println!(
         "van der Pol μ = 1000 to t = {t_end}: x = {:?}, {:?}",
@@ -481,7 +483,7 @@ fn van_der_pol_mu_1000_completes_with_modest_work() {
     let reference = TrBdf2::new()
         .rtol(1e-9)
         .atol(1e-9)
-        .solve_model(&model, 0.0, &[2.0, 0.0], t_end, &[])
+        .solve_model(&model, &[], 0.0, &[2.0, 0.0], t_end)
         .unwrap();
     println!("reference: x = {:?}, {:?}", reference.x, reference.stats);
     assert!((sol.x[0] - reference.x[0]).abs() < 1e-2, "{:?}", sol.x);
@@ -491,7 +493,7 @@ fn van_der_pol_mu_1000_completes_with_modest_work() {
     let half = TrBdf2::new()
         .rtol(1e-6)
         .atol(1e-6)
-        .solve_model(&model, 0.0, &[2.0, 0.0], 1000.0, &[])
+        .solve_model(&model, &[], 0.0, &[2.0, 0.0], 1000.0)
         .unwrap();
     assert!(half.x[0] < -1.0 && half.x[0] > -2.1, "{:?}", half.x);
 }
@@ -520,12 +522,12 @@ fn backward_integration_returns_to_the_start() {
     let fwd = TrBdf2::new()
         .rtol(1e-10)
         .atol(1e-10)
-        .solve_model(&Smooth, 0.0, &[1.0, 1.0, 0.0], 1.0, &[])
+        .solve_model(&Smooth, &[], 0.0, &[1.0, 1.0, 0.0], 1.0)
         .unwrap();
     let back = TrBdf2::new()
         .rtol(1e-10)
         .atol(1e-10)
-        .solve_model(&Smooth, 1.0, &fwd.x, 0.0, &[])
+        .solve_model(&Smooth, &[], 1.0, &fwd.x, 0.0)
         .unwrap();
     assert_eq!(back.t, 0.0);
     assert!(max_err(&back.x, &[1.0, 1.0, 0.0]) < 1e-7, "{:?}", back.x);
@@ -534,7 +536,7 @@ fn backward_integration_returns_to_the_start() {
 #[test]
 fn zero_length_interval_returns_the_initial_state() {
     let sol = TrBdf2::new()
-        .solve_model(&Smooth, 1.0, &[1.0, 2.0, 3.0], 1.0, &[])
+        .solve_model(&Smooth, &[], 1.0, &[1.0, 2.0, 3.0], 1.0)
         .unwrap();
     assert_eq!(sol.x, vec![1.0, 2.0, 3.0]);
     assert_eq!(sol.stats, TrBdf2Stats::default());
@@ -546,11 +548,11 @@ fn errors_are_typed() {
     let stiff = StiffLinear { lambda: LAMBDA };
     // Too many steps.
     assert!(matches!(
-        s.max_steps(5).solve_model(&stiff, 0.0, &[0.0], 5.0, &[1.0]),
+        s.max_steps(5).solve_model(&stiff, &[1.0], 0.0, &[0.0], 5.0),
         Err(IntegrateError::TooManySteps { steps: 5, t }) if t > 0.0 && t < 5.0
     ));
     // Blow-up at t = 1: the step shrinks to nothing there.
-    match s.solve_model(&BlowUp, 0.0, &[1.0], 2.0, &[]) {
+    match s.solve_model(&BlowUp, &[], 0.0, &[1.0], 2.0) {
         Err(IntegrateError::StepSizeTooSmall { t, .. } | IntegrateError::NonFinite { t }) => {
             assert!((t - 1.0).abs() < 1e-2, "{t}")
         }
@@ -558,19 +560,19 @@ fn errors_are_typed() {
     }
     // A minimum step size that is too large.
     assert!(matches!(
-        s.h_min(0.5).solve_model(&BlowUp, 0.0, &[1.0], 2.0, &[]),
+        s.h_min(0.5).solve_model(&BlowUp, &[], 0.0, &[1.0], 2.0),
         Err(IntegrateError::StepSizeTooSmall { h, .. }) if h < 0.5
     ));
     // Model errors are passed on.
     assert_eq!(
-        s.solve_model(&Singular, 0.0, &[0.0], 1.0, &[]),
+        s.solve_model(&Singular, &[], 0.0, &[0.0], 1.0),
         Err(IntegrateError::Model(ModelError::SingularMassMatrix {
             index: 0,
             pivot: 0.0
         }))
     );
     assert!(matches!(
-        s.solve_model(&stiff, 0.0, &[0.0, 1.0], 1.0, &[1.0]),
+        s.solve_model(&stiff, &[1.0], 0.0, &[0.0, 1.0], 1.0),
         Err(IntegrateError::Model(ModelError::Length {
             argument: "state",
             expected: 1,
@@ -578,7 +580,7 @@ fn errors_are_typed() {
         }))
     ));
     assert!(matches!(
-        s.solve_model(&stiff, 0.0, &[0.0], 1.0, &[]),
+        s.solve_model(&stiff, &[], 0.0, &[0.0], 1.0),
         Err(IntegrateError::Model(ModelError::Length {
             argument: "inputs",
             ..
@@ -586,11 +588,11 @@ fn errors_are_typed() {
     ));
     // Non-finite initial state; a rhs that is NaN at the start.
     assert_eq!(
-        s.solve_model(&stiff, 0.0, &[f64::NAN], 1.0, &[1.0]),
+        s.solve_model(&stiff, &[1.0], 0.0, &[f64::NAN], 1.0),
         Err(IntegrateError::NonFinite { t: 0.0 })
     );
     assert_eq!(
-        s.solve_model(&stiff, 0.0, &[0.0], 1.0, &[f64::INFINITY]),
+        s.solve_model(&stiff, &[f64::INFINITY], 0.0, &[0.0], 1.0),
         Err(IntegrateError::NonFinite { t: 0.0 })
     );
     // A rhs that becomes NaN past x = 0.5 (the step shrinks, then fails).
@@ -619,14 +621,14 @@ fn errors_are_typed() {
     ] {
         assert!(
             matches!(
-                bad.solve_model(&stiff, 0.0, &[0.0], 1.0, &[1.0]),
+                bad.solve_model(&stiff, &[1.0], 0.0, &[0.0], 1.0),
                 Err(IntegrateError::InvalidInput { .. })
             ),
             "{bad:?}"
         );
     }
     assert!(matches!(
-        s.solve_model(&stiff, 0.0, &[0.0], f64::NAN, &[1.0]),
+        s.solve_model(&stiff, &[1.0], 0.0, &[0.0], f64::NAN),
         Err(IntegrateError::InvalidInput { .. })
     ));
 }
@@ -649,7 +651,7 @@ fn step_ends<M: Model>(
         1.0
     };
     let sol = s
-        .solve_model_until(model, g, 0.0, x0, t_end, inputs)
+        .solve_model_until(model, inputs, g, 0.0, x0, t_end)
         .unwrap();
     assert!(!sol.event);
     assert_eq!(sol.t, t_end);
@@ -682,7 +684,7 @@ fn dense_vs_ends<M: Model>(
         }
     }
     out.push((t_end, Vec::new()));
-    let sol = s.solve_model_at(model, 0.0, x0, &mut out, inputs).unwrap();
+    let sol = s.solve_model_at(model, inputs, 0.0, x0, &mut out).unwrap();
     assert_eq!(sol.outputs, out.len());
     assert!(!sol.event);
     let e_dense = out
@@ -740,10 +742,10 @@ fn dense_output_is_as_accurate_as_the_step_ends_on_the_stiff_problem() {
 fn solve_at_costs_no_extra_work_and_ends_where_solve_ends() {
     let s = TrBdf2::new().rtol(1e-8).atol(1e-8);
     let stiff = StiffLinear { lambda: LAMBDA };
-    let plain = s.solve_model(&stiff, 0.0, &[0.0], 5.0, &[1.0]).unwrap();
+    let plain = s.solve_model(&stiff, &[1.0], 0.0, &[0.0], 5.0).unwrap();
     let mut out: Vec<(f64, Vec<f64>)> = (0..=500).map(|k| (0.01 * k as f64, vec![])).collect();
     let at = s
-        .solve_model_at(&stiff, 0.0, &[0.0], &mut out, &[1.0])
+        .solve_model_at(&stiff, &[1.0], 0.0, &[0.0], &mut out)
         .unwrap();
     assert_eq!(at.t, 5.0);
     assert_eq!(at.x, plain.x);
@@ -792,7 +794,7 @@ fn output_times_are_validated() {
         vec![0.5, -1.0],          // changes direction
     ] {
         let mut out: Vec<(f64, Vec<f64>)> = times.iter().map(|&t| (t, vec![])).collect();
-        let r = s.solve_model_at(&Smooth, 0.0, &[1.0, 1.0, 0.0], &mut out, &[]);
+        let r = s.solve_model_at(&Smooth, &[], 0.0, &[1.0, 1.0, 0.0], &mut out);
         assert!(
             matches!(r, Err(IntegrateError::InvalidInput { .. })),
             "{times:?}: {r:?}"
@@ -802,7 +804,7 @@ fn output_times_are_validated() {
     // Wrong state length is a model error.
     let mut out = vec![(1.0, vec![])];
     assert!(matches!(
-        s.solve_model_at(&Smooth, 0.0, &[1.0], &mut out, &[]),
+        s.solve_model_at(&Smooth, &[], 0.0, &[1.0], &mut out),
         Err(IntegrateError::Model(ModelError::Length { .. }))
     ));
 }
@@ -813,7 +815,7 @@ fn event_is_located_to_tolerance() {
     let s = TrBdf2::new().rtol(1e-10).atol(1e-10);
     let x0 = [1.0, 1.0, 0.0];
     let sol = s
-        .solve_model_until(&Smooth, |_t, x: &[f64]| x[1] - 0.25, 0.0, &x0, 10.0, &[])
+        .solve_model_until(&Smooth, &[], |_t, x: &[f64]| x[1] - 0.25, 0.0, &x0, 10.0)
         .unwrap();
     println!(
         "event y = 1/4: t = {:.15}, error {:.3e}, {} steps",
@@ -836,7 +838,7 @@ fn event_is_located_to_tolerance() {
     );
 
     let sol = s
-        .solve_model_until(&Smooth, |_t, x: &[f64]| x[0] - 0.5, 0.0, &x0, 10.0, &[])
+        .solve_model_until(&Smooth, &[], |_t, x: &[f64]| x[0] - 0.5, 0.0, &x0, 10.0)
         .unwrap();
     let exact = std::f64::consts::FRAC_PI_3;
     println!(
@@ -853,7 +855,7 @@ fn event_is_located_to_tolerance() {
     // at most event_tol.
     let coarse = s.event_tol(1e-3);
     let sol = coarse
-        .solve_model_until(&Smooth, |_t, x: &[f64]| x[1] - 0.25, 0.0, &x0, 10.0, &[])
+        .solve_model_until(&Smooth, &[], |_t, x: &[f64]| x[1] - 0.25, 0.0, &x0, 10.0)
         .unwrap();
     println!("event_tol 1e-3: t = {:.15}", sol.t);
     assert!(
@@ -866,11 +868,11 @@ fn event_is_located_to_tolerance() {
     let sol = s
         .solve_model_until(
             &Smooth,
+            &[],
             |_t, x: &[f64]| x[1] - 0.5,
             3.0,
             &smooth_exact(3.0),
             0.0,
-            &[],
         )
         .unwrap();
     assert!(sol.event);
@@ -879,7 +881,7 @@ fn event_is_located_to_tolerance() {
 
     // A zero at t0 is not an event (cos t − 1 ≤ 0 touches 0 again only at 2π).
     let sol = s
-        .solve_model_until(&Smooth, |_t, x: &[f64]| x[0] - 1.0, 0.0, &x0, 5.0, &[])
+        .solve_model_until(&Smooth, &[], |_t, x: &[f64]| x[0] - 1.0, 0.0, &x0, 5.0)
         .unwrap();
     assert!(!sol.event);
     assert_eq!(sol.t, 5.0);
@@ -914,16 +916,16 @@ fn non_finite_event_function_is_an_error() {
     let s = TrBdf2::new();
     let x0 = [1.0, 1.0, 0.0];
     assert_eq!(
-        s.solve_model_until(&Smooth, |_t, _x: &[f64]| f64::NAN, 0.0, &x0, 5.0, &[]),
+        s.solve_model_until(&Smooth, &[], |_t, _x: &[f64]| f64::NAN, 0.0, &x0, 5.0),
         Err(IntegrateError::NonFinite { t: 0.0 })
     );
     match s.solve_model_until(
         &Smooth,
+        &[],
         |t, _x: &[f64]| if t > 1.0 { f64::INFINITY } else { 1.0 },
         0.0,
         &x0,
         5.0,
-        &[],
     ) {
         Err(IntegrateError::NonFinite { t }) => assert!(t > 0.0 && t <= 1.0, "{t}"),
         other => panic!("{other:?}"),
@@ -932,8 +934,113 @@ fn non_finite_event_function_is_an_error() {
     for tol in [-1.0, f64::NAN] {
         assert!(matches!(
             s.event_tol(tol)
-                .solve_model_until(&Smooth, |_t, x: &[f64]| x[0], 0.0, &x0, 5.0, &[]),
+                .solve_model_until(&Smooth, &[], |_t, x: &[f64]| x[0], 0.0, &x0, 5.0),
             Err(IntegrateError::InvalidInput { .. })
         ));
     }
+}
+
+// ---------------------------------------------------------------------------
+// Radau5 on the same models: Jacobians by dual numbers, inputs, work
+// against TR-BDF2.
+
+#[test]
+fn radau5_user_jacobian_gives_the_same_trajectory_as_dual_numbers() {
+    let f = |t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+        dx[0] = -(LAMBDA * (x[0] - Scalar::cos(t)));
+        Ok(())
+    };
+    let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+        j[0] = -LAMBDA;
+        Ok(())
+    };
+    let solver = Radau5::new().rtol(1e-6).atol(1e-6);
+    let a = solver.solve(f, jac, 0.0, &[0.0], 5.0).unwrap();
+    let model = StiffLinear { lambda: LAMBDA };
+    let b = solver
+        .solve_model(&model, &[1.0], 0.0, &[0.0], 5.0)
+        .unwrap();
+    assert_eq!(a.x, b.x);
+    assert_eq!(a.stats.accepted, b.stats.accepted);
+    assert_eq!(a.stats.jacobian_rhs_calls, 0);
+    assert_eq!(b.stats.jacobian_rhs_calls, b.stats.jacobians);
+    // Inputs reach the model: a = 2 doubles the solution.
+    let c = Radau5::new()
+        .rtol(1e-8)
+        .atol(1e-8)
+        .solve_model(&model, &[2.0], 0.0, &[0.0], 2.0)
+        .unwrap();
+    assert!((c.x[0] - 2.0 * stiff_exact(LAMBDA, 2.0)).abs() < 1e-6);
+    // Wrong lengths are the model's typed errors.
+    assert!(matches!(
+        Radau5::new().solve_model(&model, &[], 0.0, &[0.0], 2.0),
+        Err(IntegrateError::Model(ModelError::Length { .. }))
+    ));
+}
+
+#[test]
+fn radau5_does_van_der_pol_with_a_fraction_of_the_work_of_trbdf2() {
+    let model = VanDerPol { mu: 1000.0 };
+    let (x0, t_end) = ([2.0, 0.0], 2000.0);
+    let radau = Radau5::new()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .solve_model(&model, &[], 0.0, &x0, t_end)
+        .unwrap();
+    let trbdf2 = TrBdf2::new()
+        .rtol(1e-6)
+        .atol(1e-6)
+        .solve_model(&model, &[], 0.0, &x0, t_end)
+        .unwrap();
+    let reference = Radau5::new()
+        .rtol(1e-11)
+        .atol(1e-11)
+        .solve_model(&model, &[], 0.0, &x0, t_end)
+        .unwrap();
+    let err = |x: &[f64]| (x[0] - reference.x[0]).abs();
+    println!(
+        "van der Pol to {t_end}: Radau5 error {:e}, {:?}; TR-BDF2 error {:e}, {:?}",
+        err(&radau.x),
+        radau.stats,
+        err(&trbdf2.x),
+        trbdf2.stats
+    );
+    assert!(err(&radau.x) < 1e-5, "{:?}", radau.x);
+    assert!(err(&radau.x) < err(&trbdf2.x));
+    let (r, t) = (radau.stats, trbdf2.stats);
+    assert!(
+        r.accepted + r.rejected < t.accepted + t.rejected,
+        "{r:?} {t:?}"
+    );
+    assert_eq!(r.jacobian_rhs_calls, 2 * r.jacobians);
+}
+
+#[test]
+fn projected_model_solves_keep_the_invariant() {
+    // The Smooth model's x² + x'² = 1 (components 0 and 2).
+    let onto_circle = |_t: f64, s: &mut [f64]| {
+        let r = s[0].hypot(s[2]);
+        if r == 0.0 {
+            return Err(ProjectionFailed {
+                reason: "zero radius",
+            });
+        }
+        s[0] /= r;
+        s[2] /= r;
+        Ok(())
+    };
+    let x0 = smooth_exact(0.0);
+    let radau = Radau5::new()
+        .rtol(1e-3)
+        .solve_model_projected(&Smooth, &[], onto_circle, 0.0, &x0, 20.0)
+        .unwrap();
+    let trbdf2 = TrBdf2::new()
+        .rtol(1e-3)
+        .solve_model_projected(&Smooth, &[], onto_circle, 0.0, &x0, 20.0)
+        .unwrap();
+    for x in [&radau.x, &trbdf2.x] {
+        assert!((x[0].hypot(x[2]) - 1.0).abs() < 1e-15, "{x:?}");
+    }
+    // The projection does not touch z = 1/(1 + t).
+    assert!((radau.x[1] - 1.0 / 21.0).abs() < 1e-5, "{:?}", radau.x);
 }

@@ -646,7 +646,7 @@ pub fn stiff_spring(t_end: f64) -> Vec<CaseResult> {
     let imp = TrBdf2::new()
         .rtol(1e-6)
         .atol(1e-9)
-        .solve_model(&p, 0.0, &x0, t_end, &[]);
+        .solve_model(&p, &[], 0.0, &x0, t_end);
     let exp = Dop853::new()
         .rtol(1e-6)
         .atol(1e-9)

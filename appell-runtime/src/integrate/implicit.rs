@@ -1,4 +1,5 @@
-//! Adaptive implicit integration for stiff models: TR-BDF2 (std only).
+//! Adaptive implicit integration for stiff models: TR-BDF2 (std only), and
+//! the parts of its loop [`Radau5`](super::Radau5) shares.
 
 mod coefficients;
 mod control;
@@ -6,9 +7,16 @@ mod dense;
 mod driver;
 mod newton;
 mod settings;
+mod shared;
 mod solve;
 mod stages;
 mod stats;
 
+pub(super) use control::{all_finite, wrms};
+pub(super) use dense::{Dense, EventG};
 pub use settings::TrBdf2;
+pub(super) use shared::{
+    check_problem, end_of_step, event_value, initial_outputs, initial_step, next_step,
+    project_state, ProjectG,
+};
 pub use stats::{TrBdf2Solution, TrBdf2Stats};

@@ -37,6 +37,9 @@ pub enum IntegrateError {
     Projection {
         /// Time of the state that could not be projected.
         t: f64,
+        /// Why: the [`ProjectionFailed::reason`] the projection gave, or
+        /// what the integrator found wrong with its result.
+        reason: &'static str,
     },
     /// A setting or an argument is invalid (non-finite times, negative
     /// tolerances, output times out of order or outside the interval).
@@ -64,8 +67,11 @@ impl core::fmt::Display for IntegrateError {
                 write!(f, "{steps} steps taken, stopped at t = {t}")
             }
             IntegrateError::NonFinite { t } => write!(f, "non-finite value at t = {t}"),
-            IntegrateError::Projection { t } => {
-                write!(f, "projection onto the constraints failed at t = {t}")
+            IntegrateError::Projection { t, reason } => {
+                write!(
+                    f,
+                    "projection onto the constraints failed at t = {t}: {reason}"
+                )
             }
             IntegrateError::InvalidInput { what } => write!(f, "invalid input: {what}"),
             IntegrateError::Model(e) => write!(f, "model error: {e}"),
@@ -86,7 +92,29 @@ pub type EventFn<'a, T, const S: usize> = dyn FnMut(f64, &[T; S]) -> f64 + 'a;
 /// place back onto a constraint manifold (for a model, with
 /// [`project_holonomic`](crate::linearize::project_holonomic)) and returns
 /// `false` if it could not.
-pub type ProjectFn<'a, T, const S: usize> = dyn FnMut(f64, &mut [T; S]) -> bool + 'a;
+pub type ProjectFn<'a, T, const S: usize> =
+    dyn FnMut(f64, &mut [T; S]) -> Result<(), ProjectionFailed> + 'a;
+
+/// Why a projection (as passed to the `solve_projected` of
+/// [`TrBdf2`](super::TrBdf2) and [`Radau5`](super::Radau5), with `std`)
+/// could not move the state onto its manifold; the integration stops with
+/// [`IntegrateError::Projection`] carrying the reason.
+///
+/// ```
+/// use appell_runtime::integrate::{IntegrateError, ProjectionFailed};
+///
+/// let fail = ProjectionFailed { reason: "Newton did not converge" };
+/// let e = IntegrateError::Projection { t: 1.5, reason: fail.reason };
+/// assert_eq!(
+///     e.to_string(),
+///     "projection onto the constraints failed at t = 1.5: Newton did not converge"
+/// );
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ProjectionFailed {
+    /// What went wrong.
+    pub reason: &'static str,
+}
 
 /// Work counts of an adaptive integration.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -152,3 +152,35 @@ impl std::error::Error for LinearizeError {
         }
     }
 }
+
+/// A failed [`project_holonomic`](super::project_holonomic) as the
+/// integrators' projection failure, so that a projection callback is
+/// `|t, x| project_holonomic(&model, t, x, 1e-14, 20).map(|_| ()).map_err(Into::into)`.
+///
+/// ```
+/// use appell_runtime::integrate::ProjectionFailed;
+/// use appell_runtime::linearize::LinearizeError;
+///
+/// let e = LinearizeError::NotConverged { iterations: 20, residual: 1e-3 };
+/// let failed = ProjectionFailed::from(e);
+/// assert_eq!(failed.reason, "Newton's method did not bring the holonomic residuals below the tolerance");
+/// ```
+impl From<LinearizeError> for crate::integrate::ProjectionFailed {
+    fn from(e: LinearizeError) -> Self {
+        let reason = match e {
+            LinearizeError::NotConverged { .. } => {
+                "Newton's method did not bring the holonomic residuals below the tolerance"
+            }
+            LinearizeError::RankDeficient { .. } => {
+                "the holonomic Jacobian is rank deficient at this configuration"
+            }
+            LinearizeError::Model(ModelError::SingularConstraints { .. }) => {
+                "the dependent constraint block is singular at this configuration"
+            }
+            LinearizeError::Model(_) => "a model function failed during the projection",
+            LinearizeError::NonFinite { .. } => "the projection met a non-finite value",
+            _ => "the projection's arguments are invalid (state length, tolerance)",
+        };
+        crate::integrate::ProjectionFailed { reason }
+    }
+}

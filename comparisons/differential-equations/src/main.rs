@@ -119,7 +119,7 @@ fn compare<M: Model, const S: usize>(
             .max_steps(10_000_000);
         if tol >= 1e-9 {
             let (r, s) = timed(repeats.min(5), || {
-                trbdf2.solve_model(model, 0.0, &x0, t_end, inputs)
+                trbdf2.solve_model(model, inputs, 0.0, &x0, t_end)
             });
             let r = r?;
             let mut x = [0.0; S];

@@ -188,14 +188,15 @@ macro_rules! explicit_api {
         #[doc = concat!("As [`", stringify!($ty), "::solve`], with `project(t, x)` applied to the state")]
         /// after every accepted step: it moves `x` back onto a constraint
         /// manifold (a holonomic constraint the integration drifts from, an
-        /// invariant) and returns `false` if it cannot
-        /// ([`IntegrateError::Projection`]). When it moves the state, the next
+        /// invariant) and returns a [`ProjectionFailed`](crate::integrate::ProjectionFailed)
+        /// saying why if it cannot (the integration then stops with
+        /// [`IntegrateError::Projection`], which carries the reason). When it moves the state, the next
         /// step starts afresh from the projected state (one more rhs call,
         /// counted). The step's error control and dense output are those of the
         /// unprojected step.
         ///
         /// ```
-        #[doc = concat!("use appell_runtime::integrate::", stringify!($ty), ";")]
+        #[doc = concat!("use appell_runtime::integrate::{", stringify!($ty), ", ProjectionFailed};")]
         /// // The harmonic oscillator keeps x² + v² = 1; projecting onto that
         /// // circle removes the slow drift of a loose tolerance.
         /// let f = |_t: f64, x: &[f64; 2], dx: &mut [f64; 2]| {
@@ -205,9 +206,12 @@ macro_rules! explicit_api {
         /// };
         /// let mut onto_circle = |_t: f64, x: &mut [f64; 2]| {
         ///     let r = (x[0] * x[0] + x[1] * x[1]).sqrt();
+        ///     if r == 0.0 {
+        ///         return Err(ProjectionFailed { reason: "the origin has no nearest point on the circle" });
+        ///     }
         ///     x[0] /= r;
         ///     x[1] /= r;
-        ///     r > 0.0
+        ///     Ok(())
         /// };
         #[doc = concat!("let solver = ", stringify!($ty), "::new().rtol(1e-4).atol(1e-6);")]
         /// let free = solver.solve(f, 0.0, &[1.0, 0.0], 100.0).unwrap();

@@ -368,8 +368,17 @@ where
     F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
 {
     let before = *x;
-    if !p(t, x) || !all_finite(x) {
-        return Err(IntegrateError::Projection { t });
+    if let Err(failed) = p(t, x) {
+        return Err(IntegrateError::Projection {
+            t,
+            reason: failed.reason,
+        });
+    }
+    if !all_finite(x) {
+        return Err(IntegrateError::Projection {
+            t,
+            reason: "the projection left a non-finite state",
+        });
     }
     if x.iter().zip(&before).any(|(a, b)| a.re() != b.re()) {
         let mut k1 = [T::zero(); S];

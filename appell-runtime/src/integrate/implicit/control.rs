@@ -7,7 +7,7 @@ pub(super) const FAC_NEWTON: f64 = 0.25;
 const HOLD_MAX: f64 = 1.2;
 
 /// RMS of `v_i / sk_i`.
-pub(super) fn wrms(v: &[f64], sk: &[f64]) -> f64 {
+pub(in crate::integrate) fn wrms(v: &[f64], sk: &[f64]) -> f64 {
     if v.is_empty() {
         return 0.0;
     }
@@ -15,7 +15,7 @@ pub(super) fn wrms(v: &[f64], sk: &[f64]) -> f64 {
     (s / v.len() as f64).sqrt()
 }
 
-pub(super) fn all_finite(v: &[f64]) -> bool {
+pub(in crate::integrate) fn all_finite(v: &[f64]) -> bool {
     v.iter().all(|x| x.is_finite())
 }
 

@@ -6,7 +6,7 @@ use crate::integrate::explicit::illinois;
 use crate::integrate::solution::IntegrateError;
 
 /// An event function `g(t, x)`.
-pub(super) type EventG<'a> = dyn FnMut(f64, &[f64]) -> f64 + 'a;
+pub(in crate::integrate) type EventG<'a> = dyn FnMut(f64, &[f64]) -> f64 + 'a;
 
 /// Overwrites `slot` with `x`.
 pub(super) fn put(slot: &mut Vec<f64>, x: &[f64]) {
@@ -27,9 +27,33 @@ pub(super) struct Hermite<'a> {
     pub(super) f1: &'a [f64],
 }
 
-impl Hermite<'_> {
+/// The dense output of one accepted step, as the end of a step needs it
+/// (events and outputs). Shared by the implicit integrators.
+pub(in crate::integrate) trait Dense {
+    /// The start of the step.
+    fn start(&self) -> f64;
+    /// The end of the step (exactly).
+    fn end(&self) -> f64;
+    /// The state at the end of the step.
+    fn end_state(&self) -> &[f64];
     /// The interpolated state at `tau` into `slot` (resized).
-    pub(super) fn at(&self, tau: f64, slot: &mut Vec<f64>) {
+    fn at(&self, tau: f64, slot: &mut Vec<f64>);
+}
+
+impl Dense for Hermite<'_> {
+    fn start(&self) -> f64 {
+        self.t
+    }
+
+    fn end(&self) -> f64 {
+        self.t1
+    }
+
+    fn end_state(&self) -> &[f64] {
+        self.x1
+    }
+
+    fn at(&self, tau: f64, slot: &mut Vec<f64>) {
         let s = (tau - self.t) / self.h;
         let s2 = s * s;
         let s3 = s2 * s;
@@ -47,17 +71,18 @@ impl Hermite<'_> {
 
 /// The event of `g` inside the step of `dense` (`g` is `ga` at its start
 /// and `gb` at its end, of opposite signs or `gb = 0`), located by
-/// [`illinois`] on the interpolant: the far end of the final bracket and
+/// [`illinois`] on the dense output: the far end of the final bracket and
 /// the state there (the step's end state exactly when the bracket did not
 /// move).
-pub(super) fn locate(
+pub(in crate::integrate) fn locate<D: Dense>(
     event_tol: f64,
     g: &mut EventG<'_>,
-    dense: &Hermite<'_>,
+    dense: &D,
     ga: f64,
     gb: f64,
 ) -> Result<(f64, Vec<f64>), IntegrateError> {
-    let mut xc = Vec::with_capacity(dense.x1.len());
+    let n = dense.end_state().len();
+    let mut xc = Vec::with_capacity(n);
     let on_dense = |tc: f64| {
         dense.at(tc, &mut xc);
         if all_finite(&xc) {
@@ -66,11 +91,11 @@ pub(super) fn locate(
             Err(IntegrateError::NonFinite { t: tc })
         }
     };
-    let te = illinois(event_tol, on_dense, dense.t, ga, dense.t1, gb)?;
-    if te == dense.t1 {
-        Ok((te, dense.x1.to_vec()))
+    let te = illinois(event_tol, on_dense, dense.start(), ga, dense.end(), gb)?;
+    if te == dense.end() {
+        Ok((te, dense.end_state().to_vec()))
     } else {
-        let mut xe = Vec::with_capacity(dense.x1.len());
+        let mut xe = Vec::with_capacity(n);
         dense.at(te, &mut xe);
         Ok((te, xe))
     }

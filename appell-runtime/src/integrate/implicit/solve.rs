@@ -3,15 +3,17 @@
 
 use super::dense::EventG;
 use super::settings::TrBdf2;
+use super::shared::ProjectG;
 use super::stats::TrBdf2Solution;
-use crate::dynamic::{DynRhs, Prepared};
-use crate::integrate::solution::IntegrateError;
+use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
+use crate::integrate::solution::{IntegrateError, ProjectionFailed};
 use crate::model::{check_len, Model, ModelError};
-use num_dual::Dual64;
 
 // Items the documentation links to.
 #[cfg(doc)]
 use super::TrBdf2Stats;
+#[cfg(doc)]
+use num_dual::Dual64;
 
 impl TrBdf2 {
     /// Integrates `dx/dt = f(t, x)` from `(t0, x0)` to `t_end` (which may be
@@ -33,7 +35,7 @@ impl TrBdf2 {
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
         J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
     {
-        self.run(f, jac, t0, x0, t_end, &mut [], None)
+        self.run(f, jac, t0, x0, t_end, &mut [], None, None)
     }
 
     /// Integrates from `(t0, x0)` to the last time of `out` and writes the
@@ -81,7 +83,7 @@ impl TrBdf2 {
         J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
     {
         let t_end = out.last().map_or(t0, |o| o.0);
-        self.run(f, jac, t0, x0, t_end, out, None)
+        self.run(f, jac, t0, x0, t_end, out, None, None)
     }
 
     /// As [`TrBdf2::solve`], stopping at the first sign change of the event
@@ -131,7 +133,70 @@ impl TrBdf2 {
         J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
         G: FnMut(f64, &[f64]) -> f64,
     {
-        self.run(f, jac, t0, x0, t_end, &mut [], Some(&mut g))
+        self.run(f, jac, t0, x0, t_end, &mut [], Some(&mut g), None)
+    }
+
+    /// As [`TrBdf2::solve`], with `project(t, x)` applied to the state after
+    /// every accepted step: it moves `x` (in place) back onto a constraint
+    /// manifold (a holonomic constraint the integration drifts from, an
+    /// invariant), or returns a [`ProjectionFailed`] whose reason stops the
+    /// integration as [`IntegrateError::Projection`] (so does a non-finite
+    /// projected state). When it moves the state, the next step starts from
+    /// the projected state with its own derivative (one more rhs call,
+    /// counted). The step's error control and dense output are those of the
+    /// unprojected step.
+    ///
+    /// ```
+    /// use appell_runtime::integrate::{ProjectionFailed, TrBdf2};
+    /// use appell_runtime::ModelError;
+    ///
+    /// // The harmonic oscillator keeps x² + v² = 1; TR-BDF2 damps it
+    /// // slightly, projecting onto the circle removes that drift.
+    /// let f = |_t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+    ///     dx[0] = x[1];
+    ///     dx[1] = -x[0];
+    ///     Ok(())
+    /// };
+    /// let jac = |_t: f64, _x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+    ///     j.copy_from_slice(&[0.0, 1.0, -1.0, 0.0]);
+    ///     Ok(())
+    /// };
+    /// let onto_circle = |_t: f64, x: &mut [f64]| {
+    ///     let r = x[0].hypot(x[1]);
+    ///     if r == 0.0 {
+    ///         return Err(ProjectionFailed { reason: "the origin has no direction" });
+    ///     }
+    ///     x[0] /= r;
+    ///     x[1] /= r;
+    ///     Ok(())
+    /// };
+    /// let solver = TrBdf2::new().rtol(1e-4).atol(1e-6);
+    /// let free = solver.solve(f, jac, 0.0, &[1.0, 0.0], 100.0).unwrap();
+    /// let kept = solver.solve_projected(f, jac, onto_circle, 0.0, &[1.0, 0.0], 100.0).unwrap();
+    /// let radius = |x: &[f64]| x[0].hypot(x[1]);
+    /// assert!((radius(&kept.x) - 1.0).abs() < 1e-15);
+    /// assert!((radius(&free.x) - 1.0).abs() > 1e-6);
+    /// // A failing projection stops the integration with its reason.
+    /// let err = solver
+    ///     .solve_projected(f, jac, onto_circle, 0.0, &[0.0, 0.0], 1.0)
+    ///     .unwrap_err();
+    /// assert!(err.to_string().contains("the origin has no direction"));
+    /// ```
+    pub fn solve_projected<F, J, P>(
+        &self,
+        f: F,
+        jac: J,
+        mut project: P,
+        t0: f64,
+        x0: &[f64],
+        t_end: f64,
+    ) -> Result<TrBdf2Solution, IntegrateError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+        J: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+        P: FnMut(f64, &mut [f64]) -> Result<(), ProjectionFailed>,
+    {
+        self.run(f, jac, t0, x0, t_end, &mut [], None, Some(&mut project))
     }
 
     /// Integrates a model's reduced equations ([`Model::rhs`]) from
@@ -147,12 +212,12 @@ impl TrBdf2 {
     pub fn solve_model<M: Model>(
         &self,
         model: &M,
+        inputs: &[f64],
         t0: f64,
         x0: &[f64],
         t_end: f64,
-        inputs: &[f64],
     ) -> Result<TrBdf2Solution, IntegrateError> {
-        self.run_model(model, t0, x0, t_end, inputs, &mut [], None)
+        self.run_model(model, t0, x0, t_end, inputs, &mut [], None, None)
     }
 
     /// [`TrBdf2::solve_at`] of a model's reduced equations, as
@@ -203,7 +268,7 @@ impl TrBdf2 {
     /// let sol = TrBdf2::new()
     ///     .rtol(1e-9)
     ///     .atol(1e-12)
-    ///     .solve_model_at(&model, 0.0, &[1.0, 0.0], &mut out, &[])
+    ///     .solve_model_at(&model, &[], 0.0, &[1.0, 0.0], &mut out)
     ///     .unwrap();
     /// assert_eq!(sol.outputs, 10);
     /// for (t, x) in &out {
@@ -211,18 +276,18 @@ impl TrBdf2 {
     /// }
     /// // Output times out of order are invalid input.
     /// let mut bad = vec![(0.5, vec![]), (0.2, vec![])];
-    /// assert!(TrBdf2::new().solve_model_at(&model, 0.0, &[1.0, 0.0], &mut bad, &[]).is_err());
+    /// assert!(TrBdf2::new().solve_model_at(&model, &[], 0.0, &[1.0, 0.0], &mut bad).is_err());
     /// ```
     pub fn solve_model_at<M: Model>(
         &self,
         model: &M,
+        inputs: &[f64],
         t0: f64,
         x0: &[f64],
         out: &mut [(f64, Vec<f64>)],
-        inputs: &[f64],
     ) -> Result<TrBdf2Solution, IntegrateError> {
         let t_end = out.last().map_or(t0, |o| o.0);
-        self.run_model(model, t0, x0, t_end, inputs, out, None)
+        self.run_model(model, t0, x0, t_end, inputs, out, None, None)
     }
 
     /// [`TrBdf2::solve_until`] of a model's reduced equations, as
@@ -272,7 +337,7 @@ impl TrBdf2 {
     /// let sol = TrBdf2::new()
     ///     .rtol(1e-10)
     ///     .atol(1e-12)
-    ///     .solve_model_until(&model, |_t, x: &[f64]| x[0], 0.0, &[1.0, 0.0], 10.0, &[])
+    ///     .solve_model_until(&model, &[], |_t, x: &[f64]| x[0], 0.0, &[1.0, 0.0], 10.0)
     ///     .unwrap();
     /// assert!(sol.event);
     /// assert!((sol.t - core::f64::consts::FRAC_PI_4).abs() < 1e-6);
@@ -280,16 +345,87 @@ impl TrBdf2 {
     pub fn solve_model_until<M: Model, G>(
         &self,
         model: &M,
+        inputs: &[f64],
         mut g: G,
         t0: f64,
         x0: &[f64],
         t_end: f64,
-        inputs: &[f64],
     ) -> Result<TrBdf2Solution, IntegrateError>
     where
         G: FnMut(f64, &[f64]) -> f64,
     {
-        self.run_model(model, t0, x0, t_end, inputs, &mut [], Some(&mut g))
+        self.run_model(model, t0, x0, t_end, inputs, &mut [], Some(&mut g), None)
+    }
+
+    /// [`TrBdf2::solve_projected`] of a model's reduced equations, as
+    /// [`TrBdf2::solve_model`]; the arguments in the order of the explicit
+    /// integrators' [`solve_model_projected`](crate::integrate::Dopri5::solve_model_projected)
+    /// (model, inputs, projection, then the interval).
+    ///
+    /// ```
+    /// use appell_runtime::integrate::{ProjectionFailed, TrBdf2};
+    /// use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+    /// # struct Oscillator { w: f64 }
+    /// # static INFO: ModelInfo = ModelInfo {
+    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
+    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
+    /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
+    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     equations: "x'' = -w^2 x",
+    /// # };
+    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+    /// # impl Model for Oscillator {
+    /// #     type Prepared<T: Scalar> = T;
+    /// #     fn info() -> &'static ModelInfo { &INFO }
+    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
+    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
+    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
+    /// #         appell_runtime::check_len("state", s, 2)?;
+    /// #         appell_runtime::check_len("dstate", ds, 2)?;
+    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
+    /// #     }
+    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+    /// # }
+    ///
+    /// // x'' = −x keeps x² + x'² = 1 from (1, 0).
+    /// let model = Oscillator { w: 1.0 };
+    /// let onto_circle = |_t: f64, x: &mut [f64]| {
+    ///     let r = x[0].hypot(x[1]);
+    ///     x[0] /= r;
+    ///     x[1] /= r;
+    ///     Ok::<(), ProjectionFailed>(())
+    /// };
+    /// let sol = TrBdf2::new()
+    ///     .rtol(1e-4)
+    ///     .solve_model_projected(&model, &[], onto_circle, 0.0, &[1.0, 0.0], 50.0)
+    ///     .unwrap();
+    /// assert!((sol.x[0].hypot(sol.x[1]) - 1.0).abs() < 1e-15);
+    /// ```
+    pub fn solve_model_projected<M: Model, P>(
+        &self,
+        model: &M,
+        inputs: &[f64],
+        mut project: P,
+        t0: f64,
+        x0: &[f64],
+        t_end: f64,
+    ) -> Result<TrBdf2Solution, IntegrateError>
+    where
+        P: FnMut(f64, &mut [f64]) -> Result<(), ProjectionFailed>,
+    {
+        let project: &mut ProjectG<'_> = &mut project;
+        self.run_model(model, t0, x0, t_end, inputs, &mut [], None, Some(project))
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -302,9 +438,19 @@ impl TrBdf2 {
         inputs: &[f64],
         out: &mut [(f64, Vec<f64>)],
         event: Option<&mut EventG<'_>>,
+        project: Option<&mut ProjectG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError> {
         check_len("state", x0, M::info().state_len())?;
-        self.run_prepared(&Prepared::new(model), t0, x0, t_end, inputs, out, event)
+        self.run_prepared(
+            &Prepared::new(model),
+            t0,
+            x0,
+            t_end,
+            inputs,
+            out,
+            event,
+            project,
+        )
     }
 
     /// [`TrBdf2::solve_model_at`] of a prepared rhs (compiled once for
@@ -318,7 +464,7 @@ impl TrBdf2 {
         inputs: &[f64],
     ) -> Result<TrBdf2Solution, IntegrateError> {
         let t_end = out.last().map_or(t0, |o| o.0);
-        self.run_prepared(rhs, t0, x0, t_end, inputs, out, None)
+        self.run_prepared(rhs, t0, x0, t_end, inputs, out, None, None)
     }
 
     #[allow(clippy::too_many_arguments)]
@@ -331,30 +477,13 @@ impl TrBdf2 {
         inputs: &[f64],
         out: &mut [(f64, Vec<f64>)],
         event: Option<&mut EventG<'_>>,
+        project: Option<&mut ProjectG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError> {
         let n = rhs.state_len();
         check_len("state", x0, n)?;
-        let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
-        let mut xd = vec![Dual64::from_re(0.0); n];
-        let mut outd = vec![Dual64::from_re(0.0); n];
         let f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, inputs, dx);
-        let jac = |t: f64, x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
-            let td = Dual64::from_re(t);
-            for (d, &v) in xd.iter_mut().zip(x) {
-                *d = Dual64::from_re(v);
-            }
-            for col in 0..n {
-                xd[col].eps = 1.0;
-                let r = rhs.rhs_dual(td, &xd, &inputs_d, &mut outd);
-                xd[col].eps = 0.0;
-                r?;
-                for (row, o) in outd.iter().enumerate() {
-                    j[row * n + col] = o.eps;
-                }
-            }
-            Ok(())
-        };
-        let mut sol = self.run(f, jac, t0, x0, t_end, out, event)?;
+        let jac = dual_jacobian(rhs, inputs);
+        let mut sol = self.run(f, jac, t0, x0, t_end, out, event, project)?;
         sol.stats.jacobian_rhs_calls = sol.stats.jacobians * n;
         Ok(sol)
     }

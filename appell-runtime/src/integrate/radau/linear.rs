@@ -1,0 +1,239 @@
+//! Dense LU factorization with partial pivoting over real and complex
+//! entries: the real and the complex Newton system of each step.
+
+use core::ops::{Add, Div, Mul, Neg, Sub};
+
+/// A complex number, for the complex Newton system.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub(super) struct C64 {
+    pub(super) re: f64,
+    pub(super) im: f64,
+}
+
+impl C64 {
+    pub(super) const fn new(re: f64, im: f64) -> Self {
+        C64 { re, im }
+    }
+}
+
+impl Add for C64 {
+    type Output = C64;
+    fn add(self, o: C64) -> C64 {
+        C64::new(self.re + o.re, self.im + o.im)
+    }
+}
+
+impl Sub for C64 {
+    type Output = C64;
+    fn sub(self, o: C64) -> C64 {
+        C64::new(self.re - o.re, self.im - o.im)
+    }
+}
+
+impl Mul for C64 {
+    type Output = C64;
+    fn mul(self, o: C64) -> C64 {
+        C64::new(
+            self.re * o.re - self.im * o.im,
+            self.re * o.im + self.im * o.re,
+        )
+    }
+}
+
+impl Div for C64 {
+    type Output = C64;
+    /// Smith's division (no overflow of `|o|²` for large entries).
+    fn div(self, o: C64) -> C64 {
+        if o.re.abs() >= o.im.abs() {
+            let r = o.im / o.re;
+            let d = o.re + o.im * r;
+            C64::new((self.re + self.im * r) / d, (self.im - self.re * r) / d)
+        } else {
+            let r = o.re / o.im;
+            let d = o.re * r + o.im;
+            C64::new((self.re * r + self.im) / d, (self.im * r - self.re) / d)
+        }
+    }
+}
+
+impl Neg for C64 {
+    type Output = C64;
+    fn neg(self) -> C64 {
+        C64::new(-self.re, -self.im)
+    }
+}
+
+/// The arithmetic an LU factorization needs.
+pub(super) trait Entry:
+    Copy + Add<Output = Self> + Sub<Output = Self> + Mul<Output = Self> + Div<Output = Self>
+{
+    const ZERO: Self;
+    /// A real entry.
+    fn real(v: f64) -> Self;
+    /// The magnitude used to choose pivots (`|re| + |im|` for complex).
+    fn magnitude(self) -> f64;
+}
+
+impl Entry for f64 {
+    const ZERO: f64 = 0.0;
+    fn real(v: f64) -> f64 {
+        v
+    }
+    fn magnitude(self) -> f64 {
+        self.abs()
+    }
+}
+
+impl Entry for C64 {
+    const ZERO: C64 = C64::new(0.0, 0.0);
+    fn real(v: f64) -> C64 {
+        C64::new(v, 0.0)
+    }
+    fn magnitude(self) -> f64 {
+        self.re.abs() + self.im.abs()
+    }
+}
+
+/// The LU factors of an n×n matrix (row-major, unit lower triangle
+/// implied) and the row exchanges of partial pivoting.
+pub(super) struct Lu<T> {
+    n: usize,
+    a: Vec<T>,
+    pivots: Vec<usize>,
+}
+
+impl<T: Entry> Lu<T> {
+    /// Room for an n×n factorization.
+    pub(super) fn new(n: usize) -> Self {
+        Lu {
+            n,
+            a: vec![T::ZERO; n * n],
+            pivots: vec![0; n],
+        }
+    }
+
+    /// Factors `shift · I − J` (`jac` row-major n×n); false when a pivot
+    /// is zero or not finite (the factors are then unusable).
+    pub(super) fn factor_shifted(&mut self, shift: T, jac: &[f64]) -> bool {
+        let n = self.n;
+        for (i, row) in self.a.chunks_exact_mut(n.max(1)).enumerate() {
+            for (j, v) in row.iter_mut().enumerate() {
+                *v = T::ZERO - T::real(jac[i * n + j]);
+            }
+            row[i] = row[i] + shift;
+        }
+        self.factor()
+    }
+
+    /// In-place Doolittle factorization with partial pivoting.
+    fn factor(&mut self) -> bool {
+        let n = self.n;
+        let a = &mut self.a;
+        for k in 0..n {
+            let p = (k..n)
+                .max_by(|&i, &j| {
+                    a[i * n + k]
+                        .magnitude()
+                        .total_cmp(&a[j * n + k].magnitude())
+                })
+                .unwrap_or(k);
+            let m = a[p * n + k].magnitude();
+            if m == 0.0 || !m.is_finite() {
+                return false;
+            }
+            self.pivots[k] = p;
+            if p != k {
+                for j in 0..n {
+                    a.swap(k * n + j, p * n + j);
+                }
+            }
+            let pivot = a[k * n + k];
+            for i in k + 1..n {
+                let l = a[i * n + k] / pivot;
+                a[i * n + k] = l;
+                for j in k + 1..n {
+                    a[i * n + j] = a[i * n + j] - l * a[k * n + j];
+                }
+            }
+        }
+        true
+    }
+
+    /// Solves `M y = b` in place with the factors of `M`.
+    pub(super) fn solve(&self, b: &mut [T]) {
+        let n = self.n;
+        let a = &self.a;
+        for k in 0..n {
+            b.swap(k, self.pivots[k]);
+        }
+        for i in 1..n {
+            let mut s = b[i];
+            for j in 0..i {
+                s = s - a[i * n + j] * b[j];
+            }
+            b[i] = s;
+        }
+        for i in (0..n).rev() {
+            let mut s = b[i];
+            for j in i + 1..n {
+                s = s - a[i * n + j] * b[j];
+            }
+            b[i] = s / a[i * n + i];
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn real_solve_with_row_exchanges() {
+        // 2 I − J with J = [[2, 1, 0], [1, 2, 3], [4, 0, 1]] is
+        // [[0, −1, 0], [−1, 0, −3], [−4, 0, 1]]: the first pivot is zero.
+        let jac = [2.0, 1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 0.0, 1.0];
+        let mut lu = Lu::<f64>::new(3);
+        assert!(lu.factor_shifted(2.0, &jac));
+        let x = [1.0, -2.0, 0.5];
+        let m = [[0.0, -1.0, 0.0], [-1.0, 0.0, -3.0], [-4.0, 0.0, 1.0]];
+        let mut b: Vec<f64> = m
+            .iter()
+            .map(|r| r.iter().zip(&x).map(|(a, b)| a * b).sum())
+            .collect();
+        lu.solve(&mut b);
+        for (u, v) in b.iter().zip(&x) {
+            assert!((u - v).abs() < 1e-15, "{b:?}");
+        }
+    }
+
+    #[test]
+    fn complex_solve_matches_a_known_solution() {
+        // (1 + i) I − J, J = [[1, 2], [3, 4]]: [[i, −2], [−3, −3 + i]].
+        let jac = [1.0, 2.0, 3.0, 4.0];
+        let mut lu = Lu::<C64>::new(2);
+        assert!(lu.factor_shifted(C64::new(1.0, 1.0), &jac));
+        let x = [C64::new(1.0, -1.0), C64::new(0.5, 2.0)];
+        let m = [
+            [C64::new(0.0, 1.0), C64::new(-2.0, 0.0)],
+            [C64::new(-3.0, 0.0), C64::new(-3.0, 1.0)],
+        ];
+        let mut b: Vec<C64> = m.iter().map(|r| r[0] * x[0] + r[1] * x[1]).collect();
+        lu.solve(&mut b);
+        for (u, v) in b.iter().zip(&x) {
+            assert!((*u - *v).magnitude() < 1e-14, "{b:?}");
+        }
+        assert_eq!(C64::new(1.0, 2.0) / C64::new(0.0, 1.0), C64::new(2.0, -1.0));
+        assert_eq!(-C64::new(1.0, -2.0), C64::new(-1.0, 2.0));
+    }
+
+    #[test]
+    fn singular_and_non_finite_matrices_are_reported() {
+        let mut lu = Lu::<f64>::new(2);
+        // I − J = 0.
+        assert!(!lu.factor_shifted(1.0, &[1.0, 0.0, 0.0, 1.0]));
+        assert!(!lu.factor_shifted(1.0, &[f64::NAN, 0.0, 0.0, 1.0]));
+        let mut lc = Lu::<C64>::new(1);
+        assert!(!lc.factor_shifted(C64::new(2.0, 0.0), &[2.0]));
+        assert!(lc.factor_shifted(C64::new(2.0, 1e-300), &[2.0]));
+    }
+}
