@@ -28,6 +28,7 @@ fn main() -> ExitCode {
         g: 9.81,
     };
     rows.extend(cases::four_bar_singular_positions(&forty, 40, 20.0, 5e-3));
+    rows.extend(cases::four_bar_condition_warning(1e3));
     rows.extend(cases::singular_dependent_block());
     rows.extend(cases::disc_steady_circle());
     rows.extend(cases::bicycle_self_stability(10.0));

@@ -21,6 +21,8 @@ pub mod augmented;
 #[cfg(feature = "std")]
 pub mod cli;
 #[cfg(feature = "std")]
+pub mod conditioning;
+#[cfg(feature = "std")]
 pub mod constraint_forces;
 #[cfg(feature = "std")]
 pub mod dynamic;

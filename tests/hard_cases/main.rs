@@ -118,3 +118,8 @@ fn double_pendulum_separates_when_its_lyapunov_exponent_says() {
     // example).
     check(precision::double_pendulum_chaos(200.0));
 }
+
+#[test]
+fn the_condition_watch_warns_before_the_four_bars_dead_centre() {
+    check(cases::four_bar_condition_warning(1e3));
+}
