@@ -37,6 +37,7 @@ fn main() -> ExitCode {
     rows.extend(cases::stiff_spring(1.0));
     rows.extend(cases::mass_ratio_chain());
     rows.extend(cases::bad_states());
+    rows.extend(cases::andrews_squeezer());
     rows.extend(precision::round_off_all(10_000));
     rows.extend(precision::double_pendulum_chaos(1000.0));
     println!("| case | criterion | measured | result |");

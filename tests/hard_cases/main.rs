@@ -123,3 +123,8 @@ fn double_pendulum_separates_when_its_lyapunov_exponent_says() {
 fn the_condition_watch_warns_before_the_four_bars_dead_centre() {
     check(cases::four_bar_condition_warning(1e3));
 }
+
+#[test]
+fn andrews_squeezer_matches_the_ivp_test_set() {
+    check(cases::andrews_squeezer());
+}
