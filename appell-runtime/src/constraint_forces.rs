@@ -339,11 +339,11 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
             info.row_sources.len()
         )));
     }
-    let qdot = oracle::coordinate_rates_dyn(model, t, q, u)?;
+    let qdot = oracle::driven_coordinate_rates_dyn(model, t, q, u, inputs)?;
     let sol = oracle::accelerations_dyn(model, t, q, &qdot, inputs)?;
     let mut dmat = vec![0.0; m * n];
     let mut d0 = vec![0.0; m];
-    model.dyn_constraint_rows(t, q, &mut dmat, &mut d0)?;
+    model.dyn_driven_constraint_rows(t, q, inputs, &mut dmat, &mut d0)?;
     let rows: Vec<RowReaction> = (0..m)
         .map(|s| RowReaction {
             source: info.row_sources[s],

@@ -401,6 +401,36 @@ pub trait DynModel: sealed::Sealed {
         d0: &mut [f64],
     ) -> Result<(), ModelError>;
 
+    /// [`Model::driven_constraint_rows`].
+    fn dyn_driven_constraint_rows(
+        &self,
+        t: f64,
+        q: &[f64],
+        inputs: &[f64],
+        d: &mut [f64],
+        d0: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::driven_constraint_rows`] in [`Dual64`].
+    fn dyn_driven_constraint_rows_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        inputs: &[Dual64],
+        d: &mut [Dual64],
+        d0: &mut [Dual64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::driven_coordinate_rates`].
+    fn dyn_driven_coordinate_rates(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+        qdot: &mut [f64],
+    ) -> Result<(), ModelError>;
+
     /// [`Model::constraint_rows`] in [`Dual64`].
     fn dyn_constraint_rows_dual(
         &self,
@@ -629,6 +659,39 @@ impl<M: Model> DynModel for M {
         d0: &mut [Dual64],
     ) -> Result<(), ModelError> {
         self.constraint_rows(t, q, d, d0)
+    }
+
+    fn dyn_driven_constraint_rows(
+        &self,
+        t: f64,
+        q: &[f64],
+        inputs: &[f64],
+        d: &mut [f64],
+        d0: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.driven_constraint_rows(t, q, inputs, d, d0)
+    }
+
+    fn dyn_driven_constraint_rows_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        inputs: &[Dual64],
+        d: &mut [Dual64],
+        d0: &mut [Dual64],
+    ) -> Result<(), ModelError> {
+        self.driven_constraint_rows(t, q, inputs, d, d0)
+    }
+
+    fn dyn_driven_coordinate_rates(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+        qdot: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.driven_coordinate_rates(t, q, u, inputs, qdot)
     }
 
     fn dyn_load_geometry(

@@ -142,5 +142,5 @@ pub(crate) use kkt::accelerations_dyn;
 pub use kkt::{accelerations, OracleSolution};
 pub(crate) use layout::finite_all;
 pub use rates::{coordinate_rates, reduced_rhs};
-pub(crate) use rates::{coordinate_rates_dyn, reduced_rhs_dyn};
+pub(crate) use rates::{driven_coordinate_rates_dyn, reduced_rhs_dyn};
 pub(crate) use vec3::{mul, mul_bt, vee};

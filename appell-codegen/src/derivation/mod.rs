@@ -99,18 +99,24 @@ pub struct Calculus {
 }
 
 impl Calculus {
-    /// The derivatives, with `twin` where the model has one.
-    pub fn new(twin: Option<Twin>) -> Calculus {
-        let twin_rules = twin.as_ref().map(|t| t.rate_rules());
+    /// The derivatives, with `twin` where the model has one; the inputs
+    /// that drive constraints have their companions as rates.
+    pub fn new(model: &mut Model, twin: Option<Twin>) -> Result<Calculus, SymbolicError> {
+        let rates = model.input_rates.clone();
+        let g = &mut model.g;
+        let twin_rules = match twin.as_ref() {
+            Some(t) => Some(Model::with_input_rates(g, &rates, t.rate_rules())?),
+            None => None,
+        };
         let uncut = twin
             .as_ref()
             .map_or_else(Substitution::new, |t| t.uncut_substitution());
-        Calculus {
-            rules: RateRules::coordinates(),
+        Ok(Calculus {
+            rules: Model::with_input_rates(g, &rates, RateRules::coordinates())?,
             twin,
             twin_rules,
             uncut,
-        }
+        })
     }
 }
 
@@ -233,7 +239,9 @@ pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
 /// [`derive()`] with the cost-driven choices forced by `options`.
 pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derived> {
     let Kinematics { mut model, twin } = kinematics;
-    let full = match stages(cx, &mut model, Calculus::new(twin), options) {
+    let full = match Calculus::new(&mut model, twin)
+        .and_then(|calculus| stages(cx, &mut model, calculus, options))
+    {
         Ok(Some(d)) => {
             let mut d = d.finish(&model);
             d.structured = if options.closed_form_only {

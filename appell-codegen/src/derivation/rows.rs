@@ -102,13 +102,16 @@ fn holonomic_rows(cx: &Ctxt, model: &mut Model, calculus: &Calculus) -> (Vec<Id>
             .filter(|s| {
                 !matches!(
                     model.g.symbol_kind(*s),
-                    SymbolKind::Coordinate | SymbolKind::Parameter | SymbolKind::Time
+                    SymbolKind::Coordinate
+                        | SymbolKind::Parameter
+                        | SymbolKind::Time
+                        | SymbolKind::Input
                 )
             })
             .map(|s| model.g.symbol_name(s).to_string())
             .collect();
         if !bad.is_empty() {
-            cx.error_spanned_by(&c.at, format!("a holonomic constraint relates coordinates, parameters and time only; it uses {}", bad.join(", ")));
+            cx.error_spanned_by(&c.at, format!("a holonomic constraint relates coordinates, parameters, inputs and time only; it uses {}", bad.join(", ")));
             continue;
         }
         let raw = match (&calculus.twin, &calculus.twin_rules) {
@@ -318,6 +321,7 @@ fn linear_rows(
     contacts: Vec<ContactMotion>,
 ) -> ConstraintRows {
     let rates = model.coordinate_rates();
+    let driving: Vec<_> = model.input_rates.iter().map(|(s, _)| *s).collect();
     let mut out = ConstraintRows {
         holonomic,
         d: Vec::new(),
@@ -334,18 +338,18 @@ fn linear_rows(
             .g
             .dependencies(row.value)
             .iter()
-            .filter(|s| {
-                matches!(
-                    model.g.symbol_kind(*s),
-                    SymbolKind::Input | SymbolKind::Acceleration(_)
-                )
+            .filter(|s| match model.g.symbol_kind(*s) {
+                // A driving input's rate is its companion input.
+                SymbolKind::Input => !driving.contains(s),
+                SymbolKind::Acceleration(_) => true,
+                _ => false,
             })
             .map(|s| model.g.symbol_name(s).to_string())
             .collect();
         if !bad.is_empty() {
             cx.error_spanned_by(
                 span,
-                format!("a velocity constraint cannot depend on {}", bad.join(", ")),
+                format!("a velocity constraint cannot depend on {} (an input may drive a constraint as written in `holonomic(...)` or `nonholonomic(...)`, not through a point, frame or rolling contact)", bad.join(", ")),
             );
             continue;
         }
@@ -494,5 +498,44 @@ mod tests {
             err.contains("does not involve any coordinate rate"),
             "{err}"
         );
+    }
+
+    #[test]
+    fn an_input_drives_a_row_through_its_companion() {
+        // dt(y) == w: D = [0, 1], d = −w; and x == c: D = [1, 0], d = −c_rate.
+        let (mut m, rows) = rows_of(
+            r#"
+            #[appell(coordinates(x, y), speeds())]
+            #[appell(point(P = O + x * N.x + y * N.y), particle(P, mass = m))]
+            #[appell(holonomic(x == c), nonholonomic(dt(y) == w), inputs(w, c))]
+            #[appell(force(P, w * N.x, effect = push))]
+            struct Driven { m: f64 }
+            "#,
+        );
+        let names: Vec<String> = m.inputs.iter().map(|(i, _)| i.to_string()).collect();
+        assert_eq!(names, ["w", "c", "w_rate", "c_rate", "c_accel"]);
+        assert_eq!(m.input_rates.len(), 3);
+        assert_agrees(&mut m.g, rows.d[0], "1");
+        assert_agrees(&mut m.g, rows.d0[0], "-c_rate");
+        assert_agrees(&mut m.g, rows.d[3], "1");
+        assert_agrees(&mut m.g, rows.d0[1], "-w");
+    }
+
+    #[test]
+    fn an_input_through_a_point_has_no_rate_and_is_reported() {
+        let (mut model, calculus) = testing::model_and_calculus(
+            r#"
+            #[appell(coordinates(x, phi), speeds(phi))]
+            #[appell(frame(B = N.rotate_z(phi)))]
+            #[appell(point(D = O + x * N.x + (r + w) * N.y), point(P = D - (r + w) * N.y))]
+            #[appell(body(disc, center = D, frame = B, mass = m, inertia = principal(i, i, j)))]
+            #[appell(rolls(disc, contact = P), inputs(w))]
+            struct Disc { m: f64, r: f64, i: f64, j: f64 }
+            "#,
+        );
+        let cx = Ctxt::new();
+        let out = constraint_rows(&cx, &mut model, &calculus);
+        assert!(out.is_err() || cx.has_errors());
+        let _ = cx.check();
     }
 }

@@ -81,7 +81,8 @@ pub fn speed_map(
         }
         qdot.push(g.sum(&terms)?);
     }
-    let mut reduced = RateRules::coordinates();
+    let rates = model.input_rates.clone();
+    let mut reduced = Model::with_input_rates(g, &rates, RateRules::coordinates())?;
     for (r, (_, coord)) in model.coords.iter().enumerate() {
         reduced = reduced.with(coord.q, qdot[r]);
     }
@@ -89,7 +90,7 @@ pub fn speed_map(
         let a = g.sym(spec.accel)?;
         reduced = reduced.with(spec.symbol, a);
     }
-    let mut along = RateRules::coordinates();
+    let mut along = Model::with_input_rates(g, &rates, RateRules::coordinates())?;
     for (_, coord) in &model.coords {
         along = along.constant(coord.rate);
     }

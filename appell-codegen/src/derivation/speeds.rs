@@ -158,7 +158,7 @@ fn quasi_velocity_row(
         cx.error_spanned_by(
             &model.speeds_at,
             format!(
-                "the quasi-velocity `{}` cannot depend on {}",
+                "the quasi-velocity `{}` cannot depend on {}; to prescribe a speed by an input, write it as a constraint (`nonholonomic(dt(q) == input)`) and leave that rate out of `speeds(...)`",
                 spec.name,
                 bad.join(", ")
             ),

@@ -70,8 +70,9 @@ pub fn model(src: &str) -> Model {
 
 /// The model of `src` and the derivatives with its twin.
 pub fn model_and_calculus(src: &str) -> (Model, Calculus) {
-    let Kinematics { model, twin } = kinematics(src);
-    (model, Calculus::new(twin))
+    let Kinematics { mut model, twin } = kinematics(src);
+    let calculus = Calculus::new(&mut model, twin).expect("the rate rules");
+    (model, calculus)
 }
 
 /// A symbol of the model's graph by name.

@@ -226,6 +226,40 @@ impl Emitter<'_> {
         let chk_qdot = chk("__qdot", n);
         let checks_res = [chk("__holonomic", nh), chk("__velocity", m)];
         let checks_sd = [chk("__w", l * n), chk("__w0", l)];
+        if !self.model.input_rates.is_empty() {
+            // Driven coordinates: C, c, q̇, the residuals and T read the
+            // inputs; only the `driven_` forms take them.
+            let needs = |f: &str| quote!({ #p::Err(#p::ModelError::NeedsInputs { function: #f }) });
+            let (ns, nc, nr, nk) = (
+                needs("speed_transform"),
+                needs("coordinate_rates"),
+                needs("constraint_residuals"),
+                needs("kinetic_energy"),
+            );
+            return quote! {
+                fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
+                fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> #ns
+                fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> #nc
+                fn driven_coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #chk_u #chk_inputs #chk_qdot #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #cr_body #cr_out
+                    #p::Ok(())
+                }
+                fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> #nr
+                fn speed_definitions<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #(#checks_sd)* #params_t #bind_q #sd_body #sd_w #sd_w0
+                    #p::Ok(())
+                }
+                fn input_power<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                    #chk_q #chk_u #chk_inputs #params_t #bind_q #bind_u #bind_inputs #solve_x #ip_body
+                    #p::Ok(#ip_out)
+                }
+                fn potential_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                    #chk_q #params_t #bind_q #pe_body
+                    #p::Ok(#pe_out)
+                }
+                fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #nk
+            };
+        }
         quote! {
             fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
             fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
@@ -322,6 +356,28 @@ impl Emitter<'_> {
             poses.take_statements(),
             rows.take_statements(),
         );
+        let rows_fn = if self.model.input_rates.is_empty() {
+            quote! {
+                fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #(#checks_rows)* #params_t #bind_q #rows_body #rows_d #rows_d0
+                    #p::Ok(())
+                }
+            }
+        } else {
+            let (chk_inputs, bind_inputs) = (
+                chk("__inputs", self.inputs().len()),
+                self.bind_inputs("__inputs"),
+            );
+            quote! {
+                fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #p::Err(#p::ModelError::NeedsInputs { function: "constraint_rows" })
+                }
+                fn driven_constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __inputs: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #chk_inputs #(#checks_rows)* #params_t #bind_q #bind_inputs #rows_body #rows_d #rows_d0
+                    #p::Ok(())
+                }
+            }
+        };
         quote! {
             fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
                 #(#checks_mp)* #params_f #mp_body #(#mp_out)*
@@ -331,10 +387,7 @@ impl Emitter<'_> {
                 #chk_q #(#checks_poses)* #params_t #bind_q #poses_body #(#poses_out)*
                 #p::Ok(())
             }
-            fn constraint_rows<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __d: &mut [__T], __d0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_rows)* #params_t #bind_q #rows_body #rows_d #rows_d0
-                #p::Ok(())
-            }
+            #rows_fn
         }
     }
 

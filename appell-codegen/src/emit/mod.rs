@@ -108,6 +108,7 @@ impl Emitter<'_> {
             .iter()
             .filter(|(_, s)| {
                 self.scene.is_none()
+                    || self.model.input_rates.iter().any(|(a, b)| a == s || b == s)
                     || loads
                         .iter()
                         .any(|l| l.vector.iter().any(|&e| g.depends_on(e, *s)))

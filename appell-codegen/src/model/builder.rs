@@ -85,12 +85,13 @@ pub(super) fn build_in(
     }
     b.frames_and_points(ast)?;
     let bodies: Vec<super::Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
-    let holonomic = ast.holonomic.iter().flat_map(|c| b.constraint(c)).collect();
-    let nonholonomic = ast
+    let holonomic: Vec<_> = ast.holonomic.iter().flat_map(|c| b.constraint(c)).collect();
+    let nonholonomic: Vec<_> = ast
         .nonholonomic
         .iter()
         .flat_map(|c| b.constraint(c))
         .collect();
+    let input_rates = b.driving_inputs(&holonomic, &nonholonomic);
     let loads = b.loads(ast, &bodies)?;
     let rolling = b.rolling_contacts(ast, &bodies);
     let (speed_specs, speeds_at) = b.speeds(ast);
@@ -114,6 +115,7 @@ pub(super) fn build_in(
         speed_specs,
         speeds_at,
         inputs: b.inputs,
+        input_rates,
         time: b.time,
         frames: b.frames,
         points: b.points,
@@ -325,6 +327,55 @@ impl Builder<'_> {
             }
         }
         (out, at.clone())
+    }
+
+    /// Driven coordinates: every declared input a constraint reads gets a
+    /// companion input `{input}_rate` (its time derivative), and one read
+    /// by a holonomic constraint also `{input}_accel` (the second
+    /// derivative, the rate of `{input}_rate`), appended to the inputs in
+    /// that order, input by input. Returns each (symbol, its rate's
+    /// symbol) pair, for the derivation's rate rules.
+    pub(super) fn driving_inputs(
+        &mut self,
+        holonomic: &[super::Constraint],
+        nonholonomic: &[super::Constraint],
+    ) -> Vec<(Symbol, Symbol)> {
+        let reads = |g: &Graph, cs: &[super::Constraint], s: Symbol| {
+            cs.iter().any(|c| g.depends_on(c.residual, s))
+        };
+        let mut rates = Vec::new();
+        let declared = self.inputs.clone();
+        for (ident, s) in declared {
+            let in_h = reads(&self.g, holonomic, s);
+            if !in_h && !reads(&self.g, nonholonomic, s) {
+                continue;
+            }
+            let mut names = vec![format!("{ident}_rate")];
+            if in_h {
+                names.push(format!("{ident}_accel"));
+            }
+            let mut of = s;
+            for name in names {
+                // The twin's build finds the first build's companion in the
+                // graph, an input.
+                let clash = self.all_names().contains(&name)
+                    || self
+                        .g
+                        .symbol_named(&name)
+                        .is_some_and(|x| self.g.symbol_kind(x) != SymbolKind::Input);
+                let Some(rate) = (!clash).then(|| self.g.input(&name).ok()).flatten() else {
+                    self.cx.error_spanned_by(
+                        &ident,
+                        format!("`{ident}` drives a constraint, so the input `{name}` stands for its time derivative; `{name}` is already used"),
+                    );
+                    break;
+                };
+                self.inputs.push((Ident::new(&name, ident.span()), rate));
+                rates.push((of, rate));
+                of = rate;
+            }
+        }
+        rates
     }
 
     pub(super) fn all_names(&self) -> Vec<String> {

@@ -194,8 +194,13 @@ pub struct Model {
     pub speed_specs: Vec<SpeedSpec>,
     /// The tokens of `speeds(...)`, for errors.
     pub speeds_at: proc_macro2::TokenStream,
-    /// Inputs.
+    /// Inputs: the declared ones, then the companions of the inputs that
+    /// drive constraints (`{input}_rate`, and `{input}_accel` for a
+    /// holonomic one).
     pub inputs: Vec<(Ident, Symbol)>,
+    /// The rate of each input that drives a constraint (and of its
+    /// `_rate` companion in a holonomic one): (input, its rate's symbol).
+    pub input_rates: Vec<(Symbol, Symbol)>,
     /// Time.
     pub time: Symbol,
     /// Frames; index 0 is N.
@@ -242,6 +247,20 @@ impl Model {
     /// The symbols q̇_r of the coordinates' rates, in order.
     pub fn coordinate_rates(&self) -> Vec<Symbol> {
         self.coords.iter().map(|(_, c)| c.rate).collect()
+    }
+
+    /// `rules` with every driving input's rate (see
+    /// [`Model::input_rates`]).
+    pub fn with_input_rates(
+        g: &mut Graph,
+        input_rates: &[(Symbol, Symbol)],
+        mut rules: RateRules,
+    ) -> Result<RateRules, appell_symbolic::SymbolicError> {
+        for &(s, rate) in input_rates {
+            let r = g.sym(rate)?;
+            rules = rules.with(s, r);
+        }
+        Ok(rules)
     }
 
     /// What the model declares about signs: parameters marked `positive`.

@@ -43,6 +43,7 @@ pub(super) fn contact_forces_json(
             let source = match r.source {
                 RowSource::Holonomic { index } => format!("holonomic {index}"),
                 RowSource::Nonholonomic { index } => format!("nonholonomic {index}"),
+                RowSource::Driven { constraint, .. } => format!("driven, {constraint}"),
                 RowSource::Rolling { contact, direction } => {
                     let point = info.contacts.get(contact).map_or("?", |c| c.point);
                     match info.contacts.get(contact) {

@@ -108,7 +108,8 @@ pub(super) fn full_dynamics_with<K: DynModel + ?Sized>(
     let t1 = Dual64::new(t, 1.0);
     let mut dmat = vec![Dual64::zero(); m * n];
     let mut doff = vec![Dual64::zero(); m];
-    model.dyn_constraint_rows_dual(t1, &q1, &mut dmat, &mut doff)?;
+    let inputs1 = input_duals(info, inputs);
+    model.dyn_driven_constraint_rows_dual(t1, &q1, &inputs1, &mut dmat, &mut doff)?;
     let g1 = Geometry::<Dual64>::eval(model, lay, t1, &q1)?;
 
     let mut forces = vec![[0.0; 3]; lay.points];
@@ -300,4 +301,23 @@ fn generalized_forces(
         power += dot(&vee(&mul_bt(&fdot, &g0.frames[f])), &torques[f]);
     }
     (gen_forces, power)
+}
+
+/// The inputs as dual numbers along the motion, for constraints that read
+/// them (driven coordinates): an input `x` whose companion `x_rate` is an
+/// input too moves at it, and `x_rate` at `x_accel` when that is one;
+/// every other input is held (rate 0).
+fn input_duals(info: &crate::model::ModelInfo, inputs: &[f64]) -> Vec<Dual64> {
+    let index = |name: &str| info.inputs.iter().position(|i| *i == name);
+    info.inputs
+        .iter()
+        .zip(inputs)
+        .map(|(name, &x)| {
+            let accel = name
+                .strip_suffix("_rate")
+                .and_then(|base| index(&format!("{base}_accel")));
+            let rate = accel.or_else(|| index(&format!("{name}_rate")));
+            Dual64::new(x, rate.map_or(0.0, |k| inputs[k]))
+        })
+        .collect()
 }

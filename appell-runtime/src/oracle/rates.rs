@@ -41,7 +41,20 @@ pub(crate) fn coordinate_rates_dyn<K: DynModel + ?Sized>(
     u: &[f64],
 ) -> Result<Vec<f64>, OracleError> {
     let lay = Layout::new(model.dyn_info())?;
-    coordinate_rates_with(model, &lay, t, q_full, u)
+    coordinate_rates_with(model, &lay, t, q_full, u, &[])
+}
+
+/// [`coordinate_rates`] at `inputs` too, for a model whose constraints
+/// read inputs (driven coordinates; [`Model::driven_constraint_rows`]).
+pub(crate) fn driven_coordinate_rates_dyn<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q_full: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+) -> Result<Vec<f64>, OracleError> {
+    let lay = Layout::new(model.dyn_info())?;
+    coordinate_rates_with(model, &lay, t, q_full, u, inputs)
 }
 
 fn coordinate_rates_with<K: DynModel + ?Sized>(
@@ -50,6 +63,7 @@ fn coordinate_rates_with<K: DynModel + ?Sized>(
     t: f64,
     q_full: &[f64],
     u: &[f64],
+    inputs: &[f64],
 ) -> Result<Vec<f64>, OracleError> {
     let (n, m, l) = (lay.n, lay.m, lay.l);
     check_len("q", q_full, n)?;
@@ -59,7 +73,7 @@ fn coordinate_rates_with<K: DynModel + ?Sized>(
     finite_all(u.iter().copied(), "u")?;
     let mut dmat = vec![0.0; m * n];
     let mut doff = vec![0.0; m];
-    model.dyn_constraint_rows(t, q_full, &mut dmat, &mut doff)?;
+    model.dyn_driven_constraint_rows(t, q_full, inputs, &mut dmat, &mut doff)?;
     finite_all(dmat.iter().chain(&doff).copied(), "the constraint rows")?;
     let mut w = vec![0.0; l * n];
     let mut w0 = vec![0.0; l];
@@ -122,7 +136,7 @@ pub(crate) fn reduced_rhs_dyn<K: DynModel + ?Sized>(
     inputs: &[f64],
 ) -> Result<Vec<f64>, OracleError> {
     let lay = Layout::new(model.dyn_info())?;
-    let qdot = coordinate_rates_with(model, &lay, t, q_full, u)?;
+    let qdot = coordinate_rates_with(model, &lay, t, q_full, u, inputs)?;
     let sol = accelerations_with(model, &lay, t, q_full, &qdot, inputs)?;
     let mut out = Vec::with_capacity(lay.retained.len() + lay.l);
     out.extend(lay.retained.iter().map(|&i| qdot[i]));

@@ -78,7 +78,13 @@ pub fn projected(
     let (n, l) = (model.coords.len(), model.speed_specs.len());
     let parts = Parts::new(model)?;
     let g = &mut model.g;
-    let rates = joint_accelerations(g, model_symbols(&model.coords, &model.inputs), map)?;
+    let driving = model.input_rates.clone();
+    let rates = joint_accelerations(
+        g,
+        model_symbols(&model.coords, &model.inputs),
+        map,
+        &driving,
+    )?;
     let mut at_zero = Substitution::new();
     let zero = g.int(0)?;
     for &r in fixed {
@@ -120,14 +126,22 @@ fn model_symbols(
 }
 
 /// q̈ at ÿ = 0: Ċ ẏ + ċ, the time derivative of q̇ = C ẏ + c with the
-/// coordinates moving at q̇ and the speeds and inputs held.
-fn joint_accelerations(g: &mut Graph, symbols: Symbols, map: &SpeedMap) -> R<Vec<Id>> {
-    let mut rules = RateRules::coordinates();
+/// coordinates moving at q̇, the speeds and inputs held, except that the
+/// inputs driving constraints move at their companions' rates.
+fn joint_accelerations(
+    g: &mut Graph,
+    symbols: Symbols,
+    map: &SpeedMap,
+    driving: &[(appell_symbolic::Symbol, appell_symbolic::Symbol)],
+) -> R<Vec<Id>> {
+    let mut rules = Model::with_input_rates(g, driving, RateRules::coordinates())?;
     for (&q, &rate) in symbols.coordinates.iter().zip(&map.qdot) {
         rules = rules.with(q, rate);
     }
     for &s in map.speed_rates.iter().chain(&symbols.inputs) {
-        rules = rules.constant(s);
+        if !driving.iter().any(|(d, _)| *d == s) {
+            rules = rules.constant(s);
+        }
     }
     g.time_derivatives(&map.qdot, &rules)
 }
