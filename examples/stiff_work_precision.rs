@@ -245,7 +245,8 @@ fn main() {
         svg_chart("Stiff spring pendulum: error against time", &points),
     )
     .expect("write the chart");
-    md += "![Andrews' squeezer](andrews_squeezer.svg)\n![Stiff spring pendulum](stiff_spring.svg)\n";
+    md +=
+        "![Andrews' squeezer](andrews_squeezer.svg)\n![Stiff spring pendulum](stiff_spring.svg)\n";
     std::fs::write("docs/work_precision/stiff.md", &md).expect("write the tables");
     print!("{md}");
 }

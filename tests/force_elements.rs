@@ -239,3 +239,54 @@ fn joint_elements_are_generalized_torques_on_the_joint() {
         assert!(effects.contains(&e), "{e} in {effects:?}");
     }
 }
+
+/// A ball dropped on a one-sided spring (a contact that only pushes): the
+/// force is `if x < 0 { -k x } else { 0 }`.
+#[derive(Appell)]
+#[appell(coordinates(x), speeds(x), positive(m, k))]
+#[appell(point(P = O + x * N.z), particle(P, mass = m))]
+#[appell(force(P, (if x < 0 { -k * x } else { 0 }) * N.z, effect = contact))]
+#[appell(gravity(-9.81 * N.z))]
+struct Bouncer {
+    m: f64,
+    k: f64,
+}
+
+#[test]
+fn a_one_sided_contact_keeps_the_closed_form_contact_time_and_rebound() {
+    let p = Bouncer { m: 0.5, k: 2e4 };
+    let (g, h) = (9.81, 0.2);
+    let solver = Dop853::new().rtol(1e-12).atol(1e-14);
+    // Free fall to the contact: t = √(2h/g), v = −√(2gh).
+    let fall = solver
+        .solve_model_until(&p, &[], |_t, x: &[f64; 2]| x[0], 0.0, &[h, 0.0], 1.0)
+        .unwrap();
+    let v0 = (2.0 * g * h).sqrt();
+    assert!(fall.event);
+    assert!((fall.t - (2.0 * h / g).sqrt()).abs() < 1e-9, "{}", fall.t);
+    assert!((fall.x[1] + v0).abs() < 1e-8, "{}", fall.x[1]);
+    // In contact: simple harmonic motion about x = −m g/k at ω = √(k/m),
+    // amplitude A = √(δ² + (v0/ω)²), δ = m g/k; it leaves the spring after
+    // t_c = 2(π − acos(δ/A))/ω, at the speed it arrived with.
+    let omega = (p.k / p.m).sqrt();
+    let delta = p.m * g / p.k;
+    let amplitude = (delta * delta + (v0 / omega).powi(2)).sqrt();
+    let contact = 2.0 * (std::f64::consts::PI - (delta / amplitude).acos()) / omega;
+    let rebound = solver
+        .solve_model_until(
+            &p,
+            &[],
+            |_t, x: &[f64; 2]| x[0],
+            fall.t,
+            &fall.x,
+            fall.t + 1.0,
+        )
+        .unwrap();
+    assert!(rebound.event);
+    assert!(
+        (rebound.t - fall.t - contact).abs() < 1e-9,
+        "{} vs {contact}",
+        rebound.t - fall.t
+    );
+    assert!((rebound.x[1] - v0).abs() < 1e-7, "{} vs {v0}", rebound.x[1]);
+}

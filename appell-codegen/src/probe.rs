@@ -15,7 +15,7 @@
 //! an evaluation that fails (a square root of a negative number at a test
 //! point) as "unknown" rather than guess.
 
-use appell_symbolic::{Graph, Id, Symbol, SymbolKind, Tape};
+use appell_symbolic::{Func, Graph, Id, Node, Symbol, SymbolKind, Tape};
 
 /// A value in [0.5, 1.5] for parameters and [−1, 1] for everything else,
 /// fixed by the symbol and the trial number (the numeric rank and
@@ -113,9 +113,35 @@ pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
     first_dependent
 }
 
+/// Whether a piecewise function reachable from `roots` switches on `q`:
+/// a `select` (a conditional, `min`, `max`) whose condition or a `sign`
+/// whose argument depends on it. Such expressions can be flat in `q` at
+/// every probe (a one-sided spring probed where it does not touch) and
+/// still depend on it, so probes cannot show them independent.
+pub fn switches_on(g: &Graph, roots: &[Id], q: Symbol) -> bool {
+    let mut seen = std::collections::HashSet::new();
+    let mut stack: Vec<Id> = roots
+        .iter()
+        .copied()
+        .filter(|&r| g.depends_on(r, q))
+        .collect();
+    while let Some(id) = stack.pop() {
+        if !seen.insert(id) {
+            continue;
+        }
+        match g.node(id) {
+            Node::Select(c, _, _) if g.depends_on(*c, q) => return true,
+            Node::Fun(Func::Sign, a) if g.depends_on(*a, q) => return true,
+            node => stack.extend(node.children().into_iter().filter(|&c| g.depends_on(c, q))),
+        }
+    }
+    false
+}
+
 /// Whether the values of `tape` stay the same (to 1e-9 of 1 + the larger magnitude) when the
 /// symbol `q` alone changes, at three pseudo-random points and two shifts.
 /// Any evaluation failure counts as a dependence.
+/// Piecewise laws can fool it: see [`switches_on`].
 pub fn numerically_independent(g: &Graph, tape: &Tape, q: Symbol) -> bool {
     for trial in 0..3u64 {
         let base = |s: Symbol| Some(pseudo_value(g, s, trial));
@@ -143,6 +169,19 @@ pub fn numerically_independent(g: &Graph, tape: &Tape, q: Symbol) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_one_sided_law_is_not_taken_for_independent() {
+        let mut g = Graph::new();
+        let e = g.parse("select(-x, -k*x, 0) + y").unwrap();
+        let x = g.symbol_named("x").unwrap();
+        let y = g.symbol_named("y").unwrap();
+        assert!(switches_on(&g, &[e], x));
+        assert!(!switches_on(&g, &[e], y));
+        let s = g.parse("z*sign(w)").unwrap();
+        let w = g.symbol_named("w").unwrap();
+        assert!(switches_on(&g, &[s], w));
+    }
 
     #[test]
     fn same_function_sees_identities_the_expansion_does_not() {

@@ -136,7 +136,11 @@ fn fix_independent_coordinates(
     let independent: Vec<Symbol> = coords
         .iter()
         .map(|(_, c)| c.q)
-        .filter(|&q| deps.contains(q) && numerically_independent(g, &tape, q))
+        .filter(|&q| {
+            deps.contains(q)
+                && !crate::probe::switches_on(g, &core, q)
+                && numerically_independent(g, &tape, q)
+        })
         .collect();
     if independent.is_empty() {
         return Ok(());
