@@ -66,63 +66,62 @@ fn sweep<M: Model, const S: usize>(
                 });
             }
         };
-    for k in 3..=12 {
-        let tol = 10f64.powi(-k);
-        let (s, r) = timed(|| {
-            Dop853::new()
-                .rtol(tol)
-                .atol(tol * 1e-3)
-                .max_steps(2_000_000)
-                .solve_model(model, &[], 0.0, x0, t_end)
-                .map(|s| {
-                    (
-                        s.x.to_vec(),
-                        s.stats.rhs_calls as u64,
-                        (s.stats.accepted + s.stats.rejected) as u64,
-                    )
-                })
-        });
-        add(Method::Dop853(tol), s, r);
-    }
-    for k in 3..=11 {
-        let tol = 10f64.powi(-k);
-        let (s, r) = timed(|| {
-            Radau5::new()
-                .rtol(tol)
-                .atol(tol * 1e-3)
-                .max_steps(2_000_000)
-                .solve_model(model, &[], 0.0, x0, t_end)
-                .map(|s| {
-                    let st = s.stats;
-                    (
-                        s.x,
-                        (st.rhs_calls + st.jacobian_rhs_calls) as u64,
-                        (st.accepted + st.rejected) as u64,
-                    )
-                })
-        });
-        add(Method::Radau5(tol), s, r);
-    }
-    for k in 3..=8 {
-        let tol = 10f64.powi(-k);
-        let (s, r) = timed(|| {
-            TrBdf2::new()
-                .rtol(tol)
-                .atol(tol * 1e-3)
-                .max_steps(2_000_000)
-                .solve_model(model, &[], 0.0, x0, t_end)
-                .map(|s| {
-                    let st = s.stats;
-                    (
-                        s.x,
-                        (st.rhs_calls + st.jacobian_rhs_calls) as u64,
-                        (st.accepted + st.rejected) as u64,
-                    )
-                })
-        });
-        add(Method::TrBdf2(tol), s, r);
+    let methods = (3..=12)
+        .map(|k| Method::Dop853(10f64.powi(-k)))
+        .chain((3..=11).map(|k| Method::Radau5(10f64.powi(-k))))
+        .chain((3..=8).map(|k| Method::TrBdf2(10f64.powi(-k))));
+    for method in methods {
+        let (s, r) = timed(|| integrate(model, method, x0, t_end));
+        add(method, s, r);
     }
     points
+}
+
+/// One run of `method` at its tolerance (absolute = relative × 1e-3): the
+/// final state, the rhs calls (with the Jacobians') and the steps.
+fn integrate<M: Model, const S: usize>(
+    model: &M,
+    method: Method,
+    x0: &[f64; S],
+    t_end: f64,
+) -> Result<(Vec<f64>, u64, u64), IntegrateError> {
+    let tol = method.setting();
+    let max_steps = 2_000_000;
+    match method {
+        Method::Dop853(_) => Dop853::new()
+            .rtol(tol)
+            .atol(tol * 1e-3)
+            .max_steps(max_steps)
+            .solve_model(model, &[], 0.0, x0, t_end)
+            .map(|s| {
+                let st = s.stats;
+                (
+                    s.x.to_vec(),
+                    st.rhs_calls as u64,
+                    (st.accepted + st.rejected) as u64,
+                )
+            }),
+        Method::Radau5(_) => Radau5::new()
+            .rtol(tol)
+            .atol(tol * 1e-3)
+            .max_steps(max_steps)
+            .solve_model(model, &[], 0.0, x0, t_end)
+            .map(|s| {
+                let st = s.stats;
+                let calls = st.rhs_calls + st.jacobian_rhs_calls;
+                (s.x, calls as u64, (st.accepted + st.rejected) as u64)
+            }),
+        _ => TrBdf2::new()
+            .rtol(tol)
+            .atol(tol * 1e-3)
+            .max_steps(max_steps)
+            .solve_model(model, &[], 0.0, x0, t_end)
+            .map(|s| {
+                let st = s.stats;
+                let calls = st.rhs_calls + st.jacobian_rhs_calls;
+                (s.x, calls as u64, (st.accepted + st.rejected) as u64)
+            }),
+    }
 }
 
 /// The fastest run of `method` that reached `target` relative error.
