@@ -256,15 +256,34 @@ fn integrate<R: DynRhs + ?Sized, const S: usize>(
                 (stats.accepted + stats.rejected) as u64,
             ))
         }
-        Method::TrBdf2(tol) => {
+        Method::TrBdf2(tol) | Method::Radau5(tol) => {
             let mut out: Vec<(f64, Vec<f64>)> = (1..=checkpoints)
                 .map(|k| (t_end * k as f64 / checkpoints as f64, Vec::new()))
                 .collect();
-            let sol = TrBdf2::new()
-                .rtol(tol)
-                .atol(tol * 1e-2)
-                .max_steps(10_000_000)
-                .solve_prepared_at(rhs, 0.0, &pb.x0, &mut out, inputs)?;
+            // (rhs calls with the Jacobians', steps)
+            let (calls, steps) = if let Method::TrBdf2(_) = method {
+                let st = TrBdf2::new()
+                    .rtol(tol)
+                    .atol(tol * 1e-2)
+                    .max_steps(10_000_000)
+                    .solve_prepared_at(rhs, inputs, 0.0, &pb.x0, &mut out)?
+                    .stats;
+                (
+                    st.rhs_calls + st.jacobian_rhs_calls,
+                    st.accepted + st.rejected,
+                )
+            } else {
+                let st = Radau5::new()
+                    .rtol(tol)
+                    .atol(tol * 1e-2)
+                    .max_steps(10_000_000)
+                    .solve_prepared_at(rhs, inputs, 0.0, &pb.x0, &mut out)?
+                    .stats;
+                (
+                    st.rhs_calls + st.jacobian_rhs_calls,
+                    st.accepted + st.rejected,
+                )
+            };
             let states = out
                 .iter()
                 .map(|(_, x)| {
@@ -273,34 +292,7 @@ fn integrate<R: DynRhs + ?Sized, const S: usize>(
                     state
                 })
                 .collect();
-            Ok((
-                states,
-                (sol.stats.rhs_calls + sol.stats.jacobian_rhs_calls) as u64,
-                (sol.stats.accepted + sol.stats.rejected) as u64,
-            ))
-        }
-        Method::Radau5(tol) => {
-            let mut out: Vec<(f64, Vec<f64>)> = (1..=checkpoints)
-                .map(|k| (t_end * k as f64 / checkpoints as f64, Vec::new()))
-                .collect();
-            let sol = Radau5::new()
-                .rtol(tol)
-                .atol(tol * 1e-2)
-                .max_steps(10_000_000)
-                .solve_prepared_at(rhs, inputs, 0.0, &pb.x0, &mut out)?;
-            let states = out
-                .iter()
-                .map(|(_, x)| {
-                    let mut state = [0.0; S];
-                    state.copy_from_slice(x);
-                    state
-                })
-                .collect();
-            Ok((
-                states,
-                (sol.stats.rhs_calls + sol.stats.jacobian_rhs_calls) as u64,
-                (sol.stats.accepted + sol.stats.rejected) as u64,
-            ))
+            Ok((states, calls as u64, steps as u64))
         }
         Method::Rk4(n) | Method::Heun(n) | Method::Midpoint(n) => {
             // Round the step count up to a multiple of the checkpoints.

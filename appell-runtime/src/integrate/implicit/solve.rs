@@ -458,10 +458,10 @@ impl TrBdf2 {
     pub(crate) fn solve_prepared_at<R: DynRhs + ?Sized>(
         &self,
         rhs: &R,
+        inputs: &[f64],
         t0: f64,
         x0: &[f64],
         out: &mut [(f64, Vec<f64>)],
-        inputs: &[f64],
     ) -> Result<TrBdf2Solution, IntegrateError> {
         let t_end = out.last().map_or(t0, |o| o.0);
         self.run_prepared(rhs, t0, x0, t_end, inputs, out, None, None)
