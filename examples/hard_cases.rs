@@ -38,6 +38,7 @@ fn main() -> ExitCode {
     rows.extend(cases::mass_ratio_chain());
     rows.extend(cases::bad_states());
     rows.extend(cases::andrews_squeezer());
+    rows.extend(cases::andrews_gamma_dead_centres(1e3, 1e-5));
     rows.extend(precision::round_off_all(10_000));
     rows.extend(precision::double_pendulum_chaos(1000.0));
     println!("| case | criterion | measured | result |");

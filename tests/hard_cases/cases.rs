@@ -1334,3 +1334,149 @@ pub fn andrews_squeezer() -> Vec<CaseResult> {
     }
     rows
 }
+
+andrews_squeezer::squeezer! {
+    /// The squeezer with γ's rate privileged instead of β's: the dependent
+    /// block of the first loop, in (β, Θ), has determinant −rr d sin Θ, so
+    /// D′ is singular whenever the crank and body 2 are in line.
+    AndrewsSqueezerGamma, speed = gamma
+}
+
+/// The times in `(t0, t1)` where Θ (the state's second entry) crosses a
+/// multiple of π, on the squeezer's β-privileged motion from `(t0, x0)`:
+/// sampled every 1e-5 s, then each bracket bisected to 1e-12 s.
+fn andrews_dead_centres(p: &AndrewsSqueezer, t0: f64, x0: &[f64; 8], t1: f64) -> Vec<f64> {
+    let solver = Dop853::new().rtol(1e-12).atol(1e-15);
+    let steps = ((t1 - t0) / 1e-5).round() as usize;
+    let mut out: Vec<(f64, [f64; 8])> = (1..=steps)
+        .map(|k| (t0 + (t1 - t0) * k as f64 / steps as f64, [0.0; 8]))
+        .collect();
+    solver
+        .solve_model_at(p, &[], t0, x0, &mut out)
+        .expect("the β-privileged squeezer integrates");
+    let side = |x: &[f64; 8]| (x[1] / std::f64::consts::PI).floor();
+    let mut crossings = Vec::new();
+    let mut last = (t0, *x0);
+    for &(t, x) in &out {
+        if side(&x) != side(&last.1) {
+            let (mut a, mut b) = (last.0, t);
+            while b - a > 1e-12 {
+                let mid = 0.5 * (a + b);
+                let at = solver.solve_model(p, &[], last.0, &last.1, mid).unwrap();
+                if side(&at.x) == side(&last.1) {
+                    a = mid;
+                } else {
+                    b = mid;
+                }
+            }
+            crossings.push(0.5 * (a + b));
+        }
+        last = (t, x);
+    }
+    crossings
+}
+
+/// Andrews' squeezer with γ's rate privileged: its dependent block is
+/// singular at t = 0 (Θ = 0), where the rhs says so with a typed error,
+/// and at the five times in (0, 0.03 s) where Θ passes a multiple of π.
+/// There γ̇ does not determine the other rates, so these equations cannot
+/// be continued through a dead centre. For each of the five: start from
+/// the β-privileged motion halfway to it (Θ an odd multiple of −π/2),
+/// integrate towards it with DOP853 (`h_max` bounded) and a
+/// [`ConditionWatch`](appell::conditioning::ConditionWatch), and require
+/// a warning before the dead centre and before any error of the rhs or
+/// the integrator; in stop mode, the run ends at the warning with a typed
+/// error.
+pub fn andrews_gamma_dead_centres(threshold: f64, h_max: f64) -> Vec<CaseResult> {
+    use appell::conditioning::ConditionWatch;
+    use appell::integrate::IntegrateError;
+    use std::f64::consts::PI;
+    let (p, pg) = (AndrewsSqueezer::default(), AndrewsSqueezerGamma::default());
+    let reference = andrews_reference();
+    let mut rows = Vec::new();
+    let mut x0 = [0.0; 8];
+    for (k, row) in reference.iter().enumerate() {
+        x0[k] = row[0];
+    }
+    let mut dx = [0.0; 8];
+    let at_start = pg.rhs(&pg.prepare::<f64>(), 0.0, &x0, &[], &mut dx);
+    rows.push(result(
+        "Andrews' squeezer, γ privileged, at t = 0 (Θ = 0)",
+        "the rhs reports the singular dependent block as a typed error",
+        format!("{at_start:?}"),
+        matches!(
+            at_start,
+            Err(appell::ModelError::SingularConstraints { .. })
+        ),
+    ));
+    let crossings: Vec<f64> = andrews_dead_centres(&p, 0.0, &x0, 0.03)
+        .into_iter()
+        .filter(|&t| t > 1e-6)
+        .collect();
+    let fine = Dop853::new().rtol(1e-12).atol(1e-15);
+    let solver = Dop853::new().rtol(1e-10).atol(1e-13).h_max(Some(h_max));
+    let mut start = (0.0, x0);
+    let mut each = crossings.len() == 5;
+    let mut log = Vec::new();
+    let mut stopped = None;
+    for (k, &dead) in crossings.iter().enumerate() {
+        let level = (k as f64 + 0.5) * PI;
+        let g = |_: f64, x: &[f64; 8]| x[1] + level;
+        let half = fine
+            .solve_model_until(&p, &[], g, start.0, &start.1, 0.03)
+            .expect("Θ passes the odd multiple of −π/2");
+        // The same state in γ's rate.
+        let mut qdot = [0.0; 7];
+        p.coordinate_rates(half.t, &half.x[..7], &half.x[7..], &mut qdot)
+            .unwrap();
+        let mut xs = half.x;
+        xs[7] = qdot[2];
+        let end = (2.0 * dead - half.t).min(0.03);
+        let watched = |stop: bool| {
+            let mut watch = ConditionWatch::new(&pg, threshold);
+            if stop {
+                watch = watch.stop_past_threshold();
+            }
+            let run = solver.solve_model_projected(
+                &pg,
+                &[],
+                &mut |t, x: &mut [f64; 8]| watch.check(t, x),
+                half.t,
+                &xs,
+                end,
+            );
+            (run, watch.warnings)
+        };
+        let (run, warnings) = watched(false);
+        let first = warnings.first().copied();
+        each &= first.is_some_and(|(t, _)| t > half.t && t < dead);
+        log.push(format!(
+            "#{}: dead centre {dead:.6} s, warned {}, then {}",
+            k + 1,
+            first.map_or("never".into(), |(t, kappa)| format!(
+                "{:.1e} s before (κ = {kappa:.1e})",
+                dead - t
+            )),
+            match &run {
+                Ok(s) => format!("reached {:.6} s", s.t),
+                Err(e) => format!("{e}"),
+            }
+        ));
+        if k == 0 {
+            let (run, _) = watched(true);
+            stopped = Some(
+                matches!(run, Err(IntegrateError::Projection { t, reason }) if reason.contains("condition") && first.is_some_and(|w| w.0 == t)),
+            );
+        }
+        start = (half.t, half.x);
+    }
+    rows.push(result(
+        &format!(
+            "Andrews' squeezer, γ privileged, DOP853 rtol 1e-10, h_max = {h_max:.0e} s, warning past κ = {threshold:.0e}"
+        ),
+        "started halfway to each of the five dead centres Θ = kπ in (0, 0.03 s), the watch warns before it; stop mode ends the first run at the warning",
+        format!("{}; stop mode: {stopped:?}", log.join("; ")),
+        each && stopped == Some(true),
+    ));
+    rows
+}

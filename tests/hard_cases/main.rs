@@ -128,3 +128,8 @@ fn the_condition_watch_warns_before_the_four_bars_dead_centre() {
 fn andrews_squeezer_matches_the_ivp_test_set() {
     check(cases::andrews_squeezer());
 }
+
+#[test]
+fn the_condition_watch_warns_before_each_of_the_squeezers_dead_centres() {
+    check(cases::andrews_gamma_dead_centres(1e3, 1e-5));
+}
