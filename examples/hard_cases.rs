@@ -38,7 +38,9 @@ fn main() -> ExitCode {
     rows.extend(cases::mass_ratio_chain());
     rows.extend(cases::bad_states());
     rows.extend(cases::andrews_squeezer());
-    rows.extend(cases::andrews_gamma_dead_centres(1e3, 1e-5));
+    rows.extend(cases::andrews_gamma_dead_centres(1e3, 1e-5, false));
+    rows.extend(cases::andrews_gamma_dead_centres(1e3, 1e-5, true));
+    rows.extend(cases::pivot_estimate_against_svd(4.0));
     rows.extend(precision::round_off_all(10_000));
     rows.extend(precision::double_pendulum_chaos(1000.0));
     println!("| case | criterion | measured | result |");

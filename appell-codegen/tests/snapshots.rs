@@ -6,7 +6,8 @@
 //! The models are found, not listed: every struct deriving `Appell` in the
 //! workspace's examples, tests (UI cases included, whose expansion is the
 //! error) and benches. A struct written inside a `macro_rules!` body (the
-//! gyroscopes of `tests/composite_bodies.rs`) is not seen.
+//! gyroscopes of `tests/composite_bodies.rs`, Andrews' squeezer, declared
+//! once for each privileged speed) is not seen.
 //!
 //! The expansion is compared as formatted Rust (see [`expansion_text`]),
 //! with the workspace's directory written `$WORKSPACE` (a URDF model

@@ -411,6 +411,14 @@ pub trait DynModel: sealed::Sealed {
         d0: &mut [f64],
     ) -> Result<(), ModelError>;
 
+    /// [`Model::dependent_block_margin`].
+    fn dyn_dependent_block_margin(
+        &self,
+        t: f64,
+        q: &[f64],
+        inputs: &[f64],
+    ) -> Result<f64, ModelError>;
+
     /// [`Model::driven_constraint_rows`] in [`Dual64`].
     fn dyn_driven_constraint_rows_dual(
         &self,
@@ -681,6 +689,15 @@ impl<M: Model> DynModel for M {
         d0: &mut [Dual64],
     ) -> Result<(), ModelError> {
         self.driven_constraint_rows(t, q, inputs, d, d0)
+    }
+
+    fn dyn_dependent_block_margin(
+        &self,
+        t: f64,
+        q: &[f64],
+        inputs: &[f64],
+    ) -> Result<f64, ModelError> {
+        self.dependent_block_margin(t, q, inputs)
     }
 
     fn dyn_driven_coordinate_rates(

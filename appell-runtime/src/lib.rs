@@ -79,6 +79,7 @@ pub use num_dual;
 pub mod __private {
     pub use crate::linalg::{
         check_pivot, constraint_scale, ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs,
+        pivot_margin,
     };
     pub use crate::model::check_len;
     pub use crate::{

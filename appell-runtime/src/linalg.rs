@@ -198,6 +198,64 @@ pub fn lu_factor<T: Scalar, const N: usize>(
     Ok(swaps)
 }
 
+/// The smallest pivot of `a`'s LU factorization with partial pivoting,
+/// relative to the largest magnitude among its entries: 1 for a multiple
+/// of the identity, 0 for a matrix that is singular to working precision.
+/// Its reciprocal is a cheap estimate of `a`'s condition number, in the
+/// units in which [`lu_factor`] and [`check_pivot`] judge the dependent
+/// block: they report [`ModelError::SingularConstraints`] where it falls
+/// to 1e-12 (for the block alone; their scale may also include the right
+/// side's). It costs one factorization of `a`'s real parts, N³/3
+/// multiplications. A NaN or infinite entry is
+/// [`ModelError::NonFinite`].
+///
+/// ```
+/// use appell_runtime::linalg::pivot_margin;
+/// assert_eq!(pivot_margin(&[[2.0, 0.0], [0.0, 2.0]]).unwrap(), 1.0);
+/// // A four-bar-like block near a dead centre: 1/margin grows as 1/ε.
+/// let eps = 1e-6;
+/// let m = pivot_margin(&[[1.0, 1.0], [1.0, 1.0 + eps]]).unwrap();
+/// assert!((m / eps - 1.0).abs() < 1e-6);
+/// assert_eq!(pivot_margin(&[[1.0, 2.0], [2.0, 4.0]]).unwrap(), 0.0);
+/// assert!(pivot_margin(&[[f64::NAN, 0.0], [0.0, 1.0]]).is_err());
+/// ```
+pub fn pivot_margin<T: Scalar, const N: usize>(a: &[[T; N]; N]) -> Result<f64, ModelError> {
+    let mut u = [[0.0f64; N]; N];
+    for (row, out) in a.iter().zip(u.iter_mut()) {
+        for (x, o) in row.iter().zip(out.iter_mut()) {
+            *o = x.re();
+        }
+    }
+    if u.iter().flatten().any(|x| !x.is_finite()) {
+        return Err(ModelError::NonFinite {
+            what: "the dependent constraint block",
+        });
+    }
+    let scale = u.iter().flatten().fold(0.0f64, |m, x| m.max(x.abs()));
+    if scale == 0.0 {
+        return Ok(if N == 0 { 1.0 } else { 0.0 });
+    }
+    let mut smallest = f64::INFINITY;
+    for col in 0..N {
+        let p = (col..N)
+            .max_by(|&i, &j| u[i][col].abs().total_cmp(&u[j][col].abs()))
+            .unwrap_or(col);
+        u.swap(col, p);
+        let pivot = u[col][col];
+        smallest = smallest.min(pivot.abs());
+        if pivot == 0.0 {
+            break;
+        }
+        for r in col + 1..N {
+            let f = u[r][col] / pivot;
+            for j in col + 1..N {
+                u[r][j] -= f * u[col][j];
+            }
+        }
+    }
+    Ok((smallest / scale).min(1.0))
+}
+
 /// Exchanges rows `i` and `p ≥ i` of `a`. Written with constant indices
 /// (one test per candidate row), so that after unrolling a small matrix
 /// stays in registers instead of being indexed in memory.

@@ -577,6 +577,71 @@ pub trait Model {
         self.coordinate_rates(t, q, u, qdot)
     }
 
+    /// How far the dependent block D′ (the constraint rows' columns of the
+    /// [`ModelInfo::dependent`] coordinates) is from singular at `(q, t)`
+    /// and `inputs` (read only by models whose constraints read inputs):
+    /// [`pivot_margin`](crate::linalg::pivot_margin) of D′, the smallest
+    /// LU pivot relative to the largest entry, whose reciprocal estimates
+    /// κ(D′). The generated rhs reports
+    /// [`ModelError::SingularConstraints`] where this falls to about
+    /// 1e-12. Generated without allocation and in `no_std`; it evaluates
+    /// D′ and factors it once, about the cost of an rhs call.
+    /// [`crate::conditioning::ConditionWatch`] uses it with
+    /// [`crate::conditioning::ConditionWatch::from_pivots`].
+    ///
+    /// The default returns 1 for a model without dependent rates and
+    /// [`ModelError::NotGenerated`] for any other.
+    ///
+    /// ```
+    /// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+    /// # struct Free;
+    /// # static INFO: ModelInfo = ModelInfo {
+    /// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
+    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
+    /// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
+    /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+    /// # };
+    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NotGenerated { function: "test" }) }
+    /// # impl Model for Free {
+    /// #     type Prepared<T: Scalar> = ();
+    /// #     fn info() -> &'static ModelInfo { &INFO }
+    /// #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+    /// #     fn prepare<T: Scalar>(&self) {}
+    /// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+    /// # }
+    /// // A model without constraints is as far from singular as can be.
+    /// assert_eq!(Free.dependent_block_margin(0.0, &[0.0], &[]), Ok(1.0));
+    /// ```
+    fn dependent_block_margin<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        inputs: &[T],
+    ) -> Result<f64, ModelError> {
+        let _ = (t, inputs);
+        let info = Self::info();
+        check_len("q", q, info.coordinates.len())?;
+        if info.dependent.is_empty() {
+            Ok(1.0)
+        } else {
+            Err(ModelError::NotGenerated {
+                function: "dependent_block_margin",
+            })
+        }
+    }
+
     /// Load geometry at `(q, t)`: the position of every force's application
     /// point and the rotation matrix of every torque's frame.
     fn load_geometry<T: Scalar>(

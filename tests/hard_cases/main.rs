@@ -131,5 +131,11 @@ fn andrews_squeezer_matches_the_ivp_test_set() {
 
 #[test]
 fn the_condition_watch_warns_before_each_of_the_squeezers_dead_centres() {
-    check(cases::andrews_gamma_dead_centres(1e3, 1e-5));
+    check(cases::andrews_gamma_dead_centres(1e3, 1e-5, false));
+    check(cases::andrews_gamma_dead_centres(1e3, 1e-5, true));
+}
+
+#[test]
+fn the_pivot_estimate_of_the_condition_follows_the_svd() {
+    check(cases::pivot_estimate_against_svd(4.0));
 }

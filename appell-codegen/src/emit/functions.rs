@@ -13,6 +13,7 @@ use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use super::code::{braced, code, Code, Target};
+use super::solve::matrix;
 use super::{int, p, Emitter};
 use crate::derivation::RowSource;
 
@@ -378,7 +379,9 @@ impl Emitter<'_> {
                 }
             }
         };
+        let margin_fn = self.dependent_block_margin(c);
         quote! {
+            #margin_fn
             fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
                 #(#checks_mp)* #params_f #mp_body #(#mp_out)*
                 #p::Ok(())
@@ -388,6 +391,46 @@ impl Emitter<'_> {
                 #p::Ok(())
             }
             #rows_fn
+        }
+    }
+
+    /// `dependent_block_margin`: D′, the constraint rows' columns of the
+    /// dependent coordinates, and its pivot margin. Nothing for a model
+    /// without dependent rates (the trait's default serves it).
+    fn dependent_block_margin(&self, c: &Common) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let (n, m) = (d.n, d.m);
+        let dependent = &d.speeds.dependent;
+        if m == 0 || dependent.len() != m {
+            return TokenStream::new();
+        }
+        let Common {
+            params_t, bind_q, ..
+        } = c;
+        let mut roots = Vec::with_capacity(m * m);
+        for i in 0..m {
+            roots.extend(dependent.iter().map(|&col| d.constraints.d[i * n + col]));
+        }
+        let mut block = code(&self.model.g, &roots, Target::Generic { hoist: false });
+        let rows = matrix(&block.outputs, 0, m, m);
+        let body = block.take_statements();
+        let mi = int(m);
+        let chk_q = self.check("__q", n);
+        let (chk_inputs, bind_inputs) = if self.model.input_rates.is_empty() {
+            (TokenStream::new(), TokenStream::new())
+        } else {
+            (
+                self.check("__inputs", self.inputs().len()),
+                self.bind_inputs("__inputs"),
+            )
+        };
+        quote! {
+            fn dependent_block_margin<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __inputs: &[__T]) -> #p::Result<f64, #p::ModelError> {
+                #chk_q #chk_inputs #params_t #bind_q #bind_inputs #body
+                let __block: [[__T; #mi]; #mi] = [#rows];
+                #p::pivot_margin(&__block)
+            }
         }
     }
 

@@ -24,7 +24,7 @@ use super::{int, p, Emitter};
 use crate::derivation::{singleton_rows, Elimination, NumericElimination, SingletonOrder};
 
 /// The m×w matrix of `outputs[offset..]`, row-major, as nested arrays.
-fn matrix(outputs: &[TokenStream], offset: usize, m: usize, w: usize) -> TokenStream {
+pub(super) fn matrix(outputs: &[TokenStream], offset: usize, m: usize, w: usize) -> TokenStream {
     let rows = (0..m).map(|i| {
         let row = &outputs[offset + i * w..offset + (i + 1) * w];
         quote!([#(#row),*])
