@@ -215,7 +215,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
 /// // A four-bar-like block near a dead centre: 1/margin grows as 1/ε.
 /// let eps = 1e-6;
 /// let m = pivot_margin(&[[1.0, 1.0], [1.0, 1.0 + eps]]).unwrap();
-/// assert!((m / eps - 1.0).abs() < 1e-6);
+/// assert!((m / eps - 1.0).abs() < 1e-4);
 /// assert_eq!(pivot_margin(&[[1.0, 2.0], [2.0, 4.0]]).unwrap(), 0.0);
 /// assert!(pivot_margin(&[[f64::NAN, 0.0], [0.0, 1.0]]).is_err());
 /// ```
