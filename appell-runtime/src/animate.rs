@@ -3,7 +3,8 @@
 //! geometry.
 //!
 //! [`simulate`] integrates every coordinate (cyclic ones included, with
-//! q̇ from [`Model::coordinate_rates`]) and returns evenly spaced
+//! q̇ from [`Model::driven_coordinate_rates`], so a driven coordinate moves
+//! at its commanded rate) and returns evenly spaced
 //! [`Frame`]s; [`svg`] draws them. Each rigid body is its equivalent
 //! inertia ellipsoid (the uniform solid ellipsoid with the body's mass and
 //! central inertia: a thin disc shows as a disc, a rod as a cigar) with a
@@ -178,7 +179,7 @@ impl<'m, K: DynModel + ?Sized> FullRates<'m, K> {
         self.rhs.rhs(t, &state, self.inputs, &mut dstate)?;
         let mut dx = vec![0.0; x.len()];
         self.model
-            .dyn_coordinate_rates(t, q, u, &mut dx[..self.n])?;
+            .dyn_driven_coordinate_rates(t, q, u, self.inputs, &mut dx[..self.n])?;
         dx[self.n..].copy_from_slice(&dstate[self.retained.len()..]);
         Ok(dx)
     }

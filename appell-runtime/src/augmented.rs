@@ -323,7 +323,7 @@ pub fn project<M: Model>(
     let zero_rates = vec![0.0; n];
     let holonomic = |q: &[f64]| -> Result<Vec<f64>, OracleError> {
         let (mut h, mut v) = (vec![0.0; mh], vec![0.0; m]);
-        model.constraint_residuals(t, q, &zero_rates, &mut h, &mut v)?;
+        model.driven_constraint_residuals(t, q, &zero_rates, inputs, &mut h, &mut v)?;
         Ok(h)
     };
     let worst = |v: &[f64]| v.iter().fold(0.0f64, |a, x| a.max(x.abs()));

@@ -439,6 +439,55 @@ pub trait DynModel: sealed::Sealed {
         qdot: &mut [f64],
     ) -> Result<(), ModelError>;
 
+    /// [`Model::driven_coordinate_rates`] in [`Dual64`].
+    fn dyn_driven_coordinate_rates_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        u: &[Dual64],
+        inputs: &[Dual64],
+        qdot: &mut [Dual64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::driven_speed_transform`].
+    fn dyn_driven_speed_transform(
+        &self,
+        t: f64,
+        q: &[f64],
+        inputs: &[f64],
+        c: &mut [f64],
+        c0: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::driven_constraint_residuals`].
+    fn dyn_driven_constraint_residuals(
+        &self,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+        inputs: &[f64],
+        holonomic: &mut [f64],
+        velocity: &mut [f64],
+    ) -> Result<(), ModelError>;
+
+    /// [`Model::driven_kinetic_energy`].
+    fn dyn_driven_kinetic_energy(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+    ) -> Result<f64, ModelError>;
+
+    /// [`Model::driven_kinetic_energy`] in [`Dual64`].
+    fn dyn_driven_kinetic_energy_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        u: &[Dual64],
+        inputs: &[Dual64],
+    ) -> Result<Dual64, ModelError>;
+
     /// [`Model::constraint_rows`] in [`Dual64`].
     fn dyn_constraint_rows_dual(
         &self,
@@ -709,6 +758,60 @@ impl<M: Model> DynModel for M {
         qdot: &mut [f64],
     ) -> Result<(), ModelError> {
         self.driven_coordinate_rates(t, q, u, inputs, qdot)
+    }
+
+    fn dyn_driven_coordinate_rates_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        u: &[Dual64],
+        inputs: &[Dual64],
+        qdot: &mut [Dual64],
+    ) -> Result<(), ModelError> {
+        self.driven_coordinate_rates(t, q, u, inputs, qdot)
+    }
+
+    fn dyn_driven_speed_transform(
+        &self,
+        t: f64,
+        q: &[f64],
+        inputs: &[f64],
+        c: &mut [f64],
+        c0: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.driven_speed_transform(t, q, inputs, c, c0)
+    }
+
+    fn dyn_driven_constraint_residuals(
+        &self,
+        t: f64,
+        q: &[f64],
+        qdot: &[f64],
+        inputs: &[f64],
+        holonomic: &mut [f64],
+        velocity: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.driven_constraint_residuals(t, q, qdot, inputs, holonomic, velocity)
+    }
+
+    fn dyn_driven_kinetic_energy(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+    ) -> Result<f64, ModelError> {
+        self.driven_kinetic_energy(t, q, u, inputs)
+    }
+
+    fn dyn_driven_kinetic_energy_dual(
+        &self,
+        t: Dual64,
+        q: &[Dual64],
+        u: &[Dual64],
+        inputs: &[Dual64],
+    ) -> Result<Dual64, ModelError> {
+        self.driven_kinetic_energy(t, q, u, inputs)
     }
 
     fn dyn_load_geometry(

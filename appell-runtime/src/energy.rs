@@ -8,10 +8,18 @@
 //! [`Model::input_power`]; the difference measures the power of every
 //! other load left out of V (friction, damping, a motor without an input),
 //! and on a scene it shows what the chosen effects put in.
+//!
+//! A model with driven coordinates (constraints that read inputs) has its
+//! kinetic energy from [`Model::driven_kinetic_energy`] at the inputs, and
+//! the commands change along the motion at their companion inputs (`x` at
+//! `x_rate`, `x_rate` at `x_accel`); the rate then also contains the power
+//! of the drives, each driving row's multiplier (the
+//! [`contact_forces`](crate::constraint_forces::contact_forces) output)
+//! times its coordinate's rate, which [`Model::input_power`] leaves out.
 
 use crate::dynamic::DynModel;
 use crate::model::{Model, ModelError};
-use crate::motion::first_rates;
+use crate::motion::{first_rates, seeded_inputs};
 use num_dual::Dual64;
 
 /// The energies at one state, from [`energies`].
@@ -114,7 +122,8 @@ pub(crate) fn energies_dyn<K: DynModel + ?Sized>(
         x.iter().zip(dx).map(|(&v, &d)| Dual64::new(v, d)).collect()
     };
     let (td, qd, ud) = (Dual64::new(t, 1.0), seeded(q, &qdot), seeded(u, &udot));
-    let kinetic = model.dyn_kinetic_energy_dual(td, &qd, &ud)?;
+    let id = seeded_inputs(model.dyn_info(), inputs);
+    let kinetic = model.dyn_driven_kinetic_energy_dual(td, &qd, &ud, &id)?;
     let potential = model.dyn_potential_energy_dual(td, &qd)?;
     let input_power = model.dyn_input_power(t, q, u, inputs)?;
     let e = Energies {

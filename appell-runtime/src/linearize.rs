@@ -8,7 +8,12 @@
 //! * [`solve_holonomic`]: Newton (Gauss-Newton when the counts differ) on the
 //!   holonomic residuals of [`Model::constraint_residuals`], to put a
 //!   configuration on the constraint manifold; [`holonomic_unknowns`] picks
-//!   the dependent coordinates the residuals involve.
+//!   the dependent coordinates the residuals involve; [`project_holonomic`]
+//!   and [`check_holonomic`] do it for a reduced state. A model with driven
+//!   coordinates (constraints that read inputs) takes the `driven_` forms
+//!   ([`driven_solve_holonomic`], [`driven_holonomic_unknowns`],
+//!   [`driven_project_holonomic`], [`driven_check_holonomic`]), which
+//!   evaluate the residuals at the inputs.
 //! * [`minimal_linearization`]: the linearization in a minimal state, with
 //!   the retained coordinates fixed by holonomic constraints eliminated and
 //!   the privileged speeds an operating point holds fixed dropped.
@@ -131,6 +136,9 @@ mod minimal;
 
 pub use eigen::eigenvalues;
 pub use error::LinearizeError;
-pub use holonomic::{check_holonomic, holonomic_unknowns, project_holonomic, solve_holonomic};
+pub use holonomic::{
+    check_holonomic, driven_check_holonomic, driven_holonomic_unknowns, driven_project_holonomic,
+    driven_solve_holonomic, holonomic_unknowns, project_holonomic, solve_holonomic,
+};
 pub use jacobian::{linearize, Linearization};
 pub use minimal::minimal_linearization;

@@ -642,6 +642,60 @@ pub trait Model {
         }
     }
 
+    /// [`Model::speed_transform`] at `inputs` too: C and c of q̇ = C ẏ + c
+    /// when the constraints read inputs (a driven coordinate's rate is
+    /// c's entry, the commanded rate). Generated for a driven model, whose
+    /// `speed_transform` returns [`ModelError::NeedsInputs`]; for every
+    /// other model it is `speed_transform` and ignores `inputs` (see
+    /// [`Model::driven_constraint_rows`]).
+    fn driven_speed_transform<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        inputs: &[T],
+        c: &mut [T],
+        c0: &mut [T],
+    ) -> Result<(), ModelError> {
+        let _ = inputs;
+        self.speed_transform(t, q, c, c0)
+    }
+
+    /// [`Model::constraint_residuals`] at `inputs` too: a driven
+    /// coordinate's holonomic residual is its distance from the command
+    /// (`theta − q_cmd` for `holonomic(theta == q_cmd)`) and its velocity
+    /// row's residual reads the commanded rate. Generated for a driven
+    /// model; for every other model it is `constraint_residuals` and
+    /// ignores `inputs` (see [`Model::driven_constraint_rows`]).
+    fn driven_constraint_residuals<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        qdot: &[T],
+        inputs: &[T],
+        holonomic: &mut [T],
+        velocity: &mut [T],
+    ) -> Result<(), ModelError> {
+        let _ = inputs;
+        self.constraint_residuals(t, q, qdot, holonomic, velocity)
+    }
+
+    /// [`Model::kinetic_energy`] at `inputs` too: the driven coordinates
+    /// move at the commanded rates, which the kinetic energy reads.
+    /// Generated for a driven model, whose `kinetic_energy` returns
+    /// [`ModelError::NeedsInputs`]; for every other model it is
+    /// `kinetic_energy` and ignores `inputs` (see
+    /// [`Model::driven_constraint_rows`]).
+    fn driven_kinetic_energy<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        u: &[T],
+        inputs: &[T],
+    ) -> Result<T, ModelError> {
+        let _ = inputs;
+        self.kinetic_energy(t, q, u)
+    }
+
     /// Load geometry at `(q, t)`: the position of every force's application
     /// point and the rotation matrix of every torque's frame.
     fn load_geometry<T: Scalar>(

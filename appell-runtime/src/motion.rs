@@ -1,13 +1,16 @@
 //! The motion at one instant: q̇, u̇ and q̈ of every coordinate, the
 //! dependent ones included.
 //!
-//! u̇ comes from [`Model::rhs`] and q̇ from [`Model::coordinate_rates`];
-//! q̈ is the exact time derivative of q̇ = C(q, t) u + c(q, t) along the
-//! motion (eq. 31 differentiated: C u̇ + Ċ u + ċ), from one evaluation of
-//! `coordinate_rates` in [`Dual64`] numbers seeded with ṫ = 1, q̇ and u̇.
+//! u̇ comes from [`Model::rhs`] and q̇ from [`Model::driven_coordinate_rates`]
+//! (which is [`Model::coordinate_rates`] unless the model has driven
+//! coordinates); q̈ is the exact time derivative of q̇ = C(q, t) u + c(q, t)
+//! along the motion (eq. 31 differentiated: C u̇ + Ċ u + ċ), from one
+//! evaluation of `driven_coordinate_rates` in [`Dual64`] numbers seeded with
+//! ṫ = 1, q̇, u̇ and, for the commands of driven coordinates, their
+//! companion inputs (`x` changes at `x_rate`, `x_rate` at `x_accel`).
 
 use crate::dynamic::DynModel;
-use crate::model::{check_len, Model, ModelError};
+use crate::model::{check_len, Model, ModelError, ModelInfo};
 use num_dual::Dual64;
 
 /// The rates of the motion at one state, from [`rates`].
@@ -94,8 +97,9 @@ pub fn rates<M: Model>(
         x.iter().zip(dx).map(|(&v, &d)| Dual64::new(v, d)).collect()
     };
     let (td, qd, ud) = (Dual64::new(t, 1.0), seeded(q, &qdot), seeded(u, &udot));
+    let id = seeded_inputs(M::info(), inputs);
     let mut rates = vec![Dual64::from(0.0); q.len()];
-    model.coordinate_rates(td, &qd, &ud, &mut rates)?;
+    model.driven_coordinate_rates(td, &qd, &ud, &id, &mut rates)?;
     let qddot: Vec<f64> = rates.iter().map(|r| r.eps).collect();
     if qddot.iter().all(|x| x.is_finite()) {
         Ok(Rates { qdot, udot, qddot })
@@ -136,6 +140,31 @@ pub(crate) fn first_rates<K: DynModel + ?Sized>(
     model.dyn_rhs(t, &state, inputs, &mut dstate)?;
     let udot = dstate[info.retained.len()..].to_vec();
     let mut qdot = vec![0.0; q.len()];
-    model.dyn_coordinate_rates(t, q, u, &mut qdot)?;
+    model.dyn_driven_coordinate_rates(t, q, u, inputs, &mut qdot)?;
     Ok((qdot, udot))
+}
+
+/// The inputs as [`Dual64`] numbers seeded with their time derivatives
+/// where the model knows them: a driven coordinate's command `x` changes
+/// at its companion input `x_rate`, and `x_rate` at `x_accel` (when the
+/// model has it, for a holonomic drive). Every other input is held (its
+/// derivative is 0), as the integrators hold it.
+pub(crate) fn seeded_inputs(info: &ModelInfo, inputs: &[f64]) -> Vec<Dual64> {
+    let value = |name: &str| {
+        info.inputs
+            .iter()
+            .position(|i| *i == name)
+            .and_then(|k| inputs.get(k).copied())
+    };
+    info.inputs
+        .iter()
+        .zip(inputs)
+        .map(|(name, &v)| {
+            let rate = value(&format!("{name}_rate")).or_else(|| {
+                name.strip_suffix("_rate")
+                    .and_then(|base| value(&format!("{base}_accel")))
+            });
+            Dual64::new(v, rate.unwrap_or(0.0))
+        })
+        .collect()
 }

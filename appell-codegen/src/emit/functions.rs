@@ -154,7 +154,6 @@ impl Emitter<'_> {
             bind_qdot,
             bind_u,
             bind_inputs,
-            solve_x_and_w,
             solve_x,
             ..
         } = c;
@@ -205,76 +204,17 @@ impl Emitter<'_> {
                 ])
             }
         };
-        let checks_mf = [chk("__m", l * l), chk("__f", l)];
-        let mf_fn = match (&d.structured, d.closed_form) {
-            (Ok(s), false) => self.structured_mass_and_forcing(c, s),
-            _ => {
-                let mut mf_roots = d.equations.mass.clone();
-                mf_roots.extend(&d.equations.forcing);
-                let mut mf = code(&self.model.g, &mf_roots, generic);
-                let (mf_m, mf_f) = (
-                    outputs_into(&mf, "__m", 0..l * l),
-                    outputs_into(&mf, "__f", l * l..l * l + l),
-                );
-                braced([
-                    quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #solve_x_and_w),
-                    mf.take_statements(),
-                    quote!(#mf_m #mf_f #p::Ok(())),
-                ])
-            }
-        };
+        let mf_fn = self.mass_and_forcing_fn(c);
         let checks_ct = [chk("__c", n * l), chk("__c0", n)];
         let chk_qdot = chk("__qdot", n);
         let checks_res = [chk("__holonomic", nh), chk("__velocity", m)];
         let checks_sd = [chk("__w", l * n), chk("__w0", l)];
-        if !self.model.input_rates.is_empty() {
-            // Driven coordinates: C, c, q̇, the residuals and T read the
-            // inputs; only the `driven_` forms take them.
-            let needs = |f: &str| quote!({ #p::Err(#p::ModelError::NeedsInputs { function: #f }) });
-            let (ns, nc, nr, nk) = (
-                needs("speed_transform"),
-                needs("coordinate_rates"),
-                needs("constraint_residuals"),
-                needs("kinetic_energy"),
-            );
-            return quote! {
-                fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
-                fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> #ns
-                fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> #nc
-                fn driven_coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                    #chk_q #chk_u #chk_inputs #chk_qdot #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #cr_body #cr_out
-                    #p::Ok(())
-                }
-                fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> #nr
-                fn speed_definitions<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                    #chk_q #(#checks_sd)* #params_t #bind_q #sd_body #sd_w #sd_w0
-                    #p::Ok(())
-                }
-                fn input_power<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
-                    #chk_q #chk_u #chk_inputs #params_t #bind_q #bind_u #bind_inputs #solve_x #ip_body
-                    #p::Ok(#ip_out)
-                }
-                fn potential_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T]) -> #p::Result<__T, #p::ModelError> {
-                    #chk_q #params_t #bind_q #pe_body
-                    #p::Ok(#pe_out)
-                }
-                fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #nk
-            };
-        }
-        quote! {
+        let mf_item = quote! {
             fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
-            fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_ct)* #pos #params_t #bind_q #solve_x #ct_body #ct_c #ct_c0
-                #p::Ok(())
-            }
-            fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #solve_x #cr_body #cr_out
-                #p::Ok(())
-            }
-            fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #chk_qdot #(#checks_res)* #params_t #bind_q #bind_qdot #res_body #res_h #res_v
-                #p::Ok(())
-            }
+        };
+        // W and w, the input power and V: the same whether or not the
+        // constraints read inputs.
+        let sd_ip_pe = quote! {
             fn speed_definitions<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
                 #chk_q #(#checks_sd)* #params_t #bind_q #sd_body #sd_w #sd_w0
                 #p::Ok(())
@@ -287,8 +227,97 @@ impl Emitter<'_> {
                 #chk_q #params_t #bind_q #pe_body
                 #p::Ok(#pe_out)
             }
+        };
+        if !self.model.input_rates.is_empty() {
+            // Driven coordinates: C, c, q̇, the residuals and T read the
+            // inputs; only the `driven_` forms take them. T is always the
+            // symbolic one: ½ uᵀ M u leaves out the commanded rates.
+            let (ke_body, ke_out) = single(d.energies.kinetic);
+            let needs = |f: &str| quote!({ #p::Err(#p::ModelError::NeedsInputs { function: #f }) });
+            let (ns, nc, nr, nk) = (
+                needs("speed_transform"),
+                needs("coordinate_rates"),
+                needs("constraint_residuals"),
+                needs("kinetic_energy"),
+            );
+            return quote! {
+                #mf_item
+                fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> #ns
+                fn driven_speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __inputs: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #chk_inputs #(#checks_ct)* #pos #params_t #bind_q #bind_inputs #solve_x #ct_body #ct_c #ct_c0
+                    #p::Ok(())
+                }
+                fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> #nc
+                fn driven_coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #chk_u #chk_inputs #chk_qdot #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #cr_body #cr_out
+                    #p::Ok(())
+                }
+                fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> #nr
+                fn driven_constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __inputs: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                    #chk_q #chk_qdot #chk_inputs #(#checks_res)* #params_t #bind_q #bind_qdot #bind_inputs #res_body #res_h #res_v
+                    #p::Ok(())
+                }
+                #sd_ip_pe
+                fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #nk
+                fn driven_kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                    #chk_q #chk_u #chk_inputs #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #ke_body
+                    #p::Ok(#ke_out)
+                }
+            };
+        }
+        quote! {
+            #mf_item
+            fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_ct)* #pos #params_t #bind_q #solve_x #ct_body #ct_c #ct_c0
+                #p::Ok(())
+            }
+            fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #solve_x #cr_body #cr_out
+                #p::Ok(())
+            }
+            fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_qdot #(#checks_res)* #params_t #bind_q #bind_qdot #res_body #res_h #res_v
+                #p::Ok(())
+            }
+            #sd_ip_pe
             fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #ke_fn
         }
+    }
+
+    /// The body of `mass_matrix_and_forcing`: the structured form's, or M
+    /// and f of the closed form.
+    fn mass_and_forcing_fn(&self, c: &Common) -> proc_macro2::Group {
+        let p = p();
+        let d = self.d;
+        let (n, l) = (d.n, d.l);
+        if let (Ok(s), false) = (&d.structured, d.closed_form) {
+            return self.structured_mass_and_forcing(c, s);
+        }
+        let Common {
+            params_t,
+            positivity: pos,
+            bind_q,
+            bind_u,
+            bind_inputs,
+            solve_x_and_w,
+            ..
+        } = c;
+        let chk = |arg: &str, len: usize| self.check(arg, len);
+        let (chk_q, chk_u) = (chk("__q", n), chk("__u", l));
+        let chk_inputs = chk("__inputs", self.inputs().len());
+        let checks_mf = [chk("__m", l * l), chk("__f", l)];
+        let mut mf_roots = d.equations.mass.clone();
+        mf_roots.extend(&d.equations.forcing);
+        let mut mf = code(&self.model.g, &mf_roots, Target::Generic { hoist: false });
+        let (mf_m, mf_f) = (
+            outputs_into(&mf, "__m", 0..l * l),
+            outputs_into(&mf, "__f", l * l..l * l + l),
+        );
+        braced([
+            quote!(#chk_q #chk_u #chk_inputs #(#checks_mf)* #pos #params_t #bind_q #bind_u #bind_inputs #solve_x_and_w),
+            mf.take_statements(),
+            quote!(#mf_m #mf_f #p::Ok(())),
+        ])
     }
 
     /// The bodies' description: mass properties, body poses and the

@@ -182,7 +182,7 @@ impl EvalState {
         .map_err(|e| e.to_string())?;
         let mut qdot = vec![0.0; info.coordinates.len()];
         model
-            .dyn_coordinate_rates(t, &q, &u, &mut qdot)
+            .dyn_driven_coordinate_rates(t, &q, &u, &inputs, &mut qdot)
             .map_err(|e| e.to_string())?;
 
         let mut qdot_out = Map::new();
@@ -197,7 +197,7 @@ impl EvalState {
         let mut answer = Map::new();
         answer.insert("qdot".into(), Value::Object(qdot_out));
         answer.insert("udot".into(), Value::Object(udot_out));
-        if let Some(warning) = holonomic_warning(model, info, t, &q, &qdot)? {
+        if let Some(warning) = holonomic_warning(model, info, t, &q, &qdot, &inputs)? {
             answer.insert("warning".into(), warning);
         }
         let (energies, contacts) = (
@@ -329,13 +329,14 @@ fn holonomic_warning(
     t: f64,
     q: &[f64],
     qdot: &[f64],
+    inputs: &[f64],
 ) -> Result<Option<Value>, String> {
     if info.holonomic == 0 {
         return Ok(None);
     }
     let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
     model
-        .dyn_constraint_residuals(t, q, qdot, &mut h, &mut v)
+        .dyn_driven_constraint_residuals(t, q, qdot, inputs, &mut h, &mut v)
         .map_err(|e| e.to_string())?;
     let scale = 1.0 + q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let tolerance = HOLONOMIC_TOLERANCE * scale;

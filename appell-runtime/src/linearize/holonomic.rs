@@ -4,7 +4,8 @@
 
 use super::checks::{check_configuration, finite, indices};
 use super::error::LinearizeError;
-use crate::model::{check_len, Model};
+use crate::model::{check_len, Model, ModelError};
+use crate::scalar::Scalar;
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
 
@@ -19,31 +20,52 @@ pub(super) const RANK_RTOL: f64 = 1e-10;
 /// Halvings of a Newton step before giving up on decreasing the residual.
 const MAX_BACKTRACKS: usize = 30;
 
+/// The residuals of the holonomic constraints (and of the velocity rows)
+/// at `q` with zero coordinate rates: [`Model::constraint_residuals`], or
+/// [`Model::driven_constraint_residuals`] at `inputs` when they are given.
+fn residuals_at<M: Model, T: Scalar>(
+    model: &M,
+    t: T,
+    q: &[T],
+    inputs: Option<&[T]>,
+    holonomic: &mut [T],
+    velocity: &mut [T],
+) -> Result<(), ModelError> {
+    let qdot = vec![T::zero(); q.len()];
+    match inputs {
+        Some(inputs) => model.driven_constraint_residuals(t, q, &qdot, inputs, holonomic, velocity),
+        None => model.constraint_residuals(t, q, &qdot, holonomic, velocity),
+    }
+}
+
 /// The holonomic residuals at `q` and their Jacobian columns at the
 /// coordinates `cols` (h × cols.len()), one [`Dual64`] pass per column. The
-/// coordinate rates passed to the model are zero.
-pub(super) fn holonomic_jacobian<M: Model>(
+/// coordinate rates passed to the model are zero; the residuals are those
+/// at `inputs` ([`Model::driven_constraint_residuals`]) when given.
+pub(super) fn jacobian_at<M: Model>(
     model: &M,
     t: f64,
     q: &[f64],
+    inputs: Option<&[f64]>,
     cols: &[usize],
 ) -> Result<(DVector<f64>, DMatrix<f64>), LinearizeError> {
     let info = M::info();
-    let (n, h, m) = (info.coordinates.len(), info.holonomic, info.constraints);
+    let (h, m) = (info.holonomic, info.constraints);
     let mut values = DVector::<f64>::zeros(h);
     let mut jac = DMatrix::<f64>::zeros(h, cols.len());
     if cols.is_empty() {
         let mut vel = vec![0.0; m];
-        model.constraint_residuals(t, q, &vec![0.0; n], values.as_mut_slice(), &mut vel)?;
+        residuals_at(model, t, q, inputs, values.as_mut_slice(), &mut vel)?;
     } else {
         let td = Dual64::from_re(t);
         let mut qd: Vec<Dual64> = q.iter().map(|&x| Dual64::from_re(x)).collect();
-        let qdot = vec![Dual64::from_re(0.0); n];
+        let id: Option<Vec<Dual64>> =
+            inputs.map(|i| i.iter().map(|&x| Dual64::from_re(x)).collect());
         let mut res = vec![Dual64::from_re(0.0); h];
         let mut vel = vec![Dual64::from_re(0.0); m];
         for (k, &c) in cols.iter().enumerate() {
             qd[c].eps = 1.0;
-            let r = model.constraint_residuals(td, &qd, &qdot, &mut res, &mut vel);
+            let r = residuals_at(model, td, &qd, id.as_deref(), &mut res, &mut vel);
             qd[c].eps = 0.0;
             r?;
             for (i, v) in res.iter().enumerate() {
@@ -102,6 +124,43 @@ pub fn solve_holonomic<M: Model>(
     tol: f64,
     max_iter: usize,
 ) -> Result<usize, LinearizeError> {
+    solve_at(model, t, q, None, unknowns, tol, max_iter)
+}
+
+/// [`solve_holonomic`] of a model with driven coordinates: the holonomic
+/// residuals are [`Model::driven_constraint_residuals`] at `inputs` (a
+/// driven coordinate is solved onto its command). For a model without
+/// driven coordinates it is `solve_holonomic`. Errors also for `inputs` of
+/// the wrong length or not finite. Example at [`driven_project_holonomic`].
+pub fn driven_solve_holonomic<M: Model>(
+    model: &M,
+    t: f64,
+    q: &mut [f64],
+    inputs: &[f64],
+    unknowns: &[usize],
+    tol: f64,
+    max_iter: usize,
+) -> Result<usize, LinearizeError> {
+    check_inputs::<M>(inputs)?;
+    solve_at(model, t, q, Some(inputs), unknowns, tol, max_iter)
+}
+
+/// Checks `inputs` against the model's input count and for finiteness.
+fn check_inputs<M: Model>(inputs: &[f64]) -> Result<(), LinearizeError> {
+    check_len("inputs", inputs, M::info().inputs.len())?;
+    Ok(finite(inputs, "inputs")?)
+}
+
+/// [`solve_holonomic`] at `inputs`, when given.
+fn solve_at<M: Model>(
+    model: &M,
+    t: f64,
+    q: &mut [f64],
+    inputs: Option<&[f64]>,
+    unknowns: &[usize],
+    tol: f64,
+    max_iter: usize,
+) -> Result<usize, LinearizeError> {
     let info = M::info();
     let n = info.coordinates.len();
     check_configuration(info, t, q)?;
@@ -126,11 +185,10 @@ pub fn solve_holonomic<M: Model>(
     let all: Vec<usize> = (0..n).collect();
     let mut trial = q.to_vec();
     let mut vel = vec![0.0; info.constraints];
-    let zeros = vec![0.0; n];
     let mut res = vec![0.0; h];
     let mut iter = 0;
     loop {
-        let (r, jfull) = holonomic_jacobian(model, t, q, &all)?;
+        let (r, jfull) = jacobian_at(model, t, q, inputs, &all)?;
         let norm = r.norm();
         if norm <= tol {
             return Ok(iter);
@@ -162,7 +220,7 @@ pub fn solve_holonomic<M: Model>(
                 trial[i] += alpha * step[k];
             }
             if trial.iter().all(|x| x.is_finite()) {
-                model.constraint_residuals(t, &trial, &zeros, &mut res, &mut vel)?;
+                residuals_at(model, t, &trial, inputs, &mut res, &mut vel)?;
                 let trial_norm = res.iter().map(|x| x * x).sum::<f64>().sqrt();
                 if trial_norm < norm {
                     accepted = true;
@@ -195,6 +253,30 @@ pub fn holonomic_unknowns<M: Model>(
     t: f64,
     q: &[f64],
 ) -> Result<Vec<usize>, LinearizeError> {
+    unknowns_at(model, t, q, None)
+}
+
+/// [`holonomic_unknowns`] of a model with driven coordinates, its
+/// residuals at `inputs` ([`Model::driven_constraint_residuals`]); a
+/// driven coordinate is among them (its constraint involves it). For a
+/// model without driven coordinates it is `holonomic_unknowns`.
+pub fn driven_holonomic_unknowns<M: Model>(
+    model: &M,
+    t: f64,
+    q: &[f64],
+    inputs: &[f64],
+) -> Result<Vec<usize>, LinearizeError> {
+    check_inputs::<M>(inputs)?;
+    unknowns_at(model, t, q, Some(inputs))
+}
+
+/// [`holonomic_unknowns`] at `inputs`, when given.
+fn unknowns_at<M: Model>(
+    model: &M,
+    t: f64,
+    q: &[f64],
+    inputs: Option<&[f64]>,
+) -> Result<Vec<usize>, LinearizeError> {
     let info = M::info();
     check_configuration(info, t, q)?;
     let mut dep = indices(info, info.dependent, "dependent")?;
@@ -203,7 +285,7 @@ pub fn holonomic_unknowns<M: Model>(
     if info.holonomic == 0 {
         return Ok(Vec::new());
     }
-    let (_, jac) = holonomic_jacobian(model, t, q, &dep)?;
+    let (_, jac) = jacobian_at(model, t, q, inputs, &dep)?;
     Ok(dep
         .iter()
         .enumerate()
@@ -286,6 +368,88 @@ pub fn project_holonomic<M: Model>(
     tol: f64,
     max_iter: usize,
 ) -> Result<(f64, usize), LinearizeError> {
+    project_at(model, t, state, None, tol, max_iter)
+}
+
+/// [`project_holonomic`] of a model with driven coordinates: the residuals
+/// are [`Model::driven_constraint_residuals`] at `inputs` (the inputs at
+/// time `t`, companions included), so a driven coordinate the reduced state
+/// carries is put back on its command. For a model without driven
+/// coordinates it is `project_holonomic`. Errors also for `inputs` of the
+/// wrong length or not finite.
+///
+/// ```
+/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar};
+/// # struct Servo;
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Servo", parameters: &[], coordinates: &["theta", "x"],
+/// #     speeds: &["x"], dependent: &["theta"], cyclic: &[], ignorable: &[],
+/// #     retained: &["theta", "x"], inputs: &["q_cmd", "q_cmd_rate", "q_cmd_accel"], effects: &[], outputs: &[],
+/// #     row_sources: &[RowSource::Driven { holonomic: true, index: 0, constraint: "holonomic: theta == q_cmd" }],
+/// #     contacts: &[], holonomic: 1, constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
+/// #     force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// # };
+/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
+/// # impl Model for Servo {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> {
+/// #         Err(ModelError::NeedsInputs { function: "constraint_residuals" })
+/// #     }
+/// #     fn driven_constraint_residuals<T: Scalar>(&self, _: T, q: &[T], qd: &[T], i: &[T], h: &mut [T], v: &mut [T]) -> Result<(), ModelError> {
+/// #         check_len("q", q, 2)?; check_len("inputs", i, 3)?;
+/// #         h[0] = q[0] - i[0];
+/// #         v[0] = qd[0] - i[1];
+/// #         Ok(())
+/// #     }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
+/// # }
+/// use appell_runtime::linearize::{driven_check_holonomic, driven_project_holonomic, project_holonomic};
+///
+/// // A joint position-controlled to q_cmd = 0.5, state (theta, x, ẋ)
+/// // drifted off the command.
+/// let (mut state, inputs) = ([0.52, 1.0, 0.3], [0.5, 0.0, 0.0]);
+/// let (residual, _) = driven_project_holonomic(&Servo, 0.0, &mut state, &inputs, 1e-14, 20).unwrap();
+/// assert!((residual - 0.02).abs() < 1e-12);
+/// assert!((state[0] - 0.5).abs() < 1e-14 && state[1..] == [1.0, 0.3]);
+/// assert!(driven_check_holonomic(&Servo, 0.0, &state, &inputs, 1e-14).is_ok());
+/// // Without the inputs the constraint cannot be evaluated.
+/// assert!(project_holonomic(&Servo, 0.0, &mut state, 1e-14, 20).is_err());
+/// ```
+pub fn driven_project_holonomic<M: Model>(
+    model: &M,
+    t: f64,
+    state: &mut [f64],
+    inputs: &[f64],
+    tol: f64,
+    max_iter: usize,
+) -> Result<(f64, usize), LinearizeError> {
+    check_inputs::<M>(inputs)?;
+    project_at(model, t, state, Some(inputs), tol, max_iter)
+}
+
+/// [`project_holonomic`] at `inputs`, when given.
+fn project_at<M: Model>(
+    model: &M,
+    t: f64,
+    state: &mut [f64],
+    inputs: Option<&[f64]>,
+    tol: f64,
+    max_iter: usize,
+) -> Result<(f64, usize), LinearizeError> {
     let info = M::info();
     check_len("state", state, info.state_len())?;
     finite(state, "state")?;
@@ -298,7 +462,7 @@ pub fn project_holonomic<M: Model>(
         q[i] = state[k];
     }
     let all: Vec<usize> = (0..q.len()).collect();
-    let (r, jac) = holonomic_jacobian(model, t, &q, &all)?;
+    let (r, jac) = jacobian_at(model, t, &q, inputs, &all)?;
     if let Some(c) =
         (0..q.len()).find(|&c| !retained.contains(&c) && jac.column(c).iter().any(|&x| x != 0.0))
     {
@@ -307,11 +471,11 @@ pub fn project_holonomic<M: Model>(
             info.coordinates[c]
         )));
     }
-    let unknowns: Vec<usize> = holonomic_unknowns(model, t, &q)?
+    let unknowns: Vec<usize> = unknowns_at(model, t, &q, inputs)?
         .into_iter()
         .filter(|i| retained.contains(i))
         .collect();
-    let steps = solve_holonomic(model, t, &mut q, &unknowns, tol, max_iter)?;
+    let steps = solve_at(model, t, &mut q, inputs, &unknowns, tol, max_iter)?;
     for (k, &i) in retained.iter().enumerate() {
         state[k] = q[i];
     }
@@ -374,6 +538,33 @@ pub fn check_holonomic<M: Model>(
     state: &[f64],
     tol: f64,
 ) -> Result<Vec<f64>, LinearizeError> {
+    check_at(model, t, state, None, tol)
+}
+
+/// [`check_holonomic`] of a model with driven coordinates, the residuals
+/// at `inputs` ([`Model::driven_constraint_residuals`]): a driven
+/// coordinate's is its distance from the command. For a model without
+/// driven coordinates it is `check_holonomic`. Errors also for `inputs` of
+/// the wrong length or not finite. Example at [`driven_project_holonomic`].
+pub fn driven_check_holonomic<M: Model>(
+    model: &M,
+    t: f64,
+    state: &[f64],
+    inputs: &[f64],
+    tol: f64,
+) -> Result<Vec<f64>, LinearizeError> {
+    check_inputs::<M>(inputs)?;
+    check_at(model, t, state, Some(inputs), tol)
+}
+
+/// [`check_holonomic`] at `inputs`, when given.
+fn check_at<M: Model>(
+    model: &M,
+    t: f64,
+    state: &[f64],
+    inputs: Option<&[f64]>,
+    tol: f64,
+) -> Result<Vec<f64>, LinearizeError> {
     let info = M::info();
     check_len("state", state, info.state_len())?;
     finite(state, "state")?;
@@ -389,7 +580,7 @@ pub fn check_holonomic<M: Model>(
         q[i] = state[k];
     }
     let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
-    model.constraint_residuals(t, &q, &vec![0.0; n], &mut h, &mut v)?;
+    residuals_at(model, t, &q, inputs, &mut h, &mut v)?;
     if let Some((index, &residual)) = h
         .iter()
         .enumerate()

@@ -4,7 +4,7 @@
 
 use super::checks::{check_configuration, finite, indices};
 use super::error::LinearizeError;
-use super::holonomic::{holonomic_jacobian, svd, RANK_RTOL};
+use super::holonomic::{jacobian_at, svd, RANK_RTOL};
 use super::jacobian::{linearize, Linearization};
 use crate::model::{check_len, Model};
 use nalgebra::DMatrix;
@@ -111,7 +111,9 @@ pub fn minimal_linearization<M: Model>(
     let mut follow = DMatrix::<f64>::zeros(0, nr);
     if info.holonomic > 0 {
         let all: Vec<usize> = (0..n).collect();
-        let (f0, jac) = holonomic_jacobian(model, t, q_full, &all)?;
+        // At the inputs: a driven coordinate's constraint reads its command
+        // (for every other model they are not read).
+        let (f0, jac) = jacobian_at(model, t, q_full, Some(inputs), &all)?;
         let residual = f0.norm();
         let q_scale = q_full.iter().fold(0.0_f64, |s, x| s.max(x.abs()));
         let tolerance = MANIFOLD_RTOL * (jac.norm() * q_scale).max(1.0);
