@@ -2,8 +2,12 @@
 //! Newton-dependent safety factor, Gustafsson's predictive controller and
 //! the rule that keeps the Jacobian and the step.
 
-/// Newton converged fast enough to keep the Jacobian (RADAU5's `THET`).
-pub(super) const THETA_KEEP: f64 = 0.001;
+/// The contraction rate up to which the Jacobian is kept when the caller
+/// gives it (RADAU5's default `THET`).
+pub(super) const REUSE_GIVEN: f64 = 0.001;
+/// The same when it is computed by dual numbers, at the cost of one
+/// evaluation per state component (RADAU5's advice for costly Jacobians).
+pub(super) const REUSE_DUAL: f64 = 0.1;
 const SAFETY: f64 = 0.9;
 /// Bounds of `h_new/h`.
 const FAC_MIN: f64 = 0.2;
@@ -67,10 +71,10 @@ impl Gustafsson {
 }
 
 /// Whether the next step keeps the step size and both factorizations: the
-/// Jacobian is kept (`theta ≤ THETA_KEEP`) and the proposed factor is in
-/// `[1, 1.2]`.
-pub(super) fn keeps_step(theta: f64, fac: f64) -> bool {
-    theta <= THETA_KEEP && (1.0..=HOLD_MAX).contains(&fac)
+/// Jacobian is kept (the contraction rate `theta` is at most `reuse`) and
+/// the proposed factor is in `[1, 1.2]`.
+pub(super) fn keeps_step(theta: f64, reuse: f64, fac: f64) -> bool {
+    theta <= reuse && (1.0..=HOLD_MAX).contains(&fac)
 }
 
 #[cfg(test)]
@@ -99,6 +103,7 @@ mod tests {
         // 0.9 (0.5/0.81)^(1/4) ≈ 0.80 wins over the classical one.
         let f = g.accepted(0.1, 0.9, 1.0);
         assert!((f - 0.9 * (0.5_f64 / 0.81).powf(0.25)).abs() < 1e-12, "{f}");
-        assert!(keeps_step(0.0, 1.1) && !keeps_step(0.01, 1.1) && !keeps_step(0.0, 1.3));
+        assert!(keeps_step(0.0, 1e-3, 1.1) && !keeps_step(0.01, 1e-3, 1.1));
+        assert!(!keeps_step(0.0, 1e-3, 1.3) && keeps_step(0.01, 0.1, 1.1));
     }
 }

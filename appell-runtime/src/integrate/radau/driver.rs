@@ -1,9 +1,9 @@
 //! The adaptive loop behind every `solve*` of [`Radau5`].
 
 use super::control::{
-    keeps_step, newton_tolerance, step_factor, Gustafsson, FAC_FAIL, FAC_FIRST, THETA_KEEP,
+    keeps_step, newton_tolerance, step_factor, Gustafsson, FAC_FAIL, FAC_FIRST, REUSE_GIVEN,
 };
-use super::dense::{coefficients, Collocation, Previous};
+use super::dense::{coefficients, end_derivative, Collocation, Previous};
 use super::iteration::Iteration;
 use super::settings::Radau5;
 use super::stages::{Newton, Stages};
@@ -54,6 +54,7 @@ impl Radau5 {
         derivative(&mut f, t, &x, &mut f0, &mut stats)?;
         let (rtol, atol) = self.internal_tolerances();
         let fnewt = newton_tolerance(rtol);
+        let reuse = self.jacobian_reuse.unwrap_or(REUSE_GIVEN);
         let h_max = self.h_max.unwrap_or(f64::INFINITY).min((t_end - t0).abs());
         let mut scal: Vec<f64> = x.iter().map(|v| atol + rtol * v.abs()).collect();
         let mut h = initial_step(self.h0, &x, &f0, &scal, h_max);
@@ -79,7 +80,7 @@ impl Radau5 {
 
             it.refresh(&mut jac_fn, t, &x, &mut stats)?;
             let outcome = if it.prepare(hs, &mut stats) {
-                prev.extrapolate(hs, &x, &mut st.z, &mut buf);
+                prev.extrapolate(hs, &x, &mut st.z);
                 let nit = self.newton_max_iter;
                 st.newton(&it, &mut f, t, hs, &x, &scal, fnewt, nit, &mut stats)?
             } else {
@@ -118,7 +119,7 @@ impl Radau5 {
                     _ => fac,
                 };
                 // A Jacobian under which Newton converged fast is kept.
-                if theta > THETA_KEEP {
+                if theta > reuse {
                     it.after_rejection();
                 }
                 continue;
@@ -151,29 +152,32 @@ impl Radau5 {
                 return Ok(solution(te, xe, stats, h_new, true, next_out));
             }
 
+            // f at the new state for the next error estimate, from the
+            // polynomial (evaluated instead when a projection moves it).
+            end_derivative(&q, hs, &mut f0);
             // The step's polynomial starts the next one.
             prev.keep(&mut x, &mut q, &x_new, hs);
             t = t_new;
             if let Some(p) = project.as_mut() {
                 if project_state(p, t, &mut x, &mut buf)? {
+                    derivative(&mut f, t, &x, &mut f0, &mut stats)?;
                     if let Some(g) = event.as_mut() {
                         g_old = event_value(g, t, &x, t)?;
                     }
                 }
             }
-            derivative(&mut f, t, &x, &mut f0, &mut stats)?;
             for (s, v) in scal.iter_mut().zip(&x) {
                 *s = atol + rtol * v.abs();
             }
             it.fresh = false;
-            if theta > THETA_KEEP {
+            if theta > reuse {
                 it.have_jac = false;
             }
             (rejected, non_finite) = (false, false);
             if last {
                 return Ok(solution(t, x, stats, h_new, false, next_out));
             }
-            if !keeps_step(theta, h_new / h) {
+            if !keeps_step(theta, reuse, h_new / h) {
                 h = h_new;
             }
         }

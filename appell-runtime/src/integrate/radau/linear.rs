@@ -95,10 +95,12 @@ impl Entry for C64 {
 }
 
 /// The LU factors of an n×n matrix (row-major, unit lower triangle
-/// implied) and the row exchanges of partial pivoting.
+/// implied), the reciprocals of the pivots and the row exchanges of
+/// partial pivoting.
 pub(super) struct Lu<T> {
     n: usize,
     a: Vec<T>,
+    inv_diag: Vec<T>,
     pivots: Vec<usize>,
 }
 
@@ -108,6 +110,7 @@ impl<T: Entry> Lu<T> {
         Lu {
             n,
             a: vec![T::ZERO; n * n],
+            inv_diag: vec![T::ZERO; n],
             pivots: vec![0; n],
         }
     }
@@ -116,43 +119,47 @@ impl<T: Entry> Lu<T> {
     /// is zero or not finite (the factors are then unusable).
     pub(super) fn factor_shifted(&mut self, shift: T, jac: &[f64]) -> bool {
         let n = self.n;
-        for (i, row) in self.a.chunks_exact_mut(n.max(1)).enumerate() {
-            for (j, v) in row.iter_mut().enumerate() {
-                *v = T::ZERO - T::real(jac[i * n + j]);
-            }
-            row[i] = row[i] + shift;
+        for (v, &j) in self.a.iter_mut().zip(jac) {
+            *v = T::real(-j);
+        }
+        for i in 0..n {
+            self.a[i * n + i] = self.a[i * n + i] + shift;
         }
         self.factor()
     }
 
-    /// In-place Doolittle factorization with partial pivoting.
+    /// In-place Doolittle factorization with partial pivoting (rows are
+    /// eliminated by slices, each with one multiplication by the pivot's
+    /// reciprocal).
     fn factor(&mut self) -> bool {
         let n = self.n;
         let a = &mut self.a;
         for k in 0..n {
-            let p = (k..n)
-                .max_by(|&i, &j| {
-                    a[i * n + k]
-                        .magnitude()
-                        .total_cmp(&a[j * n + k].magnitude())
-                })
-                .unwrap_or(k);
-            let m = a[p * n + k].magnitude();
+            let mut p = k;
+            let mut m = a[k * n + k].magnitude();
+            for i in k + 1..n {
+                let v = a[i * n + k].magnitude();
+                if v > m {
+                    (p, m) = (i, v);
+                }
+            }
             if m == 0.0 || !m.is_finite() {
                 return false;
             }
             self.pivots[k] = p;
             if p != k {
-                for j in 0..n {
-                    a.swap(k * n + j, p * n + j);
-                }
+                let (upper, lower) = a.split_at_mut(p * n);
+                upper[k * n..(k + 1) * n].swap_with_slice(&mut lower[..n]);
             }
-            let pivot = a[k * n + k];
-            for i in k + 1..n {
-                let l = a[i * n + k] / pivot;
-                a[i * n + k] = l;
-                for j in k + 1..n {
-                    a[i * n + j] = a[i * n + j] - l * a[k * n + j];
+            let (upper, lower) = a.split_at_mut((k + 1) * n);
+            let pivot_row = &upper[k * n + k + 1..];
+            let inv = T::real(1.0) / upper[k * n + k];
+            self.inv_diag[k] = inv;
+            for row in lower.chunks_exact_mut(n) {
+                let l = row[k] * inv;
+                row[k] = l;
+                for (r, &u) in row[k + 1..].iter_mut().zip(pivot_row) {
+                    *r = *r - l * u;
                 }
             }
         }
@@ -162,23 +169,24 @@ impl<T: Entry> Lu<T> {
     /// Solves `M y = b` in place with the factors of `M`.
     pub(super) fn solve(&self, b: &mut [T]) {
         let n = self.n;
-        let a = &self.a;
+        let (a, b) = (&self.a[..n * n], &mut b[..n]);
+        for (k, &p) in self.pivots.iter().enumerate() {
+            b.swap(k, p);
+        }
+        // Forward: column k of L once b_k is final.
         for k in 0..n {
-            b.swap(k, self.pivots[k]);
-        }
-        for i in 1..n {
-            let mut s = b[i];
-            for j in 0..i {
-                s = s - a[i * n + j] * b[j];
+            let y = b[k];
+            for i in k + 1..n {
+                b[i] = b[i] - a[i * n + k] * y;
             }
-            b[i] = s;
         }
-        for i in (0..n).rev() {
-            let mut s = b[i];
-            for j in i + 1..n {
-                s = s - a[i * n + j] * b[j];
+        // Backward: column k of U once y_k is final.
+        for k in (0..n).rev() {
+            let y = b[k] * self.inv_diag[k];
+            b[k] = y;
+            for i in 0..k {
+                b[i] = b[i] - a[i * n + k] * y;
             }
-            b[i] = s / a[i * n + i];
         }
     }
 }

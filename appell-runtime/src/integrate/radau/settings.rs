@@ -26,18 +26,22 @@ use super::Radau5Stats;
 ///   above 0.99, or one too slow to converge in the iterations left,
 ///   rejects the step and shrinks it.
 /// * **Jacobian reuse** (as RADAU5): after an accepted step the Jacobian is
-///   kept when Newton converged fast (θ ≤ 0.001, or in one iteration);
-///   then, when the proposed step changes by a factor in `[1, 1.2]`, the
-///   step size and both factorizations are kept too. A Newton failure with
-///   a stale Jacobian gets a new one for the retry, and so does a step
-///   rejected by the error estimate unless its Newton iteration converged
-///   fast (RADAU5 renews it after every rejection).
+///   kept when Newton converged fast (θ ≤ [`Radau5::jacobian_reuse`], or
+///   in one iteration); then, when the proposed step changes by a factor
+///   in `[1, 1.2]`, the step size and both factorizations are kept too. A
+///   Newton failure with a stale Jacobian gets a new one for the retry, and
+///   so does a step rejected by the error estimate unless its Newton
+///   iteration converged fast (RADAU5 renews it after every rejection).
 /// * **Error estimate**: the embedded estimate of order 3,
 ///   `(γ/h − J)⁻¹ (f(t, x) + Σ e_i z_i / h)`; the filter by `(I − h J/γ)⁻¹`
 ///   keeps it bounded on stiff components. On the first step and after a
 ///   rejection, an estimate above 1 is refined once by `f` at `x + err`.
-///   Norm: RMS of `err_i / sk_i`, `sk_i = atol' + rtol' · max(|x_i|,
-///   |x_new_i|)`; a step is accepted when the norm is below 1.
+///   After an accepted step, `f(t, x)` is the derivative of its
+///   collocation polynomial at its end (equal to `f` there up to the
+///   residual of the converged Newton iteration, and free), unless a
+///   projection moved the state. Norm: RMS of `err_i / sk_i`, `sk_i =
+///   atol' + rtol' · max(|x_i|, |x_new_i|)`; a step is accepted when the
+///   norm is below 1.
 /// * **Tolerances**: as RADAU5, the given tolerances are mapped to
 ///   `rtol' = 0.1 rtol^(2/3)`, `atol' = atol · rtol'/rtol` (for `rtol = 0`:
 ///   `atol' = 0.1 atol^(2/3)`), which makes the global error follow the
@@ -67,7 +71,8 @@ use super::Radau5Stats;
 ///
 /// Defaults: `rtol = 1e-6`, `atol = 1e-9`, `max_steps = 100_000`,
 /// `h0 = None` (automatic), `h_max = None` (the interval length),
-/// `newton_max_iter = 7`, `event_tol = 1e-12`.
+/// `newton_max_iter = 7`, `event_tol = 1e-12`, `jacobian_reuse` 0.001
+/// with a given Jacobian and 0.1 with one by dual numbers.
 ///
 /// ```
 /// use appell_runtime::integrate::Radau5;
@@ -102,6 +107,7 @@ pub struct Radau5 {
     pub(super) h_max: Option<f64>,
     pub(super) max_steps: usize,
     pub(super) newton_max_iter: usize,
+    pub(super) jacobian_reuse: Option<f64>,
     pub(super) event_tol: f64,
 }
 
@@ -126,6 +132,7 @@ impl Radau5 {
             h_max: None,
             max_steps: 100_000,
             newton_max_iter: 7,
+            jacobian_reuse: None,
             event_tol: 1e-12,
         }
     }
@@ -284,6 +291,47 @@ impl Radau5 {
         self
     }
 
+    /// The Newton contraction rate up to which an accepted step's Jacobian
+    /// is kept for the next step (RADAU5's `THET`; must be in `[0, 1)`).
+    /// Larger values trade Newton iterations for Jacobians: worth it when a
+    /// Jacobian costs many rhs calls. A Newton solve that converged in one
+    /// iteration keeps the Jacobian at any setting. Default: `0.001` (as
+    /// RADAU5) where the Jacobian is given, `0.1` (RADAU5's advice for
+    /// costly Jacobians) for the `solve_model*` methods, whose Jacobian by
+    /// dual numbers costs one evaluation of the equations per state
+    /// component.
+    ///
+    /// ```
+    /// use appell_runtime::integrate::{IntegrateError, Radau5};
+    /// use appell_runtime::ModelError;
+    ///
+    /// // x' = −x²: a Jacobian that changes with the state.
+    /// let f = |_t: f64, x: &[f64], dx: &mut [f64]| -> Result<(), ModelError> {
+    ///     dx[0] = -x[0] * x[0];
+    ///     Ok(())
+    /// };
+    /// let jac = |_t: f64, x: &[f64], j: &mut [f64]| -> Result<(), ModelError> {
+    ///     j[0] = -2.0 * x[0];
+    ///     Ok(())
+    /// };
+    /// let fresh = Radau5::new().rtol(1e-8).solve(f, jac, 0.0, &[1.0], 10.0).unwrap();
+    /// let kept = Radau5::new()
+    ///     .rtol(1e-8)
+    ///     .jacobian_reuse(0.1)
+    ///     .solve(f, jac, 0.0, &[1.0], 10.0)
+    ///     .unwrap();
+    /// assert!(kept.stats.jacobians <= fresh.stats.jacobians);
+    /// assert!((kept.x[0] - 1.0 / 11.0).abs() < 1e-8);
+    /// assert!(matches!(
+    ///     Radau5::new().jacobian_reuse(1.0).solve(f, jac, 0.0, &[1.0], 1.0),
+    ///     Err(IntegrateError::InvalidInput { .. })
+    /// ));
+    /// ```
+    pub const fn jacobian_reuse(mut self, theta: f64) -> Self {
+        self.jacobian_reuse = Some(theta);
+        self
+    }
+
     /// Absolute time tolerance of event location (default `1e-12`; must be
     /// ≥ 0; never tighter than 4 ulp of the event time), see
     /// [`Radau5::solve_until`].
@@ -335,6 +383,11 @@ impl Radau5 {
         }
         if self.newton_max_iter == 0 {
             return bad("newton_max_iter must be at least 1");
+        }
+        if let Some(theta) = self.jacobian_reuse {
+            if !(0.0..1.0).contains(&theta) {
+                return bad("jacobian_reuse must be in [0, 1)");
+            }
         }
         if self.max_steps == 0 {
             return bad("max_steps must be at least 1");

@@ -1,6 +1,7 @@
 //! The public `solve*` methods of [`Radau5`], for a right-hand side with
 //! its Jacobian or for a [`Model`] (Jacobian by dual numbers).
 
+use super::control::REUSE_DUAL;
 use super::settings::Radau5;
 use super::stats::Radau5Solution;
 use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
@@ -561,7 +562,11 @@ impl Radau5 {
         check_len("state", x0, n)?;
         let f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, inputs, dx);
         let jac = dual_jacobian(rhs, inputs);
-        let mut sol = self.run(f, jac, t0, x0, t_end, out, event, project)?;
+        let settings = Radau5 {
+            jacobian_reuse: Some(self.jacobian_reuse.unwrap_or(REUSE_DUAL)),
+            ..*self
+        };
+        let mut sol = settings.run(f, jac, t0, x0, t_end, out, event, project)?;
         sol.stats.jacobian_rhs_calls = sol.stats.jacobians * n;
         Ok(sol)
     }

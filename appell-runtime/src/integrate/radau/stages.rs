@@ -3,7 +3,6 @@
 //! estimate.
 
 use super::coefficients::{ALPHA, BETA, C, E, GAMMA, T, TI};
-use super::control::THETA_KEEP;
 use super::iteration::Iteration;
 use super::linear::C64;
 use super::stats::Radau5Stats;
@@ -16,7 +15,7 @@ const THETA_DIVERGE: f64 = 0.99;
 /// How a Newton solve of the stages ended (model errors are passed on).
 pub(super) enum Newton {
     /// Converged in `iterations`, with the contraction rate `theta`
-    /// ([`THETA_KEEP`] when one iteration sufficed).
+    /// (0 when one iteration sufficed).
     Converged { theta: f64, iterations: usize },
     /// Diverged, too slow, or a non-finite value: retry with the step
     /// times `factor`.
@@ -92,7 +91,7 @@ impl Stages {
         let failed = |factor, non_finite| Ok(Newton::Failed { factor, non_finite });
         transform(&TI, &self.z, &mut self.w, self.n);
         self.faccon = self.faccon.max(f64::EPSILON).powf(0.8);
-        let mut theta = THETA_KEEP;
+        let mut theta = 0.0;
         let (mut norm_old, mut thq_old) = (0.0, 0.0);
         for k in 1..=max_iter {
             if !self.stage_derivatives(f, t, hs, x, stats)? {
@@ -166,14 +165,16 @@ impl Stages {
     fn corrections(&mut self, it: &Iteration, hs: f64, scal: &[f64]) -> f64 {
         let n = self.n;
         let (g, mu) = (GAMMA / hs, C64::new(ALPHA / hs, -BETA / hs));
-        let ti = |k: usize, i: usize| {
-            let row = &TI[k];
-            row[0] * self.fz[i] + row[1] * self.fz[n + i] + row[2] * self.fz[2 * n + i]
-        };
-        for i in 0..n {
-            self.real[i] = ti(0, i) - g * self.w[i];
-            let v = C64::new(self.w[n + i], self.w[2 * n + i]);
-            self.complex[i] = C64::new(ti(1, i), ti(2, i)) - mu * v;
+        let (f0, rest) = self.fz.split_at(n);
+        let (f1, f2) = rest.split_at(n);
+        let (w0, rest) = self.w.split_at(n);
+        let (w1, w2) = rest.split_at(n);
+        let stages = f0.iter().zip(f1).zip(f2).zip(w0.iter().zip(w1).zip(w2));
+        let out = self.real.iter_mut().zip(self.complex.iter_mut());
+        for ((r, c), (((&a, &b), &d), ((&u, &v), &y))) in out.zip(stages) {
+            let ti = |row: &[f64; 3]| row[0] * a + row[1] * b + row[2] * d;
+            *r = ti(&TI[0]) - g * u;
+            *c = C64::new(ti(&TI[1]), ti(&TI[2])) - mu * C64::new(v, y);
         }
         it.solve_real(&mut self.real);
         it.solve_complex(&mut self.complex);
@@ -187,12 +188,21 @@ impl Stages {
     /// `w += Δw`, `z = T w`.
     fn apply_corrections(&mut self) {
         let n = self.n;
-        for i in 0..n {
-            self.w[i] += self.real[i];
-            self.w[n + i] += self.complex[i].re;
-            self.w[2 * n + i] += self.complex[i].im;
+        let (w0, rest) = self.w.split_at_mut(n);
+        let (w1, w2) = rest.split_at_mut(n);
+        let (z0, rest) = self.z.split_at_mut(n);
+        let (z1, z2) = rest.split_at_mut(n);
+        let w = w0.iter_mut().zip(w1.iter_mut()).zip(w2.iter_mut());
+        let z = z0.iter_mut().zip(z1.iter_mut()).zip(z2.iter_mut());
+        let d = self.real.iter().zip(&self.complex);
+        for (((a, b), c), (((p, q), r), (dr, dc))) in w.zip(z.zip(d)) {
+            *a += dr;
+            *b += dc.re;
+            *c += dc.im;
+            *p = T[0][0] * *a + T[0][1] * *b + T[0][2] * *c;
+            *q = T[1][0] * *a + T[1][1] * *b + T[1][2] * *c;
+            *r = T[2][0] * *a + T[2][1] * *b + T[2][2] * *c;
         }
-        transform(&T, &self.w, &mut self.z, n);
     }
 
     /// The new state `x + z_3` into `x_new`.

@@ -541,3 +541,25 @@ fn jacobians_and_factorizations_are_reused() {
     let s = fixed_steps(16, 4.0).stats;
     assert_eq!((s.jacobians, s.lu_factorizations), (1, 1), "{s:?}");
 }
+
+#[test]
+fn a_larger_jacobian_reuse_keeps_jacobians_longer() {
+    // Van der Pol, μ = 1000: about the same solution from fewer Jacobians.
+    let run = |reuse| {
+        Radau5::new()
+            .rtol(1e-6)
+            .atol(1e-6)
+            .jacobian_reuse(reuse)
+            .solve(vdp, vdp_jac, 0.0, &[2.0, 0.0], 3000.0)
+            .unwrap()
+    };
+    let (fresh, kept) = (run(0.001), run(0.1));
+    assert!(
+        kept.stats.jacobians < fresh.stats.jacobians,
+        "{:?} {:?}",
+        kept.stats,
+        fresh.stats
+    );
+    let rel = (kept.x[0] - fresh.x[0]).abs() / fresh.x[0].abs();
+    assert!(rel < 1e-4, "{:?} {:?}", kept.x, fresh.x);
+}
