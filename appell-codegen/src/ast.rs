@@ -125,6 +125,9 @@ pub struct ConstraintDef {
     /// components are taken along (`along = [N.x, N.y]`); N's axes when
     /// absent.
     pub along: Option<Vec<Expr>>,
+    /// The effect it belongs to (`effect = name`): scenes that do not name
+    /// it leave it out. None: every scene keeps it.
+    pub effect: Option<Ident>,
     /// The whole constraint's tokens, for errors that underline it.
     pub at: proc_macro2::TokenStream,
 }
@@ -152,6 +155,8 @@ pub struct RollsDef {
     /// Directions of the velocity components constrained (default: N.x,
     /// N.y, N.z, identically zero ones dropped).
     pub along: Option<Vec<Expr>>,
+    /// The effect it belongs to (`effect = name`), as for a constraint.
+    pub effect: Option<Ident>,
     /// The item's tokens, for errors.
     pub at: proc_macro2::TokenStream,
 }
@@ -175,6 +180,9 @@ pub struct SceneDef {
     pub effects: Vec<Ident>,
     /// Outputs: a kind and its arguments.
     pub outputs: Vec<(Ident, Vec<Ident>)>,
+    /// `speeds(...)`: the scene's own privileged speeds (coordinates, or
+    /// the model's quasi-velocities), with its tokens for errors.
+    pub speeds: Option<(Vec<Ident>, proc_macro2::TokenStream)>,
 }
 
 /// One parameter: an `f64` field, or one element of an `[f64; N]` field.

@@ -5,7 +5,7 @@
 //! the loads that depend on an input, F·v_P + L·ω, whose integral closes the
 //! energy balance of a driven system.
 
-use appell_symbolic::{Id, Number, SymbolSet, SymbolicError};
+use appell_symbolic::{Id, Number, Substitution, SymbolSet, SymbolicError};
 
 use super::partials::PartialVelocities;
 use super::speed_map::SpeedMap;
@@ -29,6 +29,7 @@ pub fn energies(
     model: &mut Model,
     partials: &PartialVelocities,
     map: &SpeedMap,
+    fixed: &mut Substitution,
 ) -> Result<Energies, SymbolicError> {
     let g = &mut model.g;
     let speed_rates = &map.speed_rates;
@@ -61,6 +62,7 @@ pub fn energies(
             let at = &partials.forces[fi];
             let v = combine(g, &at.parts, at.rest, speed_rates)?;
             let p = dot(g, f.vector, v)?;
+            let p = fixed.apply(g, p)?;
             p_terms.push(p);
             power_terms.push((f.effect.clone(), p));
         }
@@ -70,6 +72,7 @@ pub fn energies(
             let at = &partials.torques[ti];
             let w = combine(g, &at.parts, at.rest, speed_rates)?;
             let p = dot(g, t.vector, w)?;
+            let p = fixed.apply(g, p)?;
             p_terms.push(p);
             power_terms.push((t.effect.clone(), p));
         }

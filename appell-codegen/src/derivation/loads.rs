@@ -7,7 +7,7 @@
 //! relative rotation's partial velocity). The weights of a composite's
 //! members act as one at its mass centre: Σ mᵢ g·β̄ᵢ = M g·β̄_G.
 
-use appell_symbolic::{Graph, Id, RateRules, Symbol, SymbolicError};
+use appell_symbolic::{Graph, Id, RateRules, Substitution, Symbol, SymbolicError};
 
 use super::assembly::Assembled;
 use super::assembly::Composite;
@@ -28,7 +28,8 @@ pub struct Equations {
     pub load_terms: Vec<(String, Vec<Id>)>,
 }
 
-/// Stage 10.
+/// Stage 10. A load may depend on coordinate rates (a damper, friction):
+/// `fixed` writes the dependent ones as C ẏ + c.
 pub fn equations(
     model: &mut Model,
     assembled: Assembled,
@@ -36,6 +37,7 @@ pub fn equations(
     partials: &PartialVelocities,
     map: &SpeedMap,
     rules: &RateRules,
+    fixed: &mut Substitution,
 ) -> Result<Equations, SymbolicError> {
     let l = map.speed_rates.len();
     let Assembled {
@@ -59,7 +61,8 @@ pub fn equations(
     }
     for (_, per_k) in merged.iter_mut() {
         for x in per_k.iter_mut() {
-            *x = expanded(g, *x)?;
+            let in_speeds = fixed.apply(g, *x)?;
+            *x = expanded(g, in_speeds)?;
         }
         for k in 0..l {
             forcing_terms[k].push(per_k[k]);

@@ -68,7 +68,7 @@ pub use speeds::SpeedDefinitions;
 pub use structure::{singleton_rows, SingletonOrder};
 
 use crate::ctxt::Ctxt;
-use crate::model::{Kinematics, Model, Scene, Twin};
+use crate::model::{ConstraintSet, Kinematics, Model, Scene, Twin};
 
 /// Choices the derivation makes by operation count, forced for tests that
 /// compare the forms.
@@ -175,6 +175,9 @@ pub struct Derivation {
     /// against the closed form's; where they cost less, `equations` holds
     /// them and `closed_form` is false.
     pub projection: Option<Projection>,
+    /// A scene's own constraints and speeds, where they differ from the
+    /// model's (the emitter puts them in place for its implementation).
+    pub own_constraints: Option<ConstraintSet>,
 }
 
 /// The operations per call of a constrained tree's M and f (lower
@@ -239,39 +242,16 @@ pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
 /// [`derive()`] with the cost-driven choices forced by `options`.
 pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derived> {
     let Kinematics { mut model, twin } = kinematics;
-    let full = match Calculus::new(&mut model, twin)
-        .and_then(|calculus| stages(cx, &mut model, calculus, options))
-    {
-        Ok(Some(d)) => {
-            let mut d = d.finish(&model);
-            d.structured = if options.closed_form_only {
-                Err(String::new())
-            } else {
-                structured_form(&mut model, &d.reduction.ignorable)
-            };
-            if !options.closed_form_only {
-                if let Err(e) = project(&mut model, &mut d) {
-                    cx.error_at(
-                        model.name.span(),
-                        format!("projecting the tree's equations failed: {e}"),
-                    );
-                    return None;
-                }
-            }
-            d
-        }
-        Ok(None) => return None,
-        Err(e) => {
-            cx.error_at(
-                model.name.span(),
-                format!("deriving the equations failed: {e}"),
-            );
-            return None;
-        }
-    };
+    let scenes_twin = twin.clone();
+    let full = complete(cx, &mut model, twin, options)?;
     let mut scenes = Vec::new();
     for scene in model.scenes.clone() {
-        if let Some(d) = scenes::derive_scene(cx, &mut model, &full, &scene) {
+        let d = if ConstraintSet::of_scene(&model, &scene).is_some() {
+            scenes::derive_constrained_scene(cx, &mut model, scenes_twin.as_ref(), &scene, options)
+        } else {
+            scenes::derive_scene(cx, &mut model, &full, &scene)
+        };
+        if let Some(d) = d {
             scenes.push((scene, d));
         }
     }
@@ -280,6 +260,44 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
         full,
         scenes,
     })
+}
+
+/// Stages 1 to 13 of `model` as it stands (its constraints and speeds);
+/// errors go to `cx`.
+fn complete(
+    cx: &Ctxt,
+    model: &mut Model,
+    twin: Option<Twin>,
+    options: &Options,
+) -> Option<Derivation> {
+    match Calculus::new(model, twin).and_then(|calculus| stages(cx, model, calculus, options)) {
+        Ok(Some(d)) => {
+            let mut d = d.finish(model);
+            d.structured = if options.closed_form_only {
+                Err(String::new())
+            } else {
+                structured_form(model, &d.reduction.ignorable)
+            };
+            if !options.closed_form_only {
+                if let Err(e) = project(model, &mut d) {
+                    cx.error_at(
+                        model.name.span(),
+                        format!("projecting the tree's equations failed: {e}"),
+                    );
+                    return None;
+                }
+            }
+            Some(d)
+        }
+        Ok(None) => None,
+        Err(e) => {
+            cx.error_at(
+                model.name.span(),
+                format!("deriving the equations failed: {e}"),
+            );
+            None
+        }
+    }
 }
 
 /// The structured form of a plain tree of joints (stage 13), the
@@ -299,7 +317,12 @@ fn project(model: &mut Model, d: &mut Derivation) -> Result<(), SymbolicError> {
     let Ok(spec) = model.tree.clone() else {
         return Ok(());
     };
-    if spec.plain.is_ok() || !matches!(d.elimination, Elimination::Symbolic) {
+    // Scenes keep some effects' loads of the closed form's terms, which the
+    // projected tree does not separate.
+    if spec.plain.is_ok()
+        || !matches!(d.elimination, Elimination::Symbolic)
+        || !model.scenes.is_empty()
+    {
         return Ok(());
     }
     let p = tree::projected::projected(model, &spec, &d.map, &d.reduction.ignorable)?;
@@ -370,6 +393,7 @@ impl Stages {
             text: String::new(),
             structured: Err(String::new()),
             projection: None,
+            own_constraints: None,
         };
         d.text = text::equations_text(model, &d);
         d
@@ -512,8 +536,9 @@ fn closed_form(
         &partials,
         map,
         &calculus.rules,
+        &mut rates.fixed,
     )?;
-    let energies = energies::energies(model, &partials, map)?;
+    let energies = energies::energies(model, &partials, map, &mut rates.fixed)?;
     Ok((equations, energies, folded.lines))
 }
 

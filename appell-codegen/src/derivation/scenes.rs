@@ -12,10 +12,10 @@ use appell_symbolic::{Id, SymbolicError};
 use super::energies::Energies;
 use super::loads::Equations;
 use super::reduction::{reduce_state, ReductionInputs};
-use super::{text, Derivation};
+use super::{complete, text, Derivation, Options};
 use crate::algebra::expanded;
 use crate::ctxt::Ctxt;
-use crate::model::{Model, Scene};
+use crate::model::{ConstraintSet, Model, Scene, Twin};
 
 /// Derives `scene` of `full`; errors go to `cx`, spanned by the scene's
 /// name.
@@ -100,6 +100,7 @@ fn scene_derivation(
         },
         structured: Err("a scene uses the closed form".into()),
         projection: None,
+        own_constraints: None,
         closed_form: full.closed_form,
         energies: Energies {
             kinetic: full.energies.kinetic,
@@ -114,6 +115,36 @@ fn scene_derivation(
     };
     d.text = text::equations_text(model, &d);
     Ok(d)
+}
+
+/// Derives `scene`, which leaves some of the model's constraints out or
+/// names its own speeds: stages 1 to 13 again with its constraints and
+/// speeds in place of the model's (and the twin's constraints likewise),
+/// then its effects' loads as for any scene. The model is left as it was.
+pub fn derive_constrained_scene(
+    cx: &Ctxt,
+    model: &mut Model,
+    twin: Option<&Twin>,
+    scene: &Scene,
+    options: &Options,
+) -> Option<Derivation> {
+    let mut own = ConstraintSet::of_scene(model, scene)?;
+    let twin = twin.map(|t| own.twin(t, scene));
+    own.swap(model);
+    let errors = cx.error_count();
+    let d =
+        complete(cx, model, twin, options).and_then(|full| derive_scene(cx, model, &full, scene));
+    own.swap(model);
+    if d.is_none() && cx.error_count() == errors {
+        cx.error_spanned_by(
+            &scene.name,
+            format!("deriving scene `{}` failed", scene.name),
+        );
+    }
+    d.map(|mut d| {
+        d.own_constraints = Some(own);
+        d
+    })
 }
 
 #[cfg(test)]
@@ -141,5 +172,32 @@ mod tests {
         assert_agrees(&mut g, scene.equations.forcing[0], "0");
         assert!(g.is_zero(scene.energies.input_power));
         assert_eq!(scene.equations.mass, full.equations.mass);
+    }
+
+    #[test]
+    fn a_scene_without_the_rolling_contact_slides_with_its_own_speeds() {
+        // Sliding, the disc's centre and its spin move independently: the
+        // push accelerates the centre only, f/m, and nothing turns it.
+        let src = testing::DISC_ON_A_LINE.replace(
+            "#[appell(rolls(disc, contact = P))]",
+            "#[appell(rolls(disc, contact = P, effect = rolling))]\n#[appell(scene(sliding, effects(push), speeds(x, phi)))]",
+        );
+        let cx = Ctxt::new();
+        let derived = derive(&cx, testing::kinematics(&src)).expect("derivation");
+        cx.check().expect("no errors");
+        let (full, (_, sliding)) = (&derived.full, &derived.scenes[0]);
+        assert_eq!((full.m, full.l), (1, 1));
+        assert_eq!((sliding.m, sliding.l), (0, 2));
+        assert!(sliding.own_constraints.is_some());
+        let mut g = derived.model.g.clone();
+        assert_agrees(&mut g, sliding.equations.mass[0], "m");
+        assert_agrees(&mut g, sliding.equations.mass[3], "j");
+        assert_agrees(&mut g, sliding.equations.forcing[0], "f");
+        assert_agrees(&mut g, sliding.equations.forcing[1], "0");
+        // The model is left with its own constraint and speed.
+        assert_eq!(
+            (derived.model.rolling.len(), derived.model.speed_specs.len()),
+            (1, 1)
+        );
     }
 }

@@ -222,9 +222,12 @@ impl Run {
             &partials,
             &self.map,
             &self.calculus.rules,
+            &mut self.rates.fixed,
         )
         .expect("equations");
-        let energies = super::energies::energies(model, &partials, &self.map).expect("energies");
+        let energies =
+            super::energies::energies(model, &partials, &self.map, &mut self.rates.fixed)
+                .expect("energies");
         Later {
             folded_lines: folded.lines,
             equations,

@@ -230,11 +230,46 @@ fn camel(s: &str) -> String {
 /// The `Model` implementations: the full model's, and one per scene on a
 /// generated newtype (`{Model}{Scene}(pub Model)`), all in one `const _`
 /// block; the scene types are declared beside the struct.
-pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
+pub fn emit(derived: &mut Derived, vis: &syn::Visibility) -> TokenStream {
+    let p = p();
+    let mut body = full_implementation(derived);
+    let mut decls = TokenStream::new();
+    for k in 0..derived.scenes.len() {
+        // A scene with constraints or speeds of its own is emitted with
+        // them in the model's place.
+        let mut own = derived.scenes[k].1.own_constraints.clone();
+        if let Some(o) = own.as_mut() {
+            o.swap(&mut derived.model);
+        }
+        let (decl, implementation) = scene_implementation(derived, k, vis);
+        if let Some(o) = own.as_mut() {
+            o.swap(&mut derived.model);
+        }
+        decls.extend(decl);
+        body.extend(implementation);
+    }
+    quote! {
+        #decls
+        const _: () = {
+            #[allow(unused_imports)]
+            use #p::Scalar as _;
+            #body
+        };
+    }
+}
+
+/// The type of scene `name` of `base`: `{Base}{Name}`.
+fn scene_type(base: &syn::Ident, name: &syn::Ident) -> syn::Ident {
+    format_ident!("{}{}", base, camel(&name.to_string()))
+}
+
+/// The full model's implementation, the scene infos' static and the
+/// files it includes.
+fn full_implementation(derived: &Derived) -> TokenStream {
     let p = p();
     let (model, full, scenes) = (&derived.model, &derived.full, &derived.scenes);
     let base = &model.name;
-    let scene_type = |name: &syn::Ident| format_ident!("{}{}", base, camel(&name.to_string()));
+    let scene_type = |name: &syn::Ident| scene_type(base, name);
     let scene_infos = scenes.iter().map(|(s, _)| info_static(&s.name));
     let count = int(scenes.len());
     let mut body = quote! {
@@ -257,34 +292,28 @@ pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
     // includes, so a changed URDF builds the model again.
     let files = &model.files;
     body.extend(quote!(#(const _: &[u8] = ::core::include_bytes!(#files);)*));
-    let mut decls = TokenStream::new();
-    for (scene, d) in scenes {
-        let name = &scene.name;
-        let emitter = Emitter {
-            model,
-            d,
-            scene: Some(scene),
-            type_name: scene_type(name),
-            this: quote!(self.0),
-            info_ident: info_static(name),
-            scene_infos: quote!(&[]),
-            scene_rhs: TokenStream::new(),
-        };
-        decls.extend(newtype(
-            base,
-            &emitter.type_name,
-            name,
-            &emitter.effects(),
-            vis,
-        ));
-        body.extend(emitter.implementation());
-    }
-    quote! {
-        #decls
-        const _: () = {
-            #[allow(unused_imports)]
-            use #p::Scalar as _;
-            #body
-        };
-    }
+    body
+}
+
+/// Scene `k`'s newtype declaration and its implementation.
+fn scene_implementation(
+    derived: &Derived,
+    k: usize,
+    vis: &syn::Visibility,
+) -> (TokenStream, TokenStream) {
+    let model = &derived.model;
+    let (scene, d) = &derived.scenes[k];
+    let (base, name) = (&model.name, &scene.name);
+    let emitter = Emitter {
+        model,
+        d,
+        scene: Some(scene),
+        type_name: scene_type(base, name),
+        this: quote!(self.0),
+        info_ident: info_static(name),
+        scene_infos: quote!(&[]),
+        scene_rhs: TokenStream::new(),
+    };
+    let decl = newtype(base, &emitter.type_name, name, &emitter.effects(), vis);
+    (decl, emitter.implementation())
 }

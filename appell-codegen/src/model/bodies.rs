@@ -99,6 +99,7 @@ impl Builder<'_> {
                 .map(|residual| Constraint {
                     residual,
                     at: c.at.clone(),
+                    effect: c.effect.as_ref().map(|e| e.to_string()),
                 })
                 .collect(),
             Err(e) => {
@@ -296,6 +297,7 @@ impl Builder<'_> {
                 None => None,
             };
             rolling.push(Rolling {
+                effect: r.effect.as_ref().map(|e| e.to_string()),
                 body: bi,
                 contact,
                 along,

@@ -96,7 +96,23 @@ pub(super) fn build_in(
     let rolling = b.rolling_contacts(ast, &bodies);
     let (speed_specs, speeds_at) = b.speeds(ast);
     let speeds: Vec<usize> = speed_specs.iter().filter_map(|s| s.coordinate).collect();
-    let scenes = b.scenes(ast, &loads.effects);
+    // Effects: the loads', then those only constraints name.
+    let mut effects = loads.effects.clone();
+    let mut constraint_effects: Vec<String> = Vec::new();
+    let named = holonomic
+        .iter()
+        .chain(&nonholonomic)
+        .map(|c| &c.effect)
+        .chain(rolling.iter().map(|r| &r.effect));
+    for e in named.flatten() {
+        if !constraint_effects.contains(e) {
+            constraint_effects.push(e.clone());
+        }
+        if !effects.contains(e) {
+            effects.push(e.clone());
+        }
+    }
+    let scenes = b.scenes(ast, &effects, &constraint_effects, &speed_specs);
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
             ast.name.span(),
@@ -125,7 +141,7 @@ pub(super) fn build_in(
         rolling,
         forces: loads.forces,
         torques: loads.torques,
-        effects: loads.effects,
+        effects,
         scenes,
         gravity: loads.gravity,
         norms: b.norms,

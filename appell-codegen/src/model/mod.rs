@@ -134,10 +134,13 @@ pub struct Rolling {
     pub point: String,
     /// The item's tokens, for errors.
     pub at: proc_macro2::TokenStream,
+    /// The effect it belongs to; None: every scene keeps it.
+    pub effect: Option<String>,
 }
 
-/// `scene(name, effects(...), outputs(...))`: a specialised rhs with the
-/// chosen effects' loads only, and the requested outputs.
+/// `scene(name, effects(...), outputs(...), speeds(...))`: a specialised
+/// rhs with the chosen effects' loads and constraints only, its own
+/// privileged speeds when given, and the requested outputs.
 #[derive(Clone)]
 pub struct Scene {
     /// The scene's name.
@@ -150,6 +153,92 @@ pub struct Scene {
     /// The outputs asked for, by kind (`quadrature`, `energies`,
     /// `contact_forces`), in declaration order.
     pub outputs: Vec<String>,
+    /// Its own privileged speeds (`speeds(...)`) and their tokens.
+    pub speeds: Option<(Vec<SpeedSpec>, proc_macro2::TokenStream)>,
+}
+
+impl Scene {
+    /// Whether the scene keeps a constraint of `effect` (one without an
+    /// effect is in every scene).
+    pub fn keeps_constraint(&self, effect: &Option<String>) -> bool {
+        effect.as_ref().is_none_or(|e| self.effects.contains(e))
+    }
+}
+
+/// The constraints and privileged speeds a scene is derived with, where
+/// they differ from the model's: its constraints are those without an
+/// effect or of an effect it names, its speeds its own `speeds(...)`.
+#[derive(Clone)]
+pub struct ConstraintSet {
+    /// Holonomic constraints.
+    pub holonomic: Vec<Constraint>,
+    /// Nonholonomic constraints.
+    pub nonholonomic: Vec<Constraint>,
+    /// Rolling contacts.
+    pub rolling: Vec<Rolling>,
+    /// The coordinates whose rates are privileged speeds.
+    pub speeds: Vec<usize>,
+    /// The privileged speeds.
+    pub speed_specs: Vec<SpeedSpec>,
+    /// The tokens of the scene's `speeds(...)`, for errors.
+    pub speeds_at: proc_macro2::TokenStream,
+}
+
+impl ConstraintSet {
+    /// `scene`'s constraints and speeds, or None when they are the model's.
+    pub fn of_scene(model: &Model, scene: &Scene) -> Option<ConstraintSet> {
+        let keeps = |e: &Option<String>| scene.keeps_constraint(e);
+        let drops = model
+            .holonomic
+            .iter()
+            .chain(&model.nonholonomic)
+            .any(|c| !keeps(&c.effect))
+            || model.rolling.iter().any(|r| !keeps(&r.effect));
+        if !drops && scene.speeds.is_none() {
+            return None;
+        }
+        let (speed_specs, speeds_at) = scene
+            .speeds
+            .clone()
+            .unwrap_or_else(|| (model.speed_specs.clone(), model.speeds_at.clone()));
+        let kept = |list: &[Constraint]| -> Vec<Constraint> {
+            list.iter().filter(|c| keeps(&c.effect)).cloned().collect()
+        };
+        Some(ConstraintSet {
+            holonomic: kept(&model.holonomic),
+            nonholonomic: kept(&model.nonholonomic),
+            rolling: model
+                .rolling
+                .iter()
+                .filter(|r| keeps(&r.effect))
+                .cloned()
+                .collect(),
+            speeds: speed_specs.iter().filter_map(|s| s.coordinate).collect(),
+            speed_specs,
+            speeds_at,
+        })
+    }
+
+    /// Exchanges these constraints and speeds with `model`'s: once to
+    /// derive or emit the scene, once more to restore the model.
+    pub fn swap(&mut self, model: &mut Model) {
+        std::mem::swap(&mut self.holonomic, &mut model.holonomic);
+        std::mem::swap(&mut self.nonholonomic, &mut model.nonholonomic);
+        std::mem::swap(&mut self.rolling, &mut model.rolling);
+        std::mem::swap(&mut self.speeds, &mut model.speeds);
+        std::mem::swap(&mut self.speed_specs, &mut model.speed_specs);
+        std::mem::swap(&mut self.speeds_at, &mut model.speeds_at);
+    }
+
+    /// `twin` with `scene`'s constraints only.
+    pub fn twin(&self, twin: &Twin, scene: &Scene) -> Twin {
+        let keeps = |e: &Option<String>| scene.keeps_constraint(e);
+        let mut t = twin.clone();
+        t.holonomic.retain(|c| keeps(&c.effect));
+        t.nonholonomic.retain(|c| keeps(&c.effect));
+        t.rolling.retain(|r| keeps(&r.effect));
+        t
+    }
 }
 
 /// One privileged speed ẏ_k.
@@ -174,6 +263,8 @@ pub struct Constraint {
     pub residual: Id,
     /// Its tokens, for errors.
     pub at: proc_macro2::TokenStream,
+    /// The effect it belongs to; None: every scene keeps it.
+    pub effect: Option<String>,
 }
 
 /// The resolved model.
@@ -295,6 +386,7 @@ pub struct Cut {
 /// differentiates through it where it wants a constraint row or a velocity
 /// as written, not multiplied out. Its entries match the model's one for
 /// one (the same frames, bodies, constraints and contacts, in order).
+#[derive(Clone)]
 pub struct Twin {
     /// The frames, their matrices made of direction-cosine symbols.
     pub frames: Vec<Frame>,

@@ -3,12 +3,18 @@
 //! `contact_forces`), each checked against the model.
 
 use super::builder::{hint, not_raw, Builder};
-use super::Scene;
+use super::{Scene, SpeedSpec};
 use crate::ast::*;
 
 impl Builder<'_> {
     /// The declared scenes that check out; the others are reported.
-    pub(super) fn scenes(&mut self, ast: &ModelAst, effects: &[String]) -> Vec<Scene> {
+    pub(super) fn scenes(
+        &mut self,
+        ast: &ModelAst,
+        effects: &[String],
+        constraint_effects: &[String],
+        model_speeds: &[SpeedSpec],
+    ) -> Vec<Scene> {
         let cx = self.cx;
         let mut scenes = Vec::new();
         for sc in &ast.scenes {
@@ -97,15 +103,87 @@ impl Builder<'_> {
             if !not_raw(cx, &sc.name, "scene") {
                 ok = false;
             }
+            let left_out: Vec<&String> = constraint_effects
+                .iter()
+                .filter(|e| !sc.effects.iter().any(|s| s == *e))
+                .collect();
+            if !left_out.is_empty() && sc.speeds.is_none() {
+                let names: Vec<String> = left_out.iter().map(|e| format!("`{e}`")).collect();
+                cx.error_spanned_by(
+                    &sc.name,
+                    format!(
+                        "scene `{}` leaves out the constraints of {}, so it moves with more degrees of freedom than the model: name all its privileged speeds with `speeds(...)` in the scene (or name the effect in `effects(...)` to keep the constraints)",
+                        sc.name,
+                        names.join(", ")
+                    ),
+                );
+                ok = false;
+            }
+            let speeds = match &sc.speeds {
+                Some((list, at)) => match self.scene_speeds(list, model_speeds) {
+                    Some(specs) => Some((specs, at.clone())),
+                    None => {
+                        ok = false;
+                        None
+                    }
+                },
+                None => None,
+            };
             if ok {
                 scenes.push(Scene {
                     name: sc.name.clone(),
                     effects: sc.effects.iter().map(|e| e.to_string()).collect(),
                     quadrature,
                     outputs,
+                    speeds,
                 });
             }
         }
         scenes
+    }
+
+    /// A scene's `speeds(...)`: each a coordinate (its rate) or one of the
+    /// model's quasi-velocities, once; None after reporting an error.
+    fn scene_speeds(
+        &self,
+        list: &[syn::Ident],
+        model_speeds: &[SpeedSpec],
+    ) -> Option<Vec<SpeedSpec>> {
+        let mut out: Vec<SpeedSpec> = Vec::new();
+        let mut ok = true;
+        for name in list {
+            let text = name.to_string();
+            if out.iter().any(|s| s.name == text) {
+                self.cx
+                    .error_spanned_by(name, format!("duplicate speed `{text}`"));
+                ok = false;
+                continue;
+            }
+            if let Some(spec) = model_speeds.iter().find(|s| s.name == text) {
+                out.push(spec.clone());
+                continue;
+            }
+            match self.coords.iter().position(|(c, _)| *c == *name) {
+                Some(i) => {
+                    let c = self.coords[i].1;
+                    out.push(SpeedSpec {
+                        name: text,
+                        symbol: c.rate,
+                        accel: c.accel,
+                        coordinate: Some(i),
+                        definition: None,
+                    });
+                }
+                None => {
+                    let h = hint(&text, self.coords.iter().map(|(c, _)| c.to_string()));
+                    self.cx.error_spanned_by(
+                        name,
+                        format!("`{text}` is not a coordinate; a scene's speeds are coordinates or the model's quasi-velocities{h}"),
+                    );
+                    ok = false;
+                }
+            }
+        }
+        ok.then_some(out)
     }
 }

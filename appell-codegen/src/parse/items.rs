@@ -163,6 +163,7 @@ pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
     let name: Ident = s.parse()?;
     let mut effects = Vec::new();
     let mut outputs = Vec::new();
+    let mut speeds = None;
     while !s.is_empty() {
         s.parse::<Token![,]>()?;
         if s.is_empty() {
@@ -171,6 +172,7 @@ pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
         let item: Item = s.parse()?;
         match item.name.to_string().as_str() {
             "effects" => effects.extend(ident_list(item.content)?),
+            "speeds" => speeds = Some((ident_list(item.content)?, item.all)),
             "outputs" => {
                 let list = Parser::parse2(
                     Punctuated::<OutputItem, Token![,]>::parse_terminated,
@@ -184,7 +186,7 @@ pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
                 return Err(syn::Error::new(
                     item.name.span(),
                     format!(
-                    "unknown scene part `{other}`; a scene has `effects(...)` and `outputs(...)`"
+                    "unknown scene part `{other}`; a scene has `effects(...)`, `outputs(...)` and `speeds(...)`"
                 ),
                 ))
             }
@@ -194,21 +196,23 @@ pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
         name,
         effects,
         outputs,
+        speeds,
     })
 }
 
 pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<RollsDef> {
     let body: Ident = s.parse()?;
-    let (mut contact, mut along) = (None, None);
+    let (mut contact, mut along, mut effect) = (None, None, None);
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
             "contact" => contact = Some(expr_ident(&v)?),
+            "effect" => effect = Some(expr_ident(&v)?),
             "along" => match &v {
                 syn::Expr::Array(a) => along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?),
                 other => return Err(syn::Error::new(other.span(), "`along` takes a list of directions: `along = [A.x, A.y]`")),
             },
             other => {
-                return Err(syn::Error::new(k.span(), format!("unknown rolling property `{other}`; use `contact = P` and optionally `along = [u, v]`")))
+                return Err(syn::Error::new(k.span(), format!("unknown rolling property `{other}`; use `contact = P` and optionally `along = [u, v]` and `effect = name`")))
             }
         }
     }
@@ -222,6 +226,7 @@ pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::
         body,
         contact,
         along,
+        effect,
         at,
     })
 }
@@ -356,12 +361,13 @@ pub(super) fn parse_constraint(
     at: proc_macro2::TokenStream,
 ) -> syn::Result<ConstraintDef> {
     let e: syn::Expr = s.parse()?;
-    let mut along = None;
+    let (mut along, mut effect) = (None, None);
     for (k, v) in key_values(s)? {
         match (k.to_string().as_str(), &v) {
             ("along", syn::Expr::Array(a)) => {
                 along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?)
             }
+            ("effect", _) => effect = Some(expr_ident(&v)?),
             ("along", other) => {
                 return Err(syn::Error::new(
                     other.span(),
@@ -371,7 +377,7 @@ pub(super) fn parse_constraint(
             (other, _) => {
                 return Err(syn::Error::new(
                     k.span(),
-                    format!("unknown constraint property `{other}`; an equation between points or vectors takes `along = [u, v]`"),
+                    format!("unknown constraint property `{other}`; a constraint takes `effect = name`, and an equation between points or vectors `along = [u, v]`"),
                 ))
             }
         }
@@ -381,6 +387,7 @@ pub(super) fn parse_constraint(
             lhs: convert(&b.left)?,
             rhs: convert(&b.right)?,
             along,
+            effect,
             at,
         }),
         _ => Err(syn::Error::new(

@@ -466,6 +466,7 @@ fn ball(j: &JointDef, out: &mut Lowered) -> Box<[Expr; 4]> {
         lhs: norm,
         rhs: Expr::Int(1, span),
         along: None,
+        effect: None,
         at: quote::quote_spanned!(span=> #(#e)*),
     });
     Box::new(e.map(Expr::Name))

@@ -469,6 +469,7 @@ fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, 
             lhs: Expr::Name(tree.joints[j].clone()),
             rhs,
             along: None,
+            effect: None,
             at: quote::quote!(#path),
         });
     }

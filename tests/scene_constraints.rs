@@ -1,0 +1,173 @@
+//! Scenes that leave constraints out: a constraint that belongs to an
+//! effect (`effect = grip`) is kept only by the scenes that name it, and a
+//! scene with fewer constraints names its own privileged speeds. Each such
+//! scene is derived again with its own constraints, so it costs what a
+//! model written with that constraint set alone costs, and moves as it.
+
+mod common;
+use appell::{Appell, Model};
+use common::Rng;
+
+/// The Chaplygin sleigh on an incline whose knife edge either grips (the
+/// `grip` constraint: no sideways velocity at P) or skids sideways against
+/// a viscous drag.
+#[allow(clippy::duplicated_attributes)] // the scenes name effects alike
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(x, y, theta), speeds(x, theta), positive(m, b))]
+#[appell(frame(B = N.rotate_z(theta)))]
+#[appell(point(P = O + x * N.x + y * N.y), point(C = P + b * B.x))]
+#[appell(body(sleigh, center = C, frame = B, mass = m, inertia = principal(i0, i0, i0)))]
+#[appell(nonholonomic(dt(y) * cos(theta) - dt(x) * sin(theta) == 0, effect = grip))]
+#[appell(force(C, m * g * sin(alpha) * N.x, effect = gravity))]
+#[appell(force(P, -c * dot(velocity(P), B.y) * B.y, effect = drag))]
+#[appell(scene(gripping, effects(gravity, grip)))]
+#[appell(scene(skidding, effects(gravity, drag), speeds(x, y, theta)))]
+struct Sleigh {
+    m: f64,
+    i0: f64,
+    b: f64,
+    g: f64,
+    alpha: f64,
+    c: f64,
+}
+
+/// The skidding sleigh written on its own: no constraint, three speeds.
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(x, y, theta), speeds(x, y, theta), positive(m, b))]
+#[appell(frame(B = N.rotate_z(theta)))]
+#[appell(point(P = O + x * N.x + y * N.y), point(C = P + b * B.x))]
+#[appell(body(sleigh, center = C, frame = B, mass = m, inertia = principal(i0, i0, i0)))]
+#[appell(force(C, m * g * sin(alpha) * N.x, effect = gravity))]
+#[appell(force(P, -c * dot(velocity(P), B.y) * B.y, effect = drag))]
+struct SkiddingSleigh {
+    m: f64,
+    i0: f64,
+    b: f64,
+    g: f64,
+    alpha: f64,
+    c: f64,
+}
+
+/// The gripping sleigh written on its own, with gravity only.
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(x, y, theta), speeds(x, theta), positive(m, b))]
+#[appell(frame(B = N.rotate_z(theta)))]
+#[appell(point(P = O + x * N.x + y * N.y), point(C = P + b * B.x))]
+#[appell(body(sleigh, center = C, frame = B, mass = m, inertia = principal(i0, i0, i0)))]
+#[appell(nonholonomic(dt(y) * cos(theta) - dt(x) * sin(theta) == 0))]
+#[appell(force(C, m * g * sin(alpha) * N.x, effect = gravity))]
+struct GrippingSleigh {
+    m: f64,
+    i0: f64,
+    b: f64,
+    g: f64,
+    alpha: f64,
+}
+
+fn sleigh(rng: &mut Rng) -> Sleigh {
+    Sleigh {
+        m: rng.uniform(0.5, 2.0),
+        i0: rng.uniform(0.02, 0.2),
+        b: rng.uniform(0.1, 0.5),
+        g: 9.81,
+        alpha: rng.uniform(0.05, 0.5),
+        c: rng.uniform(0.5, 5.0),
+    }
+}
+
+/// The reduced rhs of `model` at its reduced state `x`.
+fn rhs<M: Model>(model: &M, x: &[f64]) -> Vec<f64> {
+    let mut dx = vec![0.0; x.len()];
+    model
+        .rhs(&model.prepare::<f64>(), 0.0, x, &[], &mut dx)
+        .expect("the rhs evaluates");
+    dx
+}
+
+#[test]
+fn a_scene_without_a_constraint_has_its_own_speeds_and_state() {
+    let infos = Sleigh::scene_infos();
+    let names: Vec<&str> = infos.iter().map(|i| i.name).collect();
+    assert_eq!(names, ["Sleigh::gripping", "Sleigh::skidding"]);
+    let (gripping, skidding) = (infos[0], infos[1]);
+    assert_eq!(gripping.speeds, ["x", "theta"]);
+    assert_eq!((gripping.constraints, gripping.dependent), (1, &["y"][..]));
+    assert_eq!(skidding.speeds, ["x", "y", "theta"]);
+    assert_eq!((skidding.constraints, skidding.dependent), (0, &[][..]));
+    // Nothing depends on where the sleigh is: x and y leave the state.
+    assert_eq!(skidding.retained, ["theta"]);
+    assert_eq!(skidding.state_len(), 4);
+    assert_eq!(Sleigh::info().effects, ["gravity", "drag", "grip"]);
+    for info in [Sleigh::info(), gripping, skidding] {
+        println!(
+            "{}: state {:?} + {:?}, {} ops",
+            info.name, info.retained, info.speeds, info.rhs_ops.total
+        );
+    }
+}
+
+#[test]
+fn each_scene_costs_and_moves_as_the_model_written_with_its_constraints_alone() {
+    // The same equations, lowered from a graph holding other expressions
+    // too: the shared subexpressions may be grouped differently, by an
+    // operation or two (as for the load-only scenes of tests/scene_costs.rs).
+    let pairs = [
+        ("skidding", SleighSkidding::info(), SkiddingSleigh::info()),
+        ("gripping", SleighGripping::info(), GrippingSleigh::info()),
+    ];
+    for (label, scene, alone) in pairs {
+        let (a, b) = (scene.rhs_ops.total, alone.rhs_ops.total);
+        println!("{label}: scene {a} ops, written alone {b} ops");
+        assert!(
+            a.abs_diff(b) as f64 <= 0.05 * b as f64,
+            "{label}: {a} against {b}"
+        );
+        assert_eq!(
+            (scene.speeds, scene.retained),
+            (alone.speeds, alone.retained)
+        );
+    }
+    let mut rng = Rng(23);
+    let mut worst = 0.0f64;
+    for _ in 0..20 {
+        let s = sleigh(&mut rng);
+        let alone = SkiddingSleigh {
+            m: s.m,
+            i0: s.i0,
+            b: s.b,
+            g: s.g,
+            alpha: s.alpha,
+            c: s.c,
+        };
+        let x: Vec<f64> = (0..4).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let (a, b) = (rhs(SleighSkidding::from_ref(&s), &x), rhs(&alone, &x));
+        let gripping = GrippingSleigh {
+            m: s.m,
+            i0: s.i0,
+            b: s.b,
+            g: s.g,
+            alpha: s.alpha,
+        };
+        let xg: Vec<f64> = (0..SleighGripping::info().state_len())
+            .map(|_| rng.uniform(-2.0, 2.0))
+            .collect();
+        let (c, d) = (rhs(SleighGripping::from_ref(&s), &xg), rhs(&gripping, &xg));
+        // The whole model grips too, and its drag, across a velocity that
+        // the grip holds at zero, does nothing.
+        let full = rhs(&s, &xg);
+        for (p, q) in full.iter().zip(&c) {
+            worst = worst.max((p - q).abs() / (1.0 + q.abs()));
+        }
+        for (p, q) in a.iter().zip(&b).chain(c.iter().zip(&d)) {
+            worst = worst.max((p - q).abs() / (1.0 + q.abs()));
+        }
+        // The drag matters when skidding: a different drag moves it differently.
+        let stiffer = Sleigh {
+            c: s.c * 2.0,
+            ..s.clone()
+        };
+        let e = rhs(SleighSkidding::from_ref(&stiffer), &x);
+        assert!(e.iter().zip(&a).any(|(p, q)| (p - q).abs() > 1e-6) || x[2].abs() < 1e-9);
+    }
+    assert!(worst <= 1e-14, "scene against the model alone: {worst:e}");
+}
