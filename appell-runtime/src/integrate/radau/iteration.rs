@@ -2,7 +2,7 @@
 //! complex Newton system, `γ/h − J` and `(α − iβ)/h − J`.
 
 use super::coefficients::{ALPHA, BETA, GAMMA};
-use super::linear::{Lu, C64};
+use super::linear::{factor_pair, solve_pair, Lu, C64};
 use super::stats::Radau5Stats;
 use crate::integrate::implicit::all_finite;
 use crate::integrate::solution::IntegrateError;
@@ -67,10 +67,8 @@ impl Iteration {
             return true;
         }
         stats.lu_factorizations += 1;
-        let ok = self.real.factor_shifted(GAMMA / hs, &self.jac)
-            && self
-                .complex
-                .factor_shifted(C64::new(ALPHA / hs, -BETA / hs), &self.jac);
+        let mu = C64::new(ALPHA / hs, -BETA / hs);
+        let ok = factor_pair(&mut self.real, &mut self.complex, GAMMA / hs, mu, &self.jac);
         self.lu_h = ok.then_some(hs);
         ok
     }
@@ -87,8 +85,9 @@ impl Iteration {
         self.real.solve(b);
     }
 
-    /// Solves `((α − iβ)/h − J) y = b` in place.
-    pub(super) fn solve_complex(&self, b: &mut [C64]) {
-        self.complex.solve(b);
+    /// Solves `(γ/h − J) y = b` and `((α − iβ)/h − J) w = c` in place, in
+    /// one interleaved pass.
+    pub(super) fn solve_both(&self, b: &mut [f64], c: &mut [C64]) {
+        solve_pair(&self.real, &self.complex, b, c);
     }
 }

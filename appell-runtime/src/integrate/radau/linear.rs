@@ -117,6 +117,7 @@ impl<T: Entry> Lu<T> {
 
     /// Factors `shift · I − J` (`jac` row-major n×n); false when a pivot
     /// is zero or not finite (the factors are then unusable).
+    #[cfg(test)]
     pub(super) fn factor_shifted(&mut self, shift: T, jac: &[f64]) -> bool {
         let n = self.n;
         for (v, &j) in self.a.iter_mut().zip(jac) {
@@ -128,39 +129,45 @@ impl<T: Entry> Lu<T> {
         self.factor()
     }
 
-    /// In-place Doolittle factorization with partial pivoting (rows are
-    /// eliminated by slices, each with one multiplication by the pivot's
-    /// reciprocal).
+    /// In-place Doolittle factorization with partial pivoting.
+    #[cfg(test)]
     fn factor(&mut self) -> bool {
+        (0..self.n).all(|k| self.eliminate(k))
+    }
+
+    /// Step `k` of the factorization: the pivot of column `k`, the row
+    /// exchange and the elimination below it (rows by slices, each with
+    /// one multiplication by the pivot's reciprocal); false when the pivot
+    /// is zero or not finite.
+    #[inline(always)]
+    fn eliminate(&mut self, k: usize) -> bool {
         let n = self.n;
         let a = &mut self.a;
-        for k in 0..n {
-            let mut p = k;
-            let mut m = a[k * n + k].magnitude();
-            for i in k + 1..n {
-                let v = a[i * n + k].magnitude();
-                if v > m {
-                    (p, m) = (i, v);
-                }
+        let mut p = k;
+        let mut m = a[k * n + k].magnitude();
+        for i in k + 1..n {
+            let v = a[i * n + k].magnitude();
+            if v > m {
+                (p, m) = (i, v);
             }
-            if m == 0.0 || !m.is_finite() {
-                return false;
-            }
-            self.pivots[k] = p;
-            if p != k {
-                let (upper, lower) = a.split_at_mut(p * n);
-                upper[k * n..(k + 1) * n].swap_with_slice(&mut lower[..n]);
-            }
-            let (upper, lower) = a.split_at_mut((k + 1) * n);
-            let pivot_row = &upper[k * n + k + 1..];
-            let inv = T::real(1.0) / upper[k * n + k];
-            self.inv_diag[k] = inv;
-            for row in lower.chunks_exact_mut(n) {
-                let l = row[k] * inv;
-                row[k] = l;
-                for (r, &u) in row[k + 1..].iter_mut().zip(pivot_row) {
-                    *r = *r - l * u;
-                }
+        }
+        if m == 0.0 || !m.is_finite() {
+            return false;
+        }
+        self.pivots[k] = p;
+        if p != k {
+            let (upper, lower) = a.split_at_mut(p * n);
+            upper[k * n..(k + 1) * n].swap_with_slice(&mut lower[..n]);
+        }
+        let (upper, lower) = a.split_at_mut((k + 1) * n);
+        let pivot_row = &upper[k * n + k + 1..];
+        let inv = T::real(1.0) / upper[k * n + k];
+        self.inv_diag[k] = inv;
+        for row in lower.chunks_exact_mut(n) {
+            let l = row[k] * inv;
+            row[k] = l;
+            for (r, &u) in row[k + 1..].iter_mut().zip(pivot_row) {
+                *r = *r - l * u;
             }
         }
         true
@@ -187,6 +194,65 @@ impl<T: Entry> Lu<T> {
             for i in 0..k {
                 b[i] = b[i] - a[i * n + k] * y;
             }
+        }
+    }
+}
+
+/// Factors `g · I − J` into `real` and `mu · I − J` into `complex` (as
+/// [`Lu::factor_shifted`] of each), their eliminations interleaved column
+/// by column so that the processor can overlap the two; false when either
+/// matrix is singular.
+pub(super) fn factor_pair(
+    real: &mut Lu<f64>,
+    complex: &mut Lu<C64>,
+    g: f64,
+    mu: C64,
+    jac: &[f64],
+) -> bool {
+    let n = real.n;
+    assert_eq!(complex.n, n);
+    let entries = real.a.iter_mut().zip(complex.a.iter_mut()).zip(jac);
+    for ((r, c), &j) in entries {
+        *r = -j;
+        *c = C64::real(-j);
+    }
+    for i in 0..n {
+        real.a[i * n + i] += g;
+        complex.a[i * n + i] = complex.a[i * n + i] + mu;
+    }
+    (0..n).all(|k| real.eliminate(k) && complex.eliminate(k))
+}
+
+/// Solves `R y = b` and `C w = c` in place with the factors of the real
+/// matrix `R` and the complex matrix `C` of the same size, as
+/// [`Lu::solve`] of each but in one pass: each substitution is a chain of
+/// dependent operations, and interleaving the two independent chains lets
+/// the processor overlap them.
+pub(super) fn solve_pair(real: &Lu<f64>, complex: &Lu<C64>, b: &mut [f64], c: &mut [C64]) {
+    let n = real.n;
+    assert_eq!(complex.n, n);
+    let (ar, ac) = (&real.a[..n * n], &complex.a[..n * n]);
+    let (b, c) = (&mut b[..n], &mut c[..n]);
+    let pivots = real.pivots.iter().zip(&complex.pivots);
+    for (k, (&p, &q)) in pivots.enumerate() {
+        b.swap(k, p);
+        c.swap(k, q);
+    }
+    for k in 0..n {
+        let (y, z) = (b[k], c[k]);
+        for i in k + 1..n {
+            b[i] -= ar[i * n + k] * y;
+            c[i] = c[i] - ac[i * n + k] * z;
+        }
+    }
+    for k in (0..n).rev() {
+        let y = b[k] * real.inv_diag[k];
+        let z = c[k] * complex.inv_diag[k];
+        b[k] = y;
+        c[k] = z;
+        for i in 0..k {
+            b[i] -= ar[i * n + k] * y;
+            c[i] = c[i] - ac[i * n + k] * z;
         }
     }
 }
@@ -232,6 +298,45 @@ mod tests {
         }
         assert_eq!(C64::new(1.0, 2.0) / C64::new(0.0, 1.0), C64::new(2.0, -1.0));
         assert_eq!(-C64::new(1.0, -2.0), C64::new(-1.0, 2.0));
+    }
+
+    #[test]
+    fn paired_factors_and_solves_match_the_separate_ones() {
+        let jac = [2.0, 1.0, 0.0, 1.0, 2.0, 3.0, 4.0, 0.0, 1.0];
+        let mu = C64::new(1.5, -0.7);
+        let (mut lr, mut lc) = (Lu::<f64>::new(3), Lu::<C64>::new(3));
+        assert!(lr.factor_shifted(2.0, &jac));
+        assert!(lc.factor_shifted(mu, &jac));
+        let (mut pr, mut pc) = (Lu::<f64>::new(3), Lu::<C64>::new(3));
+        assert!(factor_pair(&mut pr, &mut pc, 2.0, mu, &jac));
+        assert_eq!(
+            (&pr.a, &pr.inv_diag, &pr.pivots),
+            (&lr.a, &lr.inv_diag, &lr.pivots)
+        );
+        assert_eq!(
+            (&pc.a, &pc.inv_diag, &pc.pivots),
+            (&lc.a, &lc.inv_diag, &lc.pivots)
+        );
+        // Singular: 2 I − J with J = 2 I.
+        assert!(!factor_pair(
+            &mut pr,
+            &mut pc,
+            2.0,
+            mu,
+            &[2.0, 0.0, 0.0, 0.0, 2.0, 0.0, 0.0, 0.0, 2.0]
+        ));
+        let b = [1.0, -2.0, 0.5];
+        let c = [
+            C64::new(1.0, 2.0),
+            C64::new(-0.5, 0.0),
+            C64::new(0.25, -3.0),
+        ];
+        let (mut b1, mut c1) = (b, c);
+        lr.solve(&mut b1);
+        lc.solve(&mut c1);
+        let (mut b2, mut c2) = (b, c);
+        solve_pair(&lr, &lc, &mut b2, &mut c2);
+        assert_eq!((b1, c1), (b2, c2));
     }
 
     #[test]

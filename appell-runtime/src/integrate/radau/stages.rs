@@ -176,8 +176,7 @@ impl Stages {
             *r = ti(&TI[0]) - g * u;
             *c = C64::new(ti(&TI[1]), ti(&TI[2])) - mu * C64::new(v, y);
         }
-        it.solve_real(&mut self.real);
-        it.solve_complex(&mut self.complex);
+        it.solve_both(&mut self.real, &mut self.complex);
         let mut s = 0.0;
         for ((a, z), sc) in self.real.iter().zip(&self.complex).zip(scal) {
             s += (a * a + z.re * z.re + z.im * z.im) / (sc * sc);
