@@ -171,3 +171,76 @@ fn each_scene_costs_and_moves_as_the_model_written_with_its_constraints_alone() 
     }
     assert!(worst <= 1e-14, "scene against the model alone: {worst:e}");
 }
+
+/// Full coordinates and the gripping sleigh's speeds at a random state.
+fn random_motion(rng: &mut Rng) -> ([f64; 3], Vec<f64>) {
+    let q = [
+        rng.uniform(-1.0, 1.0),
+        rng.uniform(-1.0, 1.0),
+        rng.uniform(-3.0, 3.0),
+    ];
+    (q, vec![rng.uniform(-2.0, 2.0), rng.uniform(-2.0, 2.0)])
+}
+
+#[test]
+fn releasing_the_grip_keeps_the_motion() {
+    use appell::switch::switch_state;
+    let mut rng = Rng(5);
+    for _ in 0..20 {
+        let s = sleigh(&mut rng);
+        let (q, u) = random_motion(&mut rng);
+        let (grip, skid) = (SleighGripping::from_ref(&s), SleighSkidding::from_ref(&s));
+        let out = switch_state(grip, skid, 0.0, &q, &u, &[], &[]).unwrap();
+        // The skidding speeds are the rates the gripping motion had.
+        let mut qdot = [0.0; 3];
+        grip.coordinate_rates(0.0, &q, &u, &mut qdot).unwrap();
+        for (a, b) in out.speeds.iter().zip(&qdot) {
+            assert!((a - b).abs() <= 1e-15 * (1.0 + b.abs()), "{a} against {b}");
+        }
+        assert!(out.impulses.is_empty());
+        assert!(
+            out.energy_lost().abs() <= 1e-14 * out.kinetic_before,
+            "{out:?}"
+        );
+        // And back: the motion still satisfies the grip, so nothing jumps.
+        let back = switch_state(skid, grip, 0.0, &q, &out.speeds, &[], &[]).unwrap();
+        assert!(back.impulses.is_empty());
+        for (a, b) in back.speeds.iter().zip(&u) {
+            assert!((a - b).abs() <= 1e-14 * (1.0 + b.abs()));
+        }
+    }
+}
+
+#[test]
+fn gripping_again_takes_the_sideways_impulse_and_its_energy() {
+    use appell::switch::switch_state;
+    let mut rng = Rng(11);
+    let mut worst = 0.0f64;
+    for _ in 0..20 {
+        let s = sleigh(&mut rng);
+        let q = [
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-1.0, 1.0),
+            rng.uniform(-3.0, 3.0),
+        ];
+        let u: Vec<f64> = (0..3).map(|_| rng.uniform(-2.0, 2.0)).collect();
+        let (grip, skid) = (SleighGripping::from_ref(&s), SleighSkidding::from_ref(&s));
+        let out = switch_state(skid, grip, 0.0, &q, &u, &[], &[]).unwrap();
+        // Closed form: the sideways velocity of the blade, v = ẏ cos θ −
+        // ẋ sin θ, is stopped by an impulse Λ at P along B.y, against the
+        // effective mass 1/(1/m + b²/I) the blade feels there.
+        let (sin, cos) = q[2].sin_cos();
+        let v = u[1] * cos - u[0] * sin;
+        let reduced = 1.0 / (1.0 / s.m + s.b * s.b / s.i0);
+        let (impulse, lost) = (-reduced * v, 0.5 * reduced * v * v);
+        let scale = 1.0 + impulse.abs();
+        worst = worst.max((out.impulses[0] - impulse).abs() / scale);
+        worst = worst.max((out.energy_lost() - lost).abs() / (1.0 + lost));
+        // After the switch the grip holds.
+        let after = out.qdot[1] * cos - out.qdot[0] * sin;
+        worst = worst.max(after.abs() / (1.0 + v.abs()));
+        assert_eq!(out.speeds, [out.qdot[0], out.qdot[2]]);
+    }
+    println!("impulse, energy lost and grip after the switch against the closed form: {worst:e}");
+    assert!(worst <= 1e-12, "against the closed form: {worst:e}");
+}

@@ -39,6 +39,8 @@ pub mod motion;
 pub mod oracle;
 pub mod precision;
 mod scalar;
+#[cfg(feature = "std")]
+pub mod switch;
 
 pub use model::{
     check_len, BodyInfo, ContactInfo, Model, ModelError, ModelInfo, OpCounts, RowSource,
