@@ -329,6 +329,17 @@ pub trait DynModel: sealed::Sealed {
         w0: &mut [f64],
     ) -> Result<(), ModelError>;
 
+    /// [`Model::mass_matrix_and_forcing`].
+    fn dyn_mass_matrix_and_forcing(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+        m: &mut [f64],
+        f: &mut [f64],
+    ) -> Result<(), ModelError>;
+
     /// [`Model::speed_definitions`] in [`Dual64`].
     fn dyn_speed_definitions_dual(
         &self,
@@ -615,6 +626,18 @@ impl<M: Model> DynModel for M {
         velocity: &mut [f64],
     ) -> Result<(), ModelError> {
         self.constraint_residuals(t, q, qdot, holonomic, velocity)
+    }
+
+    fn dyn_mass_matrix_and_forcing(
+        &self,
+        t: f64,
+        q: &[f64],
+        u: &[f64],
+        inputs: &[f64],
+        m: &mut [f64],
+        f: &mut [f64],
+    ) -> Result<(), ModelError> {
+        self.mass_matrix_and_forcing(t, q, u, inputs, m, f)
     }
 
     fn dyn_speed_definitions(

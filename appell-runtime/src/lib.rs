@@ -28,6 +28,8 @@ pub mod constraint_forces;
 pub mod dynamic;
 #[cfg(feature = "std")]
 pub mod energy;
+#[cfg(feature = "std")]
+pub mod hybrid;
 pub mod integrate;
 pub mod linalg;
 #[cfg(feature = "std")]

@@ -87,7 +87,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::model::{Model, ModelError, ModelInfo};
+use crate::dynamic::DynModel;
+use crate::model::{ModelError, ModelInfo};
 
 /// Relative size below which the target's constraint residual counts as
 /// satisfied (no impulse), and below which a singular value of G M⁻¹ Gᵀ
@@ -165,7 +166,7 @@ impl From<ModelError> for SwitchError {
 ///
 /// Errors: [`SwitchError::CoordinatesDiffer`], any model error, and
 /// [`SwitchError::Unattainable`].
-pub fn switch_state<A: Model, B: Model>(
+pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
     from: &A,
     to: &B,
     t: f64,
@@ -174,14 +175,14 @@ pub fn switch_state<A: Model, B: Model>(
     inputs_from: &[f64],
     inputs_to: &[f64],
 ) -> Result<Switched, SwitchError> {
-    let (ia, ib) = (A::info(), B::info());
+    let (ia, ib) = (from.dyn_info(), to.dyn_info());
     if ia.coordinates != ib.coordinates {
         return Err(SwitchError::CoordinatesDiffer);
     }
     let n = ia.coordinates.len();
     let mut qdot = vec![0.0; n];
-    from.driven_coordinate_rates(t, q, u, inputs_from, &mut qdot)?;
-    let kinetic_before = from.driven_kinetic_energy(t, q, u, inputs_from)?;
+    from.dyn_driven_coordinate_rates(t, q, u, inputs_from, &mut qdot)?;
+    let kinetic_before = from.dyn_driven_kinetic_energy(t, q, u, inputs_from)?;
     let (d, d0) = rows(to, ib, t, q, inputs_to)?;
     let scale = qdot
         .iter()
@@ -202,7 +203,7 @@ pub fn switch_state<A: Model, B: Model>(
         }
     }
     let speeds = speeds_of(to, ib, t, q, &qdot)?;
-    let kinetic_after = to.driven_kinetic_energy(t, q, &speeds, inputs_to)?;
+    let kinetic_after = to.dyn_driven_kinetic_energy(t, q, &speeds, inputs_to)?;
     Ok(Switched {
         speeds,
         qdot,
@@ -213,7 +214,7 @@ pub fn switch_state<A: Model, B: Model>(
 }
 
 /// D (m×n) and d of `model` at `(t, q)` and its inputs.
-fn rows<B: Model>(
+fn rows<B: DynModel + ?Sized>(
     model: &B,
     info: &ModelInfo,
     t: f64,
@@ -222,14 +223,14 @@ fn rows<B: Model>(
 ) -> Result<(DMatrix<f64>, DVector<f64>), ModelError> {
     let (n, m) = (info.coordinates.len(), info.constraints);
     let (mut d, mut d0) = (vec![0.0; m * n], vec![0.0; m]);
-    model.driven_constraint_rows(t, q, inputs, &mut d, &mut d0)?;
+    model.dyn_driven_constraint_rows(t, q, inputs, &mut d, &mut d0)?;
     Ok((DMatrix::from_row_slice(m, n, &d), DVector::from_vec(d0)))
 }
 
 /// The impulse in `from`'s speeds that brings its motion onto the rows
 /// `D q̇ + d = 0`: the coordinate rates after it, and the rows' impulses.
 #[allow(clippy::too_many_arguments)]
-fn impulse<A: Model>(
+fn impulse<A: DynModel + ?Sized>(
     from: &A,
     info: &ModelInfo,
     t: f64,
@@ -241,9 +242,9 @@ fn impulse<A: Model>(
 ) -> Result<(Vec<f64>, Vec<f64>), SwitchError> {
     let (n, l) = (info.coordinates.len(), info.speeds.len());
     let (mut c, mut c0) = (vec![0.0; n * l], vec![0.0; n]);
-    from.driven_speed_transform(t, q, inputs, &mut c, &mut c0)?;
+    from.dyn_driven_speed_transform(t, q, inputs, &mut c, &mut c0)?;
     let (mut mass, mut forcing) = (vec![0.0; l * l], vec![0.0; l]);
-    from.mass_matrix_and_forcing(t, q, u, inputs, &mut mass, &mut forcing)?;
+    from.dyn_mass_matrix_and_forcing(t, q, u, inputs, &mut mass, &mut forcing)?;
     let c = DMatrix::from_row_slice(n, l, &c);
     let c0 = DVector::from_vec(c0);
     let mass = DMatrix::from_row_slice(l, l, &mass);
@@ -268,7 +269,7 @@ fn impulse<A: Model>(
 }
 
 /// `model`'s privileged speeds for the coordinate rates `qdot`: W q̇ + w.
-fn speeds_of<B: Model>(
+fn speeds_of<B: DynModel + ?Sized>(
     model: &B,
     info: &ModelInfo,
     t: f64,
@@ -277,7 +278,7 @@ fn speeds_of<B: Model>(
 ) -> Result<Vec<f64>, ModelError> {
     let (n, l) = (info.coordinates.len(), info.speeds.len());
     let (mut w, mut w0) = (vec![0.0; l * n], vec![0.0; l]);
-    model.speed_definitions(t, q, &mut w, &mut w0)?;
+    model.dyn_speed_definitions(t, q, &mut w, &mut w0)?;
     Ok((0..l)
         .map(|k| (0..n).map(|r| w[k * n + r] * qdot[r]).sum::<f64>() + w0[k])
         .collect())

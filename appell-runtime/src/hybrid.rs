@@ -1,0 +1,409 @@
+//! A simulation that moves between scenes when an event says the physics
+//! changed: a foot lands or lifts off, a wheel starts or stops slipping.
+//!
+//! Each [`Phase`] is a scene (any [`DynModel`] of the same coordinates)
+//! with its inputs and its [`Guard`]s: functions of the motion that stay
+//! positive while the phase holds. [`Hybrid::run`] integrates the current
+//! phase with DOP853 on every coordinate and the phase's speeds (so
+//! coordinates a scene leaves out of its reduced state are kept), stops
+//! where a guard crosses zero (the integrator's event location), maps the
+//! motion into the guard's target phase with [`switch_state`] (nothing
+//! jumps where a constraint is released; the impulse Appell's equations in
+//! impulsive form give where one is imposed) and goes on, logging each
+//! switch: time, phases, reason, impulses, kinetic energy lost.
+//!
+//! Limits, by design: a guard fires where it comes down through zero, so a
+//! guard that starts a phase at or below zero (a foot a round-off below
+//! the ground it just left) is armed only once it has been positive, and
+//! two guards crossing within the event
+//! tolerance of each other fire as one, the one with the smaller value at
+//! the event. A motion that switches faster and faster (Zeno: a ball
+//! bouncing to rest) ends with [`HybridError::TooManySwitches`] after
+//! [`Hybrid::max_switches`], with the run so far in the error. The
+//! integrator is explicit: a stiff phase needs small steps.
+//!
+//! `tests/hybrid.rs` runs a hopping leg (flight and stance, the lift-off
+//! where the ground's normal force vanishes) against closed forms.
+
+use std::cell::RefCell;
+
+use crate::dynamic::DynModel;
+use crate::integrate::{Dop853, IntegrateError};
+use crate::model::ModelError;
+use crate::switch::{switch_state, SwitchError};
+
+/// A guard's value at `(t, q, u)`: every coordinate, the phase's speeds.
+pub type GuardFn<'a> = Box<dyn Fn(f64, &[f64], &[f64]) -> Result<f64, ModelError> + 'a>;
+
+/// A condition for leaving a phase: while `value` is positive the phase
+/// holds; where it crosses zero the run switches to phase `to`.
+pub struct Guard<'a> {
+    /// Why the switch happens (`"lift-off"`), for the log.
+    pub reason: &'static str,
+    /// The index of the phase to switch to.
+    pub to: usize,
+    /// The guard function.
+    pub value: GuardFn<'a>,
+}
+
+impl<'a> Guard<'a> {
+    /// A guard named `reason` that switches to phase `to` where `value`
+    /// crosses zero.
+    pub fn new(
+        reason: &'static str,
+        to: usize,
+        value: impl Fn(f64, &[f64], &[f64]) -> Result<f64, ModelError> + 'a,
+    ) -> Self {
+        Guard {
+            reason,
+            to,
+            value: Box::new(value),
+        }
+    }
+}
+
+/// One scene of a hybrid run.
+pub struct Phase<'a> {
+    /// Its name, for the log.
+    pub name: &'static str,
+    /// The scene (the same coordinates as every other phase).
+    pub model: &'a dyn DynModel,
+    /// Its inputs, held constant.
+    pub inputs: Vec<f64>,
+    /// The ways out of it.
+    pub guards: Vec<Guard<'a>>,
+}
+
+/// One switch of a hybrid run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct SwitchRecord {
+    /// When.
+    pub t: f64,
+    /// The phase left (index).
+    pub from: usize,
+    /// The phase entered (index).
+    pub to: usize,
+    /// The guard's reason.
+    pub reason: &'static str,
+    /// The impulse of each of the target's constraint rows (empty where
+    /// nothing was imposed).
+    pub impulses: Vec<f64>,
+    /// Kinetic energy lost at the switch.
+    pub energy_lost: f64,
+}
+
+/// The motion at one instant of a hybrid run.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sample {
+    /// Time.
+    pub t: f64,
+    /// The phase (index).
+    pub phase: usize,
+    /// Every coordinate.
+    pub q: Vec<f64>,
+    /// The phase's privileged speeds.
+    pub u: Vec<f64>,
+}
+
+/// What [`Hybrid::run`] returns.
+#[derive(Clone, Debug, PartialEq)]
+pub struct HybridRun {
+    /// The motion at the end.
+    pub end: Sample,
+    /// The switches, in order.
+    pub switches: Vec<SwitchRecord>,
+    /// The motion at every sampling time ([`Hybrid::sample_every`]), at
+    /// each switch (before and after) and at the end.
+    pub samples: Vec<Sample>,
+}
+
+/// Why a hybrid run stopped early.
+#[derive(Debug)]
+pub enum HybridError {
+    /// The integrator failed in a phase.
+    Integrate(IntegrateError),
+    /// A guard function failed.
+    Guard(ModelError),
+    /// A state map failed.
+    Switch(SwitchError),
+    /// More than [`Hybrid::max_switches`] switches (Zeno behaviour); the
+    /// run up to there.
+    TooManySwitches(Box<HybridRun>),
+    /// A phase index out of range, phases of different coordinates, or a
+    /// phase whose state does not fit `S`.
+    BadPhase(String),
+}
+
+impl core::fmt::Display for HybridError {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            HybridError::Integrate(e) => write!(f, "{e}"),
+            HybridError::Guard(e) => write!(f, "a guard failed: {e}"),
+            HybridError::Switch(e) => write!(f, "{e}"),
+            HybridError::TooManySwitches(run) => write!(
+                f,
+                "more than {} switches by t = {} (Zeno behaviour?)",
+                run.switches.len(),
+                run.end.t
+            ),
+            HybridError::BadPhase(why) => write!(f, "{why}"),
+        }
+    }
+}
+
+impl std::error::Error for HybridError {}
+
+/// A hybrid simulation over `phases`.
+pub struct Hybrid<'a> {
+    phases: Vec<Phase<'a>>,
+    solver: Dop853,
+    max_switches: usize,
+    sample_every: Option<f64>,
+}
+
+impl<'a> Hybrid<'a> {
+    /// A run over `phases` with DOP853 at rtol 1e-10, atol 1e-12, at most
+    /// 1000 switches and no sampling.
+    pub fn new(phases: Vec<Phase<'a>>) -> Self {
+        Hybrid {
+            phases,
+            solver: Dop853::new().rtol(1e-10).atol(1e-12),
+            max_switches: 1000,
+            sample_every: None,
+        }
+    }
+
+    /// The integrator every phase uses (its tolerances, step bounds and
+    /// event tolerance).
+    pub fn solver(mut self, solver: Dop853) -> Self {
+        self.solver = solver;
+        self
+    }
+
+    /// The most switches before [`HybridError::TooManySwitches`].
+    pub fn max_switches(mut self, n: usize) -> Self {
+        self.max_switches = n;
+        self
+    }
+
+    /// Records the motion every `dt` besides the switches.
+    pub fn sample_every(mut self, dt: f64) -> Self {
+        self.sample_every = Some(dt);
+        self
+    }
+
+    /// Runs from phase `phase` at `t0` with coordinates `q0` (every one)
+    /// and that phase's speeds `u0` to `t_end`. `S` bounds every phase's
+    /// n + l (the integrated state is padded to it).
+    pub fn run<const S: usize>(
+        &self,
+        phase: usize,
+        t0: f64,
+        q0: &[f64],
+        u0: &[f64],
+        t_end: f64,
+    ) -> Result<HybridRun, HybridError> {
+        self.check::<S>(phase, q0, u0)?;
+        let mut now = Sample {
+            t: t0,
+            phase,
+            q: q0.to_vec(),
+            u: u0.to_vec(),
+        };
+        let mut run = HybridRun {
+            end: now.clone(),
+            switches: Vec::new(),
+            samples: vec![now.clone()],
+        };
+        while now.t < t_end {
+            let stop = self
+                .sample_every
+                .map_or(t_end, |dt| (now.t + dt).min(t_end));
+            let (after, fired) = self.advance::<S>(&now, stop)?;
+            now = after;
+            run.samples.push(now.clone());
+            if let Some(guard) = fired {
+                if run.switches.len() == self.max_switches {
+                    run.end = now;
+                    return Err(HybridError::TooManySwitches(Box::new(run)));
+                }
+                let (next, record) = self.switch(&now, guard)?;
+                run.switches.push(record);
+                now = next;
+                run.samples.push(now.clone());
+            }
+        }
+        run.end = now;
+        Ok(run)
+    }
+
+    /// The phases' consistency and the start's lengths.
+    fn check<const S: usize>(
+        &self,
+        phase: usize,
+        q0: &[f64],
+        u0: &[f64],
+    ) -> Result<(), HybridError> {
+        let bad = |why: String| Err(HybridError::BadPhase(why));
+        let Some(first) = self.phases.get(phase) else {
+            return bad(format!("no phase {phase}"));
+        };
+        let coords = first.model.dyn_info().coordinates;
+        for p in &self.phases {
+            let info = p.model.dyn_info();
+            if info.coordinates != coords {
+                return bad(format!("phase `{}` has other coordinates", p.name));
+            }
+            if coords.len() + info.speeds.len() > S {
+                return bad(format!(
+                    "phase `{}` needs a state of {}, more than S = {S}",
+                    p.name,
+                    coords.len() + info.speeds.len()
+                ));
+            }
+            if info.state_len() != info.retained.len() + info.speeds.len() {
+                return bad(format!(
+                    "phase `{}` carries quadrature outputs in its state",
+                    p.name
+                ));
+            }
+            if let Some(g) = p.guards.iter().find(|g| g.to >= self.phases.len()) {
+                return bad(format!(
+                    "guard `{}` of phase `{}` leads to no phase",
+                    g.reason, p.name
+                ));
+            }
+        }
+        let l = first.model.dyn_info().speeds.len();
+        if q0.len() != coords.len() || u0.len() != l {
+            return bad(format!(
+                "the start needs {} coordinates and {l} speeds",
+                coords.len()
+            ));
+        }
+        Ok(())
+    }
+
+    /// Integrates `now`'s phase to `stop` or to its first guard crossing
+    /// (returned with the guard's index).
+    fn advance<const S: usize>(
+        &self,
+        now: &Sample,
+        stop: f64,
+    ) -> Result<(Sample, Option<usize>), HybridError> {
+        let phase = &self.phases[now.phase];
+        let info = phase.model.dyn_info();
+        let (n, l) = (info.coordinates.len(), info.speeds.len());
+        let prepared = phase.model.dyn_prepare();
+        let retained: Vec<usize> = info
+            .retained
+            .iter()
+            .filter_map(|name| info.coordinate_index(name))
+            .collect();
+        let reduced = RefCell::new((vec![0.0; retained.len() + l], vec![0.0; retained.len() + l]));
+        let f = |t: f64, x: &[f64; S], dx: &mut [f64; S]| -> Result<(), ModelError> {
+            let (q, u) = (&x[..n], &x[n..n + l]);
+            let (state, rates) = &mut *reduced.borrow_mut();
+            for (s, &r) in state.iter_mut().zip(&retained) {
+                *s = q[r];
+            }
+            state[retained.len()..].copy_from_slice(u);
+            prepared.rhs(t, state, &phase.inputs, rates)?;
+            dx.fill(0.0);
+            phase
+                .model
+                .dyn_driven_coordinate_rates(t, q, u, &phase.inputs, &mut dx[..n])?;
+            dx[n..n + l].copy_from_slice(&rates[retained.len()..]);
+            Ok(())
+        };
+        // A guard is armed once it is positive: one that starts the phase
+        // at or below zero (the foot a hair below the ground it just left)
+        // fires only after it has risen above zero and comes down again.
+        let failure = RefCell::new(None);
+        let armed = RefCell::new(vec![false; phase.guards.len()]);
+        let g = |t: f64, x: &[f64; S]| -> f64 {
+            let (q, u) = (&x[..n], &x[n..n + l]);
+            let mut low = 1.0f64;
+            for (guard, armed) in phase.guards.iter().zip(armed.borrow_mut().iter_mut()) {
+                match (guard.value)(t, q, u) {
+                    Ok(v) => {
+                        *armed |= v > 0.0;
+                        if *armed {
+                            low = low.min(v);
+                        }
+                    }
+                    Err(e) => {
+                        failure.borrow_mut().get_or_insert(e);
+                    }
+                }
+            }
+            low
+        };
+        let mut x0 = [0.0; S];
+        x0[..n].copy_from_slice(&now.q);
+        x0[n..n + l].copy_from_slice(&now.u);
+        let sol = self
+            .solver
+            .solve_until(f, g, now.t, &x0, stop)
+            .map_err(HybridError::Integrate)?;
+        if let Some(e) = failure.into_inner() {
+            return Err(HybridError::Guard(e));
+        }
+        let after = Sample {
+            t: sol.t,
+            phase: now.phase,
+            q: sol.x[..n].to_vec(),
+            u: sol.x[n..n + l].to_vec(),
+        };
+        let fired = if sol.event {
+            let armed = armed.into_inner();
+            let values: Vec<f64> = phase
+                .guards
+                .iter()
+                .map(|guard| (guard.value)(after.t, &after.q, &after.u))
+                .collect::<Result<_, _>>()
+                .map_err(HybridError::Guard)?;
+            values
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| armed[*k])
+                .min_by(|a, b| a.1.total_cmp(b.1))
+                .map(|(k, _)| k)
+        } else {
+            None
+        };
+        Ok((after, fired))
+    }
+
+    /// The switch through guard `guard` of `now`'s phase.
+    fn switch(&self, now: &Sample, guard: usize) -> Result<(Sample, SwitchRecord), HybridError> {
+        let from = &self.phases[now.phase];
+        let g = &from.guards[guard];
+        let to = &self.phases[g.to];
+        let out = switch_state(
+            from.model,
+            to.model,
+            now.t,
+            &now.q,
+            &now.u,
+            &from.inputs,
+            &to.inputs,
+        )
+        .map_err(HybridError::Switch)?;
+        let record = SwitchRecord {
+            t: now.t,
+            from: now.phase,
+            to: g.to,
+            reason: g.reason,
+            energy_lost: out.energy_lost(),
+            impulses: out.impulses,
+        };
+        let next = Sample {
+            t: now.t,
+            phase: g.to,
+            q: now.q.clone(),
+            u: out.speeds,
+        };
+        Ok((next, record))
+    }
+}

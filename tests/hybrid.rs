@@ -1,0 +1,189 @@
+//! A hybrid run: a hopping leg (a body on a spring leg with a foot) that
+//! alternates stance (the foot held on the ground, a constraint of effect
+//! `stance`) and flight (the constraint left out, the foot free), switching
+//! at lift-off (the ground's normal force, from the constraint-force
+//! output, falls to zero) and at touchdown (the foot's height reaches
+//! zero, a plastic impact of the foot). Checked against closed forms.
+
+use appell::constraint_forces::contact_forces;
+use appell::hybrid::{Guard, Hybrid, Phase};
+use appell::integrate::Dop853;
+
+#[path = "../examples/models/hopper.rs"]
+mod hopper;
+use hopper::{HopperFlight, HopperStance, HOPPER};
+
+/// The ground's push on the foot in stance: the stance row's multiplier,
+/// signed so that it is positive while the foot presses on the ground.
+fn normal_force(t: f64, q: &[f64], u: &[f64]) -> Result<f64, appell::ModelError> {
+    let stance = HopperStance::from_ref(&HOPPER);
+    let forces =
+        contact_forces(stance, t, q, u, &[]).map_err(|_| appell::ModelError::NonFinite {
+            what: "the normal force",
+        })?;
+    Ok(forces.multipliers[0])
+}
+
+/// The hop from `z0` at rest in stance for 3 s, at `rtol` (seven switches).
+fn hop(z0: f64, rtol: f64) -> appell::hybrid::HybridRun {
+    let solver = Dop853::new().rtol(rtol).atol(rtol * 1e-2).event_tol(1e-13);
+    let run = Hybrid::new(phases())
+        .solver(solver)
+        .max_switches(7)
+        .run::<4>(0, 0.0, &[z0, 0.0], &[0.0], 3.0);
+    match run {
+        Ok(run) => run,
+        Err(appell::hybrid::HybridError::TooManySwitches(run)) => *run,
+        Err(e) => panic!("{e}"),
+    }
+}
+
+fn phases() -> Vec<Phase<'static>> {
+    vec![
+        Phase {
+            name: "stance",
+            model: HopperStance::from_ref(&HOPPER),
+            inputs: Vec::new(),
+            guards: vec![Guard::new("lift-off", 1, normal_force)],
+        },
+        Phase {
+            name: "flight",
+            model: HopperFlight::from_ref(&HOPPER),
+            inputs: Vec::new(),
+            guards: vec![Guard::new("touchdown", 0, |_, q: &[f64], _: &[f64]| {
+                Ok(q[1])
+            })],
+        },
+    ]
+}
+
+/// Total energy: both masses' kinetic and gravity energy and the spring's.
+fn energy(q: &[f64], qdot: &[f64]) -> f64 {
+    let h = &HOPPER;
+    let stretch = q[0] - q[1] - h.l0;
+    0.5 * h.big_m * qdot[0] * qdot[0]
+        + 0.5 * h.m * qdot[1] * qdot[1]
+        + (h.big_m * q[0] + h.m * q[1]) * h.g
+        + 0.5 * h.k * stretch * stretch
+}
+
+#[test]
+fn the_normal_force_is_the_foots_equilibrium() {
+    // In stance the foot does not move: N = k (l0 − z) + m g.
+    let h = &HOPPER;
+    for z in [0.3, 0.45, 0.5, 0.52] {
+        let n = normal_force(0.0, &[z, 0.0], &[0.7]).unwrap();
+        let expected = h.k * (h.l0 - z) + h.m * h.g;
+        assert!(
+            (n - expected).abs() <= 1e-10 * (1.0 + expected.abs()),
+            "{n} against {expected}"
+        );
+    }
+}
+
+#[test]
+fn the_leg_lifts_off_where_the_normal_force_vanishes_and_lands_plastically() {
+    let h = &HOPPER;
+    // Compressed and at rest: the body oscillates about z_eq at ω until
+    // the spring pulls the foot up with its weight, at z = l0 + m g / k.
+    let (z0, omega) = (0.3, (h.k / h.big_m).sqrt());
+    let z_eq = h.l0 - h.big_m * h.g / h.k;
+    let z_lift = h.l0 + h.m * h.g / h.k;
+    let t_lift = ((z_lift - z_eq) / (z0 - z_eq)).acos() / omega;
+    let run = hop(z0, 1e-12);
+    for s in &run.switches {
+        println!(
+            "t = {:.9} s: {} -> {} ({}), impulses {:?}, energy lost {:.3e} J",
+            s.t, s.from, s.to, s.reason, s.impulses, s.energy_lost
+        );
+    }
+    let first = &run.switches[0];
+    assert_eq!((first.from, first.to, first.reason), (0, 1, "lift-off"));
+    println!(
+        "lift-off {:.1e} s from the closed form",
+        (first.t - t_lift).abs()
+    );
+    assert!(
+        (first.t - t_lift).abs() < 1e-9,
+        "lift-off at {} against {t_lift}",
+        first.t
+    );
+    // Releasing the foot keeps the motion: the body's speed and a foot at rest.
+    assert!(first.impulses.is_empty() && first.energy_lost.abs() < 1e-12);
+    let z_dot = -(z0 - z_eq) * omega * (omega * t_lift).sin();
+    let after = run
+        .samples
+        .iter()
+        .find(|s| s.t == first.t && s.phase == 1)
+        .unwrap();
+    assert!(
+        (after.u[0] - z_dot).abs() < 1e-8 && after.u[1] == 0.0,
+        "{after:?}"
+    );
+    // Stance and flight alternate; at each touchdown the foot stops, its
+    // momentum the impulse and its kinetic energy the loss.
+    for (k, s) in run.switches.iter().enumerate() {
+        assert_eq!((s.from, s.to), if k % 2 == 0 { (0, 1) } else { (1, 0) });
+    }
+    for landing in run.switches.iter().filter(|s| s.reason == "touchdown") {
+        let before = run
+            .samples
+            .iter()
+            .rev()
+            .find(|s| s.t == landing.t && s.phase == 1)
+            .unwrap();
+        let foot = before.u[1];
+        assert!(foot < 0.0);
+        let momentum = h.m * foot.abs();
+        assert!((landing.impulses[0].abs() - momentum).abs() < 1e-12 * momentum.max(1.0));
+        let lost = 0.5 * h.m * foot * foot;
+        let gap = (landing.energy_lost - lost).abs();
+        assert!(
+            gap < 1e-12 * lost.max(1.0),
+            "{} against {lost}",
+            landing.energy_lost
+        );
+    }
+    // Energy: what is left at the end is the start's less the impacts'.
+    let e0 = energy(&[z0, 0.0], &[0.0, 0.0]);
+    let end = &run.end;
+    let qdot = if end.phase == 0 {
+        vec![end.u[0], 0.0]
+    } else {
+        end.u.clone()
+    };
+    let spent: f64 = run.switches.iter().map(|s| s.energy_lost).sum();
+    let gap = (energy(&end.q, &qdot) - (e0 - spent)).abs() / e0.abs();
+    println!(
+        "{} switches, energy balance {gap:.1e} of the total",
+        run.switches.len()
+    );
+    assert!(gap < 1e-9, "energy balance {gap:e}");
+    assert!(run.switches.len() >= 3, "it hops at least twice");
+}
+
+#[test]
+fn the_switch_times_converge_with_the_tolerance() {
+    // Work and precision of the hybrid run: each switch time against the
+    // run at rtol 1e-12.
+    let reference = hop(0.3, 1e-12);
+    let mut errors = Vec::new();
+    for rtol in [1e-5, 1e-7, 1e-9] {
+        let run = hop(0.3, rtol);
+        assert_eq!(
+            run.switches.len(),
+            reference.switches.len(),
+            "rtol {rtol:e}"
+        );
+        let worst = run
+            .switches
+            .iter()
+            .zip(&reference.switches)
+            .map(|(a, b)| (a.t - b.t).abs())
+            .fold(0.0f64, f64::max);
+        println!("rtol {rtol:e}: switch times within {worst:.1e} s of the reference");
+        errors.push(worst);
+    }
+    assert!(errors[0] < 1e-3 && errors[2] < 1e-7, "{errors:?}");
+    assert!(errors[2] < errors[0], "{errors:?}");
+}
