@@ -12,10 +12,16 @@
 //! impulsive form give where one is imposed) and goes on, logging each
 //! switch: time, phases, reason, impulses, kinetic energy lost.
 //!
+//! A phase entered with a guard already below zero (by more than
+//! [`Hybrid::guard_tolerance`]) is left at once, through that guard: a
+//! disc whose slip dies where rolling would need more friction than there
+//! is slides the other way. Positions are put back on the target's
+//! holonomic constraints at each switch.
+//!
 //! Limits, by design: a guard fires where it comes down through zero, so a
-//! guard that starts a phase at or below zero (a foot a round-off below
-//! the ground it just left) is armed only once it has been positive, and
-//! two guards crossing within the event
+//! guard that starts a phase at zero or within the tolerance below it (a
+//! foot on the ground it just left) is armed only once it has been
+//! positive, and two guards crossing within the event
 //! tolerance of each other fire as one, the one with the smaller value at
 //! the event. A motion that switches faster and faster (Zeno: a ball
 //! bouncing to rest) ends with [`HybridError::TooManySwitches`] after
@@ -159,6 +165,7 @@ pub struct Hybrid<'a> {
     solver: Dop853,
     max_switches: usize,
     sample_every: Option<f64>,
+    guard_tolerance: f64,
 }
 
 impl<'a> Hybrid<'a> {
@@ -170,6 +177,7 @@ impl<'a> Hybrid<'a> {
             solver: Dop853::new().rtol(1e-10).atol(1e-12),
             max_switches: 1000,
             sample_every: None,
+            guard_tolerance: 1e-9,
         }
     }
 
@@ -183,6 +191,14 @@ impl<'a> Hybrid<'a> {
     /// The most switches before [`HybridError::TooManySwitches`].
     pub fn max_switches(mut self, n: usize) -> Self {
         self.max_switches = n;
+        self
+    }
+
+    /// How far below zero a guard may start a phase and still wait to be
+    /// armed (a value a round-off or an event tolerance from zero) instead
+    /// of switching at once; in the guards' own units, 1e-9 by default.
+    pub fn guard_tolerance(mut self, tolerance: f64) -> Self {
+        self.guard_tolerance = tolerance;
         self
     }
 
@@ -216,6 +232,20 @@ impl<'a> Hybrid<'a> {
             samples: vec![now.clone()],
         };
         while now.t < t_end {
+            // A phase entered with a guard already below zero is left at
+            // once (the slip dies where rolling would need more friction
+            // than there is: the disc slides the other way).
+            if let Some(guard) = self.violated(&now)? {
+                if run.switches.len() == self.max_switches {
+                    run.end = now;
+                    return Err(HybridError::TooManySwitches(Box::new(run)));
+                }
+                let (next, record) = self.switch(&now, guard)?;
+                run.switches.push(record);
+                now = next;
+                run.samples.push(now.clone());
+                continue;
+            }
             let stop = self
                 .sample_every
                 .map_or(t_end, |dt| (now.t + dt).min(t_end));
@@ -375,6 +405,20 @@ impl<'a> Hybrid<'a> {
         Ok((after, fired))
     }
 
+    /// The guard of `now`'s phase furthest below `-guard_tolerance`, if
+    /// any.
+    fn violated(&self, now: &Sample) -> Result<Option<usize>, HybridError> {
+        let phase = &self.phases[now.phase];
+        let mut worst: Option<(usize, f64)> = None;
+        for (k, guard) in phase.guards.iter().enumerate() {
+            let v = (guard.value)(now.t, &now.q, &now.u).map_err(HybridError::Guard)?;
+            if v < -self.guard_tolerance && worst.is_none_or(|(_, w)| v < w) {
+                worst = Some((k, v));
+            }
+        }
+        Ok(worst.map(|(k, _)| k))
+    }
+
     /// The switch through guard `guard` of `now`'s phase.
     fn switch(&self, now: &Sample, guard: usize) -> Result<(Sample, SwitchRecord), HybridError> {
         let from = &self.phases[now.phase];
@@ -401,7 +445,7 @@ impl<'a> Hybrid<'a> {
         let next = Sample {
             t: now.t,
             phase: g.to,
-            q: now.q.clone(),
+            q: out.q,
             u: out.speeds,
         };
         Ok((next, record))

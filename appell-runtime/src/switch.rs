@@ -98,6 +98,10 @@ const TOLERANCE: f64 = 1e-12;
 /// The motion just after a switch, in the target's terms.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Switched {
+    /// Every coordinate after the switch: the same, but put back on the
+    /// target's holonomic constraints where the event left them a
+    /// round-off away (a foot a hair below the ground it lands on).
+    pub q: Vec<f64>,
     /// The target's privileged speeds (its [`ModelInfo::speeds`] order).
     pub speeds: Vec<f64>,
     /// Every coordinate's rate after the switch.
@@ -180,6 +184,7 @@ pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
         return Err(SwitchError::CoordinatesDiffer);
     }
     let n = ia.coordinates.len();
+    let q = &settle(to, ib, t, q, inputs_to)?;
     let mut qdot = vec![0.0; n];
     from.dyn_driven_coordinate_rates(t, q, u, inputs_from, &mut qdot)?;
     let kinetic_before = from.dyn_driven_kinetic_energy(t, q, u, inputs_from)?;
@@ -205,12 +210,60 @@ pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
     let speeds = speeds_of(to, ib, t, q, &qdot)?;
     let kinetic_after = to.dyn_driven_kinetic_energy(t, q, &speeds, inputs_to)?;
     Ok(Switched {
+        q: q.clone(),
         speeds,
         qdot,
         impulses,
         kinetic_before,
         kinetic_after,
     })
+}
+
+/// `q` moved onto `model`'s holonomic constraints h(q, t) = 0 by
+/// Gauss–Newton steps along their rows of D (the least change of q): at
+/// most a few, since the event leaves q within its tolerance of them. A q
+/// far from them is an [`SwitchError::Unattainable`].
+fn settle<B: DynModel + ?Sized>(
+    model: &B,
+    info: &ModelInfo,
+    t: f64,
+    q: &[f64],
+    inputs: &[f64],
+) -> Result<Vec<f64>, SwitchError> {
+    let (n, h, m) = (info.coordinates.len(), info.holonomic, info.constraints);
+    let mut q = q.to_vec();
+    if h == 0 {
+        return Ok(q);
+    }
+    let scale = q.iter().fold(1.0f64, |a, x| a.max(x.abs()));
+    let (mut res, mut vel) = (vec![0.0; h], vec![0.0; m]);
+    for _ in 0..4 {
+        model.dyn_driven_constraint_residuals(t, &q, &vec![0.0; n], inputs, &mut res, &mut vel)?;
+        let r = DVector::from_column_slice(&res);
+        if r.amax() <= 1e-15 * scale {
+            return Ok(q);
+        }
+        let (d, _) = rows(model, info, t, &q, inputs)?;
+        let dh = d.rows(0, h).into_owned();
+        let gram = &dh * dh.transpose();
+        let eps = TOLERANCE * gram.amax().max(f64::MIN_POSITIVE);
+        let step = dh.transpose()
+            * gram
+                .pseudo_inverse(eps)
+                .map_err(|_| SwitchError::Unattainable { residual: r.amax() })?
+            * r;
+        for (x, dx) in q.iter_mut().zip(step.iter()) {
+            *x -= dx;
+        }
+    }
+    model.dyn_driven_constraint_residuals(t, &q, &vec![0.0; n], inputs, &mut res, &mut vel)?;
+    let left = res.iter().fold(0.0f64, |a, x| a.max(x.abs()));
+    if left > 1e-9 * scale {
+        return Err(SwitchError::Unattainable {
+            residual: left / scale,
+        });
+    }
+    Ok(q)
 }
 
 /// D (m×n) and d of `model` at `(t, q)` and its inputs.

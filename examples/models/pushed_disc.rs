@@ -1,0 +1,54 @@
+//! A disc standing on a line, pushed at its centre by a force that swings
+//! back and forth, F = F0 sin(ω t): it rolls while the friction rolling
+//! needs stays within μ N, and slides (forward or backward, kinetic
+//! friction μ N against the slip) where it does not. The disc's height is
+//! fixed by construction, so the normal force is its weight, N = m g.
+//! `tests/rolling_sliding.rs` and `examples/pushed_disc.rs` switch between
+//! the three scenes.
+
+use appell::Appell;
+
+/// The pushed disc: rolling (`rolls(..., effect = rolling)`) or sliding,
+/// with the friction of the sliding direction (a force μ m g at the
+/// contact, written as the same force at the centre and its moment).
+#[allow(clippy::duplicated_attributes)] // the scenes name effects alike
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(x, theta), speeds(theta), positive(m, r))]
+#[appell(frame(B = N.rotate_z(theta)))]
+#[appell(point(C = O + x * N.x + r * N.y), point(P = O + x * N.x))]
+#[appell(body(disc, center = C, frame = B, mass = m,
+              inertia = principal(m * r * r / 4, m * r * r / 4, m * r * r / 2)))]
+#[appell(rolls(disc, contact = P, effect = rolling))]
+#[appell(force(C, push * sin(omega * t) * N.x, effect = push))]
+#[appell(force(C, -mu * m * g * N.x, effect = slide_forward),
+         torque(B, -r * mu * m * g * N.z, effect = slide_forward))]
+#[appell(force(C, mu * m * g * N.x, effect = slide_backward),
+         torque(B, r * mu * m * g * N.z, effect = slide_backward))]
+#[appell(scene(rolling, effects(push, rolling)))]
+#[appell(scene(sliding_forward, effects(push, slide_forward), speeds(x, theta)))]
+#[appell(scene(sliding_backward, effects(push, slide_backward), speeds(x, theta)))]
+pub struct PushedDisc {
+    /// Mass [kg].
+    pub m: f64,
+    /// Radius [m].
+    pub r: f64,
+    /// Gravity [m/s²].
+    pub g: f64,
+    /// Friction coefficient.
+    pub mu: f64,
+    /// The push's amplitude F0 [N].
+    pub push: f64,
+    /// The push's angular frequency ω [rad/s].
+    pub omega: f64,
+}
+
+/// The disc the test and the example push: F0 = 3.6 μ m g, beyond the
+/// 3 μ m g it can take rolling for a stretch of each swing.
+pub const DISC: PushedDisc = PushedDisc {
+    m: 1.0,
+    r: 0.2,
+    g: 9.81,
+    mu: 0.3,
+    push: 3.6 * 0.3 * 1.0 * 9.81,
+    omega: 2.0,
+};
