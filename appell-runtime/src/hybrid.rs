@@ -10,7 +10,9 @@
 //! motion into the guard's target phase with [`switch_state`] (nothing
 //! jumps where a constraint is released; the impulse Appell's equations in
 //! impulsive form give where one is imposed) and goes on, logging each
-//! switch: time, phases, reason, impulses, kinetic energy lost.
+//! switch: time, phases, reason, impulses, kinetic energy lost. A guard
+//! may make its switch an impact with a coefficient of restitution
+//! ([`Guard::impact`]): a ball that bounces and stays in flight.
 //!
 //! A phase entered with a guard already below zero (by more than
 //! [`Hybrid::guard_tolerance`]) is left at once, through that guard: a
@@ -36,7 +38,7 @@ use std::cell::RefCell;
 use crate::dynamic::DynModel;
 use crate::integrate::{Dop853, IntegrateError};
 use crate::model::ModelError;
-use crate::switch::{switch_state, SwitchError};
+use crate::switch::{impact_state, switch_state, SwitchError};
 
 /// A guard's value at `(t, q, u)`: every coordinate, the phase's speeds.
 pub type GuardFn<'a> = Box<dyn Fn(f64, &[f64], &[f64]) -> Result<f64, ModelError> + 'a>;
@@ -50,6 +52,9 @@ pub struct Guard<'a> {
     pub to: usize,
     /// The guard function.
     pub value: GuardFn<'a>,
+    /// An impact first, against the constraints of a scene, with a
+    /// coefficient of restitution (see [`Guard::impact`]).
+    pub impact: Option<(&'a dyn DynModel, f64)>,
 }
 
 impl<'a> Guard<'a> {
@@ -64,7 +69,19 @@ impl<'a> Guard<'a> {
             reason,
             to,
             value: Box::new(value),
+            impact: None,
         }
+    }
+
+    /// Makes the switch an impact against `contact`'s constraints with
+    /// Newton's coefficient of `restitution` (see
+    /// [`impact_state`](crate::switch::impact_state)) before the motion is
+    /// mapped into phase `to`: a ball that bounces stays in flight (`to`
+    /// its own phase) with its normal velocity reversed and scaled by e.
+    /// `contact` is evaluated without inputs.
+    pub fn impact(mut self, contact: &'a dyn DynModel, restitution: f64) -> Self {
+        self.impact = Some((contact, restitution));
+        self
     }
 }
 
@@ -424,23 +441,43 @@ impl<'a> Hybrid<'a> {
         let from = &self.phases[now.phase];
         let g = &from.guards[guard];
         let to = &self.phases[g.to];
+        let (q, u, mut impulses, mut lost) = match g.impact {
+            Some((contact, e)) => {
+                let hit = impact_state(
+                    from.model,
+                    contact,
+                    now.t,
+                    &now.q,
+                    &now.u,
+                    &from.inputs,
+                    &[],
+                    e,
+                )
+                .map_err(HybridError::Switch)?;
+                let lost = hit.energy_lost();
+                (hit.q, hit.speeds, hit.impulses, lost)
+            }
+            None => (now.q.clone(), now.u.clone(), Vec::new(), 0.0),
+        };
         let out = switch_state(
             from.model,
             to.model,
             now.t,
-            &now.q,
-            &now.u,
+            &q,
+            &u,
             &from.inputs,
             &to.inputs,
         )
         .map_err(HybridError::Switch)?;
+        lost += out.energy_lost();
+        impulses.extend(out.impulses.iter());
         let record = SwitchRecord {
             t: now.t,
             from: now.phase,
             to: g.to,
             reason: g.reason,
-            energy_lost: out.energy_lost(),
-            impulses: out.impulses,
+            energy_lost: lost,
+            impulses,
         };
         let next = Sample {
             t: now.t,

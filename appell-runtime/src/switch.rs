@@ -199,7 +199,7 @@ pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
     };
     let mut impulses = Vec::new();
     if ib.constraints > 0 && residual(&qdot) > TOLERANCE {
-        let (after, lambda) = impulse(from, ia, t, q, u, inputs_from, &d, &d0)?;
+        let (after, lambda) = impulse(from, ia, t, q, u, inputs_from, &d, &d0, 0.0)?;
         qdot = after;
         impulses = lambda;
         let left = residual(&qdot);
@@ -211,6 +211,57 @@ pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
     let kinetic_after = to.dyn_driven_kinetic_energy(t, q, &speeds, inputs_to)?;
     Ok(Switched {
         q: q.clone(),
+        speeds,
+        qdot,
+        impulses,
+        kinetic_before,
+        kinetic_after,
+    })
+}
+
+/// An impact that leaves `from`'s scene as it is: the motion of `from`
+/// meets the constraints of `contact` (a ball the ground) and rebounds with
+/// Newton's coefficient of `restitution` e ∈ [0, 1]: the impulse makes
+/// the contact rows' residual −e times what it was at impact, so e = 0 is
+/// the plastic impact of [`switch_state`] and e = 1 keeps the kinetic
+/// energy. The configuration is put on `contact`'s holonomic constraints;
+/// the speeds returned are `from`'s.
+///
+/// Errors: as [`switch_state`], and a restitution outside [0, 1].
+#[allow(clippy::too_many_arguments)]
+pub fn impact_state<A: DynModel + ?Sized, C: DynModel + ?Sized>(
+    from: &A,
+    contact: &C,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs_from: &[f64],
+    inputs_contact: &[f64],
+    restitution: f64,
+) -> Result<Switched, SwitchError> {
+    let (ia, ic) = (from.dyn_info(), contact.dyn_info());
+    if ia.coordinates != ic.coordinates {
+        return Err(SwitchError::CoordinatesDiffer);
+    }
+    if !(0.0..=1.0).contains(&restitution) {
+        return Err(SwitchError::Model(ModelError::NonFinite {
+            what: "the coefficient of restitution (it must be in [0, 1])",
+        }));
+    }
+    let q = settle(contact, ic, t, q, inputs_contact)?;
+    let kinetic_before = from.dyn_driven_kinetic_energy(t, &q, u, inputs_from)?;
+    let (d, d0) = rows(contact, ic, t, &q, inputs_contact)?;
+    let (qdot, impulses) = if ic.constraints > 0 {
+        impulse(from, ia, t, &q, u, inputs_from, &d, &d0, restitution)?
+    } else {
+        let mut qdot = vec![0.0; q.len()];
+        from.dyn_driven_coordinate_rates(t, &q, u, inputs_from, &mut qdot)?;
+        (qdot, Vec::new())
+    };
+    let speeds = speeds_of(from, ia, t, &q, &qdot)?;
+    let kinetic_after = from.dyn_driven_kinetic_energy(t, &q, &speeds, inputs_from)?;
+    Ok(Switched {
+        q,
         speeds,
         qdot,
         impulses,
@@ -280,8 +331,9 @@ fn rows<B: DynModel + ?Sized>(
     Ok((DMatrix::from_row_slice(m, n, &d), DVector::from_vec(d0)))
 }
 
-/// The impulse in `from`'s speeds that brings its motion onto the rows
-/// `D q̇ + d = 0`: the coordinate rates after it, and the rows' impulses.
+/// The impulse in `from`'s speeds after which the rows' residual
+/// `D q̇ + d` is `−restitution` times what it was (0: onto the rows): the
+/// coordinate rates after it, and the rows' impulses.
 #[allow(clippy::too_many_arguments)]
 fn impulse<A: DynModel + ?Sized>(
     from: &A,
@@ -292,6 +344,7 @@ fn impulse<A: DynModel + ?Sized>(
     inputs: &[f64],
     d: &DMatrix<f64>,
     d0: &DVector<f64>,
+    restitution: f64,
 ) -> Result<(Vec<f64>, Vec<f64>), SwitchError> {
     let (n, l) = (info.coordinates.len(), info.speeds.len());
     let (mut c, mut c0) = (vec![0.0; n * l], vec![0.0; n]);
@@ -310,7 +363,7 @@ fn impulse<A: DynModel + ?Sized>(
     })?;
     let minv_gt = chol.solve(&g.transpose());
     let k = &g * &minv_gt;
-    let rhs = -(&g * &u + g0);
+    let rhs = -(1.0 + restitution) * (&g * &u + g0);
     let eps = TOLERANCE * k.amax().max(f64::MIN_POSITIVE);
     let lambda = k
         .pseudo_inverse(eps)
