@@ -244,3 +244,56 @@ fn gripping_again_takes_the_sideways_impulse_and_its_energy() {
     println!("impulse, energy lost and grip after the switch against the closed form: {worst:e}");
     assert!(worst <= 1e-12, "against the closed form: {worst:e}");
 }
+
+/// A double pendulum of joints whose elbow has a brake: locked where the
+/// brake holds (the full model), free in the scene without it.
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(joint(shoulder, revolute(z), parent = N, child = L1))]
+#[appell(joint(elbow, revolute(z), parent = L1, child = L2, xyz = [0.5, 0, 0], dependent))]
+#[appell(body(upper, frame = L1, mass = m, center = origin(L1) + 0.25 * L1.x, inertia = principal(0.01, 0.02, 0.02)))]
+#[appell(body(lower, frame = L2, mass = m, center = origin(L2) + 0.25 * L2.x, inertia = principal(0.01, 0.02, 0.02)))]
+#[appell(gravity(-g * N.y))]
+#[appell(nonholonomic(dt(elbow) == 0, effect = brake))]
+#[appell(scene(free, effects(gravity), speeds(shoulder, elbow)))]
+struct BrakedArm {
+    m: f64,
+    g: f64,
+}
+
+#[test]
+fn a_brake_locks_a_joint_in_the_scenes_that_name_it() {
+    use appell::switch::switch_state;
+    let arm = BrakedArm { m: 1.5, g: 9.81 };
+    assert_eq!(BrakedArm::info().speeds, ["shoulder"]);
+    assert_eq!(BrakedArmFree::info().speeds, ["shoulder", "elbow"]);
+    // Braked, the arm swings as one body: the elbow's rate is zero.
+    let (q, u) = ([0.4, 0.7], [1.3]);
+    let mut qdot = [0.0; 2];
+    arm.coordinate_rates(0.0, &q, &u, &mut qdot).unwrap();
+    assert_eq!(qdot, [1.3, 0.0]);
+    // Releasing the brake keeps the motion; engaging it again stops the
+    // elbow's relative rotation with an impulse and a loss.
+    let free = BrakedArmFree::from_ref(&arm);
+    let released = switch_state(&arm, free, 0.0, &q, &u, &[], &[]).unwrap();
+    assert_eq!(released.speeds, [1.3, 0.0]);
+    assert!(released.energy_lost().abs() < 1e-14);
+    let engaged = switch_state(free, &arm, 0.0, &q, &[1.3, -2.0], &[], &[]).unwrap();
+    assert_eq!(engaged.impulses.len(), 1);
+    assert!(engaged.energy_lost() > 0.0 && engaged.qdot[1].abs() < 1e-14);
+    // The brake's impulse acts on the elbow's coordinate only: the
+    // shoulder's generalized momentum (the angular momentum about the
+    // pivot) is the same before and after.
+    let (mut mf, mut ff) = ([0.0; 4], [0.0; 2]);
+    free.mass_matrix_and_forcing(0.0, &q, &[1.3, -2.0], &[], &mut mf, &mut ff)
+        .unwrap();
+    let before = mf[0] * 1.3 + mf[1] * -2.0;
+    let (mut mb, mut fb) = ([0.0; 1], [0.0; 1]);
+    arm.mass_matrix_and_forcing(0.0, &q, &engaged.speeds, &[], &mut mb, &mut fb)
+        .unwrap();
+    let after = mb[0] * engaged.speeds[0];
+    assert!(
+        (after - before).abs() < 1e-13 * before.abs(),
+        "{after} against {before}"
+    );
+    assert!(engaged.energy_lost() < engaged.kinetic_before);
+}

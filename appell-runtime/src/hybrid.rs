@@ -4,7 +4,8 @@
 //! Each [`Phase`] is a scene (any [`DynModel`] of the same coordinates)
 //! with its inputs and its [`Guard`]s: functions of the motion that stay
 //! positive while the phase holds. [`Hybrid::run`] integrates the current
-//! phase with DOP853 on every coordinate and the phase's speeds (so
+//! phase with DOP853 ([`Hybrid::solver`]) or, for stiff phases, Radau5
+//! ([`Hybrid::stiff_solver`]) on every coordinate and the phase's speeds (so
 //! coordinates a scene leaves out of its reduced state are kept), stops
 //! where a guard crosses zero (the integrator's event location), maps the
 //! motion into the guard's target phase with [`switch_state`] (nothing
@@ -35,8 +36,10 @@
 
 use std::cell::RefCell;
 
-use crate::dynamic::DynModel;
-use crate::integrate::{Dop853, IntegrateError};
+use num_dual::Dual64;
+
+use crate::dynamic::{DynModel, DynRhs};
+use crate::integrate::{Dop853, IntegrateError, Radau5};
 use crate::model::ModelError;
 use crate::switch::{impact_state, switch_state, SwitchError};
 
@@ -176,10 +179,16 @@ impl core::fmt::Display for HybridError {
 
 impl std::error::Error for HybridError {}
 
+/// The integrator of a hybrid run's phases.
+enum Integrator {
+    Dop853(Dop853),
+    Radau5(Radau5),
+}
+
 /// A hybrid simulation over `phases`.
 pub struct Hybrid<'a> {
     phases: Vec<Phase<'a>>,
-    solver: Dop853,
+    integrator: Integrator,
     max_switches: usize,
     sample_every: Option<f64>,
     guard_tolerance: f64,
@@ -191,17 +200,25 @@ impl<'a> Hybrid<'a> {
     pub fn new(phases: Vec<Phase<'a>>) -> Self {
         Hybrid {
             phases,
-            solver: Dop853::new().rtol(1e-10).atol(1e-12),
+            integrator: Integrator::Dop853(Dop853::new().rtol(1e-10).atol(1e-12)),
             max_switches: 1000,
             sample_every: None,
             guard_tolerance: 1e-9,
         }
     }
 
-    /// The integrator every phase uses (its tolerances, step bounds and
-    /// event tolerance).
+    /// DOP853 as the integrator of every phase (its tolerances, step
+    /// bounds and event tolerance).
     pub fn solver(mut self, solver: Dop853) -> Self {
-        self.solver = solver;
+        self.integrator = Integrator::Dop853(solver);
+        self
+    }
+
+    /// Radau5 as the integrator of every phase, for stiff ones (a stiff
+    /// spring, a regularised friction law): the Jacobian of each phase's
+    /// equations by dual numbers, one pass per coordinate and speed.
+    pub fn stiff_solver(mut self, solver: Radau5) -> Self {
+        self.integrator = Integrator::Radau5(solver);
         self
     }
 
@@ -339,36 +356,14 @@ impl<'a> Hybrid<'a> {
         stop: f64,
     ) -> Result<(Sample, Option<usize>), HybridError> {
         let phase = &self.phases[now.phase];
-        let info = phase.model.dyn_info();
-        let (n, l) = (info.coordinates.len(), info.speeds.len());
-        let prepared = phase.model.dyn_prepare();
-        let retained: Vec<usize> = info
-            .retained
-            .iter()
-            .filter_map(|name| info.coordinate_index(name))
-            .collect();
-        let reduced = RefCell::new((vec![0.0; retained.len() + l], vec![0.0; retained.len() + l]));
-        let f = |t: f64, x: &[f64; S], dx: &mut [f64; S]| -> Result<(), ModelError> {
-            let (q, u) = (&x[..n], &x[n..n + l]);
-            let (state, rates) = &mut *reduced.borrow_mut();
-            for (s, &r) in state.iter_mut().zip(&retained) {
-                *s = q[r];
-            }
-            state[retained.len()..].copy_from_slice(u);
-            prepared.rhs(t, state, &phase.inputs, rates)?;
-            dx.fill(0.0);
-            phase
-                .model
-                .dyn_driven_coordinate_rates(t, q, u, &phase.inputs, &mut dx[..n])?;
-            dx[n..n + l].copy_from_slice(&rates[retained.len()..]);
-            Ok(())
-        };
+        let ode = PhaseOde::new(phase);
+        let (n, l) = (ode.n, ode.l);
         // A guard is armed once it is positive: one that starts the phase
         // at or below zero (the foot a hair below the ground it just left)
         // fires only after it has risen above zero and comes down again.
         let failure = RefCell::new(None);
         let armed = RefCell::new(vec![false; phase.guards.len()]);
-        let g = |t: f64, x: &[f64; S]| -> f64 {
+        let g = |t: f64, x: &[f64]| -> f64 {
             let (q, u) = (&x[..n], &x[n..n + l]);
             let mut low = 1.0f64;
             for (guard, armed) in phase.guards.iter().zip(armed.borrow_mut().iter_mut()) {
@@ -386,23 +381,41 @@ impl<'a> Hybrid<'a> {
             }
             low
         };
-        let mut x0 = [0.0; S];
+        let mut x0 = vec![0.0; n + l];
         x0[..n].copy_from_slice(&now.q);
-        x0[n..n + l].copy_from_slice(&now.u);
-        let sol = self
-            .solver
-            .solve_until(f, g, now.t, &x0, stop)
-            .map_err(HybridError::Integrate)?;
+        x0[n..].copy_from_slice(&now.u);
+        let (t, x, event) = match &self.integrator {
+            Integrator::Dop853(solver) => {
+                let f = |t: f64, x: &[f64; S], dx: &mut [f64; S]| -> Result<(), ModelError> {
+                    dx.fill(0.0);
+                    ode.rates(t, &x[..n + l], &mut dx[..n + l])
+                };
+                let mut padded = [0.0; S];
+                padded[..n + l].copy_from_slice(&x0);
+                let sol = solver
+                    .solve_until(f, |t, x: &[f64; S]| g(t, x), now.t, &padded, stop)
+                    .map_err(HybridError::Integrate)?;
+                (sol.t, sol.x[..n + l].to_vec(), sol.event)
+            }
+            Integrator::Radau5(solver) => {
+                let f = |t: f64, x: &[f64], dx: &mut [f64]| ode.rates(t, x, dx);
+                let jac = |t: f64, x: &[f64], j: &mut [f64]| ode.jacobian(t, x, j);
+                let sol = solver
+                    .solve_until(f, jac, g, now.t, &x0, stop)
+                    .map_err(HybridError::Integrate)?;
+                (sol.t, sol.x, sol.event)
+            }
+        };
         if let Some(e) = failure.into_inner() {
             return Err(HybridError::Guard(e));
         }
         let after = Sample {
-            t: sol.t,
+            t,
             phase: now.phase,
-            q: sol.x[..n].to_vec(),
-            u: sol.x[n..n + l].to_vec(),
+            q: x[..n].to_vec(),
+            u: x[n..].to_vec(),
         };
-        let fired = if sol.event {
+        let fired = if event {
             let armed = armed.into_inner();
             let values: Vec<f64> = phase
                 .guards
@@ -486,5 +499,86 @@ impl<'a> Hybrid<'a> {
             u: out.speeds,
         };
         Ok((next, record))
+    }
+}
+
+/// A phase's equations on every coordinate and its speeds, x = (q, u):
+/// q̇ from the coordinate rates, u̇ from the rhs on the reduced state.
+struct PhaseOde<'p> {
+    phase: &'p Phase<'p>,
+    prepared: Box<dyn DynRhs + 'p>,
+    retained: Vec<usize>,
+    n: usize,
+    l: usize,
+}
+
+impl<'p> PhaseOde<'p> {
+    fn new(phase: &'p Phase<'p>) -> Self {
+        let info = phase.model.dyn_info();
+        PhaseOde {
+            phase,
+            prepared: phase.model.dyn_prepare(),
+            retained: info
+                .retained
+                .iter()
+                .filter_map(|name| info.coordinate_index(name))
+                .collect(),
+            n: info.coordinates.len(),
+            l: info.speeds.len(),
+        }
+    }
+
+    /// ẋ at `(t, x)`.
+    fn rates(&self, t: f64, x: &[f64], dx: &mut [f64]) -> Result<(), ModelError> {
+        let (n, l, r) = (self.n, self.l, self.retained.len());
+        let (q, u) = (&x[..n], &x[n..n + l]);
+        let mut state: Vec<f64> = self.retained.iter().map(|&k| q[k]).collect();
+        state.extend_from_slice(u);
+        let mut reduced = vec![0.0; r + l];
+        self.prepared
+            .rhs(t, &state, &self.phase.inputs, &mut reduced)?;
+        self.phase
+            .model
+            .dyn_driven_coordinate_rates(t, q, u, &self.phase.inputs, &mut dx[..n])?;
+        dx[n..n + l].copy_from_slice(&reduced[r..]);
+        Ok(())
+    }
+
+    /// ∂ẋ/∂x at `(t, x)` (row-major), one pass in dual numbers per column.
+    fn jacobian(&self, t: f64, x: &[f64], jac: &mut [f64]) -> Result<(), ModelError> {
+        let (n, l, r) = (self.n, self.l, self.retained.len());
+        let m = n + l;
+        let td = Dual64::from_re(t);
+        let inputs: Vec<Dual64> = self
+            .phase
+            .inputs
+            .iter()
+            .map(|&v| Dual64::from_re(v))
+            .collect();
+        let mut xd: Vec<Dual64> = x.iter().map(|&v| Dual64::from_re(v)).collect();
+        let (mut qdot, mut reduced) = (
+            vec![Dual64::from_re(0.0); n],
+            vec![Dual64::from_re(0.0); r + l],
+        );
+        for k in 0..m {
+            xd[k].eps = 1.0;
+            let (q, u) = (&xd[..n], &xd[n..]);
+            let mut state: Vec<Dual64> = self.retained.iter().map(|&c| q[c]).collect();
+            state.extend_from_slice(u);
+            let result = self
+                .prepared
+                .rhs_dual(td, &state, &inputs, &mut reduced)
+                .and_then(|()| {
+                    self.phase
+                        .model
+                        .dyn_driven_coordinate_rates_dual(td, q, u, &inputs, &mut qdot)
+                });
+            xd[k].eps = 0.0;
+            result?;
+            for (i, v) in qdot.iter().chain(&reduced[r..]).enumerate() {
+                jac[i * m + k] = v.eps;
+            }
+        }
+        Ok(())
     }
 }
