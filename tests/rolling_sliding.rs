@@ -292,3 +292,57 @@ fn the_sliding_scene_is_the_disc_written_sliding() {
     }
     assert_eq!(PushedDiscSlidingBackward::info().speeds, ["x", "theta"]);
 }
+
+/// A disc sliding on a line against the friction element on its contact
+/// point (`frame`/`center`: the slip of the disc's material point there,
+/// the force on the disc there).
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(x, theta), speeds(x, theta), positive(m, r))]
+#[appell(frame(B = N.rotate_z(theta)))]
+#[appell(point(C = O + x * N.x + r * N.y), point(P = O + x * N.x))]
+#[appell(body(disc, center = C, frame = B, mass = m,
+              inertia = principal(m * r * r / 4, m * r * r / 4, m * r * r / 2)))]
+#[appell(friction(P, mu = mu, normal = m * g, plane = N.y, smoothing = eps, frame = B, center = C))]
+struct SkiddingDisc {
+    m: f64,
+    r: f64,
+    g: f64,
+    mu: f64,
+    eps: f64,
+}
+
+#[test]
+fn the_friction_of_a_contact_on_a_body_acts_on_its_material_point() {
+    // The slip is v_s = ẋ + r θ̇ (the material point at the contact), the
+    // friction F = −μ m g v_s/√(v_s² + ε²) on the disc there: ẍ = F/m and
+    // θ̈ = r F / I, I = m r²/2 (the moment of F about the centre).
+    let disc = SkiddingDisc {
+        m: 1.3,
+        r: 0.2,
+        g: 9.81,
+        mu: 0.4,
+        eps: 1e-2,
+    };
+    let p = disc.prepare::<f64>();
+    let info = SkiddingDisc::info();
+    let mut worst = 0.0f64;
+    for k in 0..12 {
+        let (xdot, thdot) = (0.7 - 0.13 * k as f64, 2.0 - 0.45 * k as f64);
+        let x: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|_| 0.3)
+            .chain([xdot, thdot])
+            .collect();
+        let mut dx = vec![0.0; x.len()];
+        disc.rhs(&p, 0.0, &x, &[], &mut dx).unwrap();
+        let vs = xdot + disc.r * thdot;
+        let f = -disc.mu * disc.m * disc.g * vs / (vs * vs + disc.eps * disc.eps).sqrt();
+        let inertia = disc.m * disc.r * disc.r / 2.0;
+        let l = dx.len();
+        worst = worst
+            .max((dx[l - 2] - f / disc.m).abs())
+            .max((dx[l - 1] - disc.r * f / inertia).abs());
+    }
+    assert!(worst < 1e-12, "{worst:e}");
+}

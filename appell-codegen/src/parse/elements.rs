@@ -201,12 +201,26 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
 /// velocity of P across the surface, effect `friction`. The normal force
 /// N is given (an expression), not computed: a contact whose normal force
 /// the motion decides is a constraint (`rolls`), or a scene switch.
-pub(super) fn parse_friction(s: ParseStream) -> syn::Result<LoadDef> {
+///
+/// With `frame = B, center = C` (C a point fixed in B), P is a contact
+/// point that moves over the body (a wheel's): the slip is the velocity of
+/// the body's material point at P, v_C + ω_B × (P − C), and the friction
+/// acts on the body there, as the same force at C and its moment
+/// (P − C) × F on B: the loads returned are that force and that torque.
+pub(super) fn parse_friction(s: ParseStream) -> syn::Result<(LoadDef, Option<LoadDef>)> {
     let p: Ident = s.parse()?;
     let span = p.span();
     let mut values = std::collections::BTreeMap::new();
     let mut effect = None;
-    let allowed = ["normal", "mu", "plane", "smoothing", "viscous"];
+    let allowed = [
+        "normal",
+        "mu",
+        "plane",
+        "smoothing",
+        "viscous",
+        "frame",
+        "center",
+    ];
     for (k, v) in key_values(s)? {
         let key = k.to_string();
         if key == "effect" {
@@ -223,7 +237,31 @@ pub(super) fn parse_friction(s: ParseStream) -> syn::Result<LoadDef> {
     let n = values
         .remove("plane")
         .unwrap_or_else(|| Expr::Axis(Ident::new("N", span), 2, span));
-    let v = call("velocity", vec![Expr::Name(p.clone())], span);
+    let on_body = match (values.remove("frame"), values.remove("center")) {
+        (Some(Expr::Name(frame)), Some(Expr::Name(center))) => Some((frame, center)),
+        (None, None) => None,
+        (Some(other), _) | (_, Some(other)) => {
+            return Err(syn::Error::new(
+                other.span(),
+                "a contact on a body takes both `frame = B` and `center = C`, a frame and a point fixed in it, by name",
+            ))
+        }
+    };
+    let v = match &on_body {
+        None => call("velocity", vec![Expr::Name(p.clone())], span),
+        Some((frame, center)) => {
+            let arm = sub(Expr::Name(p.clone()), Expr::Name(center.clone()));
+            let spin = call(
+                "cross",
+                vec![call("omega", vec![Expr::Name(frame.clone())], span), arm],
+                span,
+            );
+            add(
+                call("velocity", vec![Expr::Name(center.clone())], span),
+                spin,
+            )
+        }
+    };
     let v_t = sub(v.clone(), times(call("dot", vec![v, n.clone()], span), n));
     let mut force = None;
     match (values.remove("mu"), values.remove("normal")) {
@@ -258,10 +296,32 @@ pub(super) fn parse_friction(s: ParseStream) -> syn::Result<LoadDef> {
     }
     let vector = force
         .ok_or_else(|| syn::Error::new(span, "friction needs `mu` and `normal`, or `viscous`"))?;
-    Ok(LoadDef {
-        target: p,
-        vector,
-        effect: effect.unwrap_or_else(|| Ident::new("friction", span)),
+    let effect = effect.unwrap_or_else(|| Ident::new("friction", span));
+    Ok(match on_body {
+        None => (
+            LoadDef {
+                target: p,
+                vector,
+                effect,
+            },
+            None,
+        ),
+        Some((frame, center)) => {
+            let arm = sub(Expr::Name(p), Expr::Name(center.clone()));
+            let moment = call("cross", vec![arm, vector.clone()], span);
+            (
+                LoadDef {
+                    target: center,
+                    vector,
+                    effect: effect.clone(),
+                },
+                Some(LoadDef {
+                    target: frame,
+                    vector: moment,
+                    effect,
+                }),
+            )
+        }
     })
 }
 

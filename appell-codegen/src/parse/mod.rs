@@ -328,9 +328,11 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, manifest_dir: Option<&std
                     tokens,
                 )?)
             }
-            "friction" => ast
-                .forces
-                .push(Parser::parse2(elements::parse_friction, tokens)?),
+            "friction" => {
+                let (force, torque) = Parser::parse2(elements::parse_friction, tokens)?;
+                ast.forces.push(force);
+                ast.torques.extend(torque);
+            }
             "scene" => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
             "rolls" => {
                 let at = item.all.clone();
