@@ -69,3 +69,33 @@ fn each_bounce_keeps_e_of_the_speed_and_the_bounces_end_zeno() {
     assert!(worst < 1e-9, "{worst:e}");
     assert!(run.end.t < zeno);
 }
+
+#[test]
+fn bad_settings_are_typed_errors() {
+    use appell::switch::{impact_state, SwitchError};
+    let flight = BallFlight::from_ref(&BALL);
+    let phases = || {
+        vec![Phase {
+            name: "flight",
+            model: flight,
+            inputs: Vec::new(),
+            guards: vec![
+                Guard::new("bounce", 0, |_, q: &[f64], _: &[f64]| Ok(q[1])).impact(&BALL, 0.5)
+            ],
+        }]
+    };
+    for dt in [0.0, -0.1, f64::NAN] {
+        let run =
+            Hybrid::new(phases())
+                .sample_every(dt)
+                .run::<4>(0, 0.0, &[0.0, 1.0], &[0.0, 0.0], 1.0);
+        assert!(
+            matches!(run, Err(HybridError::BadPhase(_))),
+            "dt = {dt}: {run:?}"
+        );
+    }
+    let run = Hybrid::new(phases()).run::<3>(0, 0.0, &[0.0, 1.0], &[0.0, 0.0], 1.0);
+    assert!(matches!(run, Err(HybridError::BadPhase(_))), "S too small");
+    let hit = impact_state(flight, &BALL, 0.0, &[0.0, 0.0], &[0.0, -1.0], &[], &[], 1.5);
+    assert_eq!(hit, Err(SwitchError::InvalidRestitution(1.5)));
+}

@@ -28,8 +28,7 @@
 //! tolerance of each other fire as one, the one with the smaller value at
 //! the event. A motion that switches faster and faster (Zeno: a ball
 //! bouncing to rest) ends with [`HybridError::TooManySwitches`] after
-//! [`Hybrid::max_switches`], with the run so far in the error. The
-//! integrator is explicit: a stiff phase needs small steps.
+//! [`Hybrid::max_switches`], with the run so far in the error.
 //!
 //! `tests/hybrid.rs` runs a hopping leg (flight and stance, the lift-off
 //! where the ground's normal force vanishes) against closed forms.
@@ -111,7 +110,9 @@ pub struct SwitchRecord {
     pub to: usize,
     /// The guard's reason.
     pub reason: &'static str,
-    /// The impulse of each of the target's constraint rows (empty where
+    /// The impulses: for a guard with an impact, the impact scene's rows'
+    /// first, then those of each of the target's constraint rows (its
+    /// [`ModelInfo::row_sources`](crate::ModelInfo) order; none where
     /// nothing was imposed).
     pub impulses: Vec<f64>,
     /// Kinetic energy lost at the switch.
@@ -265,27 +266,34 @@ impl<'a> Hybrid<'a> {
             switches: Vec::new(),
             samples: vec![now.clone()],
         };
+        // Whether the phase was just entered, and which of its guards are
+        // armed (kept across sampling stops, reset at a switch).
+        let (mut entered, mut armed) = (true, vec![false; self.phases[phase].guards.len()]);
+        let mut k = 0usize;
         while now.t < t_end {
             // A phase entered with a guard already below zero is left at
             // once (the slip dies where rolling would need more friction
             // than there is: the disc slides the other way).
-            if let Some(guard) = self.violated(&now)? {
-                if run.switches.len() == self.max_switches {
-                    run.end = now;
-                    return Err(HybridError::TooManySwitches(Box::new(run)));
+            let leave = if entered { self.violated(&now)? } else { None };
+            entered = false;
+            let fired = match leave {
+                Some(guard) => Some(guard),
+                None => {
+                    let stop = match self.sample_every {
+                        Some(dt) => {
+                            while t0 + (k as f64) * dt <= now.t {
+                                k += 1;
+                            }
+                            (t0 + k as f64 * dt).min(t_end)
+                        }
+                        None => t_end,
+                    };
+                    let (after, fired) = self.advance::<S>(&now, stop, &mut armed)?;
+                    now = after;
+                    run.samples.push(now.clone());
+                    fired
                 }
-                let (next, record) = self.switch(&now, guard)?;
-                run.switches.push(record);
-                now = next;
-                run.samples.push(now.clone());
-                continue;
-            }
-            let stop = self
-                .sample_every
-                .map_or(t_end, |dt| (now.t + dt).min(t_end));
-            let (after, fired) = self.advance::<S>(&now, stop)?;
-            now = after;
-            run.samples.push(now.clone());
+            };
             if let Some(guard) = fired {
                 if run.switches.len() == self.max_switches {
                     run.end = now;
@@ -295,6 +303,8 @@ impl<'a> Hybrid<'a> {
                 run.switches.push(record);
                 now = next;
                 run.samples.push(now.clone());
+                entered = true;
+                armed = vec![false; self.phases[now.phase].guards.len()];
             }
         }
         run.end = now;
@@ -338,6 +348,11 @@ impl<'a> Hybrid<'a> {
                 ));
             }
         }
+        if let Some(dt) = self.sample_every {
+            if !(dt.is_finite() && dt > 0.0) {
+                return bad(format!("`sample_every` must be a positive time, not {dt}"));
+            }
+        }
         let l = first.model.dyn_info().speeds.len();
         if q0.len() != coords.len() || u0.len() != l {
             return bad(format!(
@@ -354,6 +369,7 @@ impl<'a> Hybrid<'a> {
         &self,
         now: &Sample,
         stop: f64,
+        armed: &mut [bool],
     ) -> Result<(Sample, Option<usize>), HybridError> {
         let phase = &self.phases[now.phase];
         let ode = PhaseOde::new(phase);
@@ -362,7 +378,7 @@ impl<'a> Hybrid<'a> {
         // at or below zero (the foot a hair below the ground it just left)
         // fires only after it has risen above zero and comes down again.
         let failure = RefCell::new(None);
-        let armed = RefCell::new(vec![false; phase.guards.len()]);
+        let armed = RefCell::new(armed);
         let g = |t: f64, x: &[f64]| -> f64 {
             let (q, u) = (&x[..n], &x[n..n + l]);
             let mut low = 1.0f64;
@@ -392,17 +408,15 @@ impl<'a> Hybrid<'a> {
                 };
                 let mut padded = [0.0; S];
                 padded[..n + l].copy_from_slice(&x0);
-                let sol = solver
-                    .solve_until(f, |t, x: &[f64; S]| g(t, x), now.t, &padded, stop)
-                    .map_err(HybridError::Integrate)?;
+                let sol = solver.solve_until(f, |t, x: &[f64; S]| g(t, x), now.t, &padded, stop);
+                let sol = first_failure(&failure, sol)?;
                 (sol.t, sol.x[..n + l].to_vec(), sol.event)
             }
             Integrator::Radau5(solver) => {
                 let f = |t: f64, x: &[f64], dx: &mut [f64]| ode.rates(t, x, dx);
                 let jac = |t: f64, x: &[f64], j: &mut [f64]| ode.jacobian(t, x, j);
-                let sol = solver
-                    .solve_until(f, jac, g, now.t, &x0, stop)
-                    .map_err(HybridError::Integrate)?;
+                let sol = solver.solve_until(f, jac, g, now.t, &x0, stop);
+                let sol = first_failure(&failure, sol)?;
                 (sol.t, sol.x, sol.event)
             }
         };
@@ -581,4 +595,16 @@ impl<'p> PhaseOde<'p> {
         }
         Ok(())
     }
+}
+
+/// The integrator's result, unless a guard failed first (the guard's error
+/// is the cause of whatever the integrator did after it).
+fn first_failure<T>(
+    failure: &RefCell<Option<ModelError>>,
+    result: Result<T, IntegrateError>,
+) -> Result<T, HybridError> {
+    if let Some(e) = failure.borrow_mut().take() {
+        return Err(HybridError::Guard(e));
+    }
+    result.map_err(HybridError::Integrate)
 }

@@ -15,7 +15,9 @@
 //!
 //! so Λ = −(G M⁻¹ Gᵀ)⁺ (G u + g): the impulse that makes the least change of
 //! kinetic energy (a perfectly plastic impact at the new constraints; rows
-//! the source already satisfies get none). The target's speeds are then
+//! the source satisfies identically get none; nothing forbids a pulling
+//! impulse, so a guard should switch only where the contact closes). The
+//! target's speeds are then
 //! read off q̇⁺ with its speed definitions u' = W q̇⁺ + w (eq. 54's W).
 //! Releasing a constraint needs no impulse: q̇ and the kinetic energy are
 //! the same on both sides of the switch.
@@ -130,6 +132,8 @@ pub enum SwitchError {
     Model(ModelError),
     /// The two models do not have the same coordinates in the same order.
     CoordinatesDiffer,
+    /// A coefficient of restitution outside [0, 1].
+    InvalidRestitution(f64),
     /// No impulse in the source's speeds satisfies the target's
     /// constraints: the target constrains what the source holds fixed some
     /// other way. The largest residual left, relative to the rates.
@@ -143,6 +147,9 @@ impl core::fmt::Display for SwitchError {
     fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
         match self {
             SwitchError::Model(e) => write!(f, "the switch failed: {e}"),
+            SwitchError::InvalidRestitution(e) => {
+                write!(f, "the coefficient of restitution must be in [0, 1], not {e}")
+            }
             SwitchError::CoordinatesDiffer => {
                 write!(f, "the two scenes do not have the same coordinates")
             }
@@ -244,15 +251,23 @@ pub fn impact_state<A: DynModel + ?Sized, C: DynModel + ?Sized>(
         return Err(SwitchError::CoordinatesDiffer);
     }
     if !(0.0..=1.0).contains(&restitution) {
-        return Err(SwitchError::Model(ModelError::NonFinite {
-            what: "the coefficient of restitution (it must be in [0, 1])",
-        }));
+        return Err(SwitchError::InvalidRestitution(restitution));
     }
     let q = settle(contact, ic, t, q, inputs_contact)?;
     let kinetic_before = from.dyn_driven_kinetic_energy(t, &q, u, inputs_from)?;
     let (d, d0) = rows(contact, ic, t, &q, inputs_contact)?;
     let (qdot, impulses) = if ic.constraints > 0 {
-        impulse(from, ia, t, &q, u, inputs_from, &d, &d0, restitution)?
+        let mut before = vec![0.0; q.len()];
+        from.dyn_driven_coordinate_rates(t, &q, u, inputs_from, &mut before)?;
+        let (qdot, lambda) = impulse(from, ia, t, &q, u, inputs_from, &d, &d0, restitution)?;
+        // The rows' residual must now be −e times what it was.
+        let residual = |v: &[f64]| &d * DVector::from_column_slice(v) + &d0;
+        let scale = before.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+        let left = (residual(&qdot) + restitution * residual(&before)).amax() / scale;
+        if left > 1e3 * TOLERANCE {
+            return Err(SwitchError::Unattainable { residual: left });
+        }
+        (qdot, lambda)
     } else {
         let mut qdot = vec![0.0; q.len()];
         from.dyn_driven_coordinate_rates(t, &q, u, inputs_from, &mut qdot)?;

@@ -130,16 +130,27 @@ pub fn derive_constrained_scene(
 ) -> Option<Derivation> {
     let mut own = ConstraintSet::of_scene(model, scene)?;
     let twin = twin.map(|t| own.twin(t, scene));
+    // The scene's own errors, each named with the scene (and not mistaken
+    // for an earlier scene's by the stages' checks).
+    let scene_cx = Ctxt::new();
     own.swap(model);
-    let errors = cx.error_count();
-    let d =
-        complete(cx, model, twin, options).and_then(|full| derive_scene(cx, model, &full, scene));
+    let d = complete(&scene_cx, model, twin, options)
+        .and_then(|full| derive_scene(&scene_cx, model, &full, scene));
     own.swap(model);
-    if d.is_none() && cx.error_count() == errors {
-        cx.error_spanned_by(
+    match scene_cx.check() {
+        Err(errors) => {
+            for e in errors {
+                cx.syn_error(syn::Error::new(
+                    e.span(),
+                    format!("scene `{}`: {e}", scene.name),
+                ));
+            }
+        }
+        Ok(()) if d.is_none() => cx.error_spanned_by(
             &scene.name,
             format!("deriving scene `{}` failed", scene.name),
-        );
+        ),
+        Ok(()) => {}
     }
     d.map(|mut d| {
         d.own_constraints = Some(own);
