@@ -216,3 +216,29 @@ fn radau5_switches_where_dop853_does() {
     println!("Radau5 at rtol 1e-10: switch times within {worst:.1e} s of DOP853 at 1e-12");
     assert!(worst < 1e-7, "{worst:e}");
 }
+
+#[test]
+fn the_command_line_evaluates_a_scene_in_its_own_speeds() {
+    // The flight scene has the foot's speed besides the body's, and no
+    // ground constraint: the foot off the ground is no warning there.
+    use appell::cli::Evaluator;
+    let h = &HOPPER;
+    let mut ev = Evaluator::with_scene(HOPPER, "flight").unwrap();
+    let v = ev.eval_line(r#"{"t": 0.0, "q": {"z": 0.55, "f": 0.1}, "u": {"z": 0.4, "f": -0.7}}"#);
+    assert!(
+        v.get("error").is_none() && v.get("warning").is_none(),
+        "{v}"
+    );
+    assert_eq!(v["qdot"]["f"].as_f64(), Some(-0.7));
+    // The foot: m f̈ = k (z − f − l0) − m g.
+    let foot = (h.k * (0.55 - 0.1 - h.l0) - h.m * h.g) / h.m;
+    let got = v["udot"]["f"].as_f64().unwrap();
+    assert!(
+        (got - foot).abs() < 1e-12 * foot.abs().max(1.0),
+        "{got} against {foot}"
+    );
+    // The stance scene holds the foot on the ground: off it, a warning.
+    let mut ev = Evaluator::with_scene(HOPPER, "stance").unwrap();
+    let v = ev.eval_line(r#"{"t": 0.0, "q": {"z": 0.55, "f": 0.1}, "u": {"z": 0.4}}"#);
+    assert!(v.get("warning").is_some(), "{v}");
+}

@@ -132,7 +132,8 @@ impl EvalState {
     }
 
     /// The info of the model or of the selected scene (a scene has the
-    /// model's coordinates, speeds and parameters but its own reduced state).
+    /// model's coordinates and parameters, its own reduced state, and its
+    /// own speeds where it names them).
     fn info(&self, model: &dyn DynModel) -> &'static ModelInfo {
         match self.scene {
             Some(i) => model.dyn_scene_infos()[i],
@@ -180,10 +181,23 @@ impl EvalState {
             None => model.dyn_rhs(t, &state, &inputs, &mut dstate),
         }
         .map_err(|e| e.to_string())?;
+        // q̇ and the holonomic check are the scene's own: a scene may have
+        // other speeds and fewer constraints than the model.
         let mut qdot = vec![0.0; info.coordinates.len()];
-        model
-            .dyn_driven_coordinate_rates(t, &q, &u, &inputs, &mut qdot)
-            .map_err(|e| e.to_string())?;
+        let mut warning = Ok(None);
+        let mut rates_and_warning = |target: &dyn DynModel| {
+            warning = target
+                .dyn_driven_coordinate_rates(t, &q, &u, &inputs, &mut qdot)
+                .map_err(|e| e.to_string())
+                .and_then(|()| holonomic_warning(target, info, t, &q, &qdot, &inputs));
+        };
+        match self.scene {
+            Some(i) => model
+                .dyn_visit_scene(i, &mut rates_and_warning)
+                .map_err(|e| e.to_string())?,
+            None => rates_and_warning(model),
+        }
+        let warning = warning?;
 
         let mut qdot_out = Map::new();
         for (name, v) in info.coordinates.iter().zip(&qdot) {
@@ -197,7 +211,7 @@ impl EvalState {
         let mut answer = Map::new();
         answer.insert("qdot".into(), Value::Object(qdot_out));
         answer.insert("udot".into(), Value::Object(udot_out));
-        if let Some(warning) = holonomic_warning(model, info, t, &q, &qdot, &inputs)? {
+        if let Some(warning) = warning {
             answer.insert("warning".into(), warning);
         }
         let (energies, contacts) = (
