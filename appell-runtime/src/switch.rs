@@ -186,44 +186,8 @@ pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
     inputs_from: &[f64],
     inputs_to: &[f64],
 ) -> Result<Switched, SwitchError> {
-    let (ia, ib) = (from.dyn_info(), to.dyn_info());
-    if ia.coordinates != ib.coordinates {
-        return Err(SwitchError::CoordinatesDiffer);
-    }
-    let n = ia.coordinates.len();
-    let q = &settle(to, ib, t, q, inputs_to)?;
-    let mut qdot = vec![0.0; n];
-    from.dyn_driven_coordinate_rates(t, q, u, inputs_from, &mut qdot)?;
-    let kinetic_before = from.dyn_driven_kinetic_energy(t, q, u, inputs_from)?;
-    let (d, d0) = rows(to, ib, t, q, inputs_to)?;
-    let scale = qdot
-        .iter()
-        .fold(0.0f64, |m, x| m.max(x.abs()))
-        .max(f64::MIN_POSITIVE);
-    let residual = |qdot: &[f64]| -> f64 {
-        let r = &d * DVector::from_column_slice(qdot) + &d0;
-        r.amax() / scale
-    };
-    let mut impulses = Vec::new();
-    if ib.constraints > 0 && residual(&qdot) > TOLERANCE {
-        let (after, lambda) = impulse(from, ia, t, q, u, inputs_from, &d, &d0, 0.0)?;
-        qdot = after;
-        impulses = lambda;
-        let left = residual(&qdot);
-        if left > 1e3 * TOLERANCE {
-            return Err(SwitchError::Unattainable { residual: left });
-        }
-    }
-    let speeds = speeds_of(to, ib, t, q, &qdot)?;
-    let kinetic_after = to.dyn_driven_kinetic_energy(t, q, &speeds, inputs_to)?;
-    Ok(Switched {
-        q: q.clone(),
-        speeds,
-        qdot,
-        impulses,
-        kinetic_before,
-        kinetic_after,
-    })
+    let met = meet(from, to, t, q, u, inputs_from, inputs_to, 0.0)?;
+    met.in_speeds_of(to, t, inputs_to)
 }
 
 /// An impact that leaves `from`'s scene as it is: the motion of `from`
@@ -246,42 +210,94 @@ pub fn impact_state<A: DynModel + ?Sized, C: DynModel + ?Sized>(
     inputs_contact: &[f64],
     restitution: f64,
 ) -> Result<Switched, SwitchError> {
+    if !(0.0..=1.0).contains(&restitution) {
+        return Err(SwitchError::InvalidRestitution(restitution));
+    }
+    let met = meet(
+        from,
+        contact,
+        t,
+        q,
+        u,
+        inputs_from,
+        inputs_contact,
+        restitution,
+    )?;
+    met.in_speeds_of(from, t, inputs_from)
+}
+
+/// The motion of `from` after it meets `contact`'s constraints: the
+/// configuration settled on them, every coordinate's rate after the impulse
+/// (none where the motion already satisfies them), the impulses, and the
+/// kinetic energy before.
+struct Met {
+    q: Vec<f64>,
+    qdot: Vec<f64>,
+    impulses: Vec<f64>,
+    kinetic_before: f64,
+}
+
+impl Met {
+    /// The switch's result in `target`'s speeds.
+    fn in_speeds_of<B: DynModel + ?Sized>(
+        self,
+        target: &B,
+        t: f64,
+        inputs: &[f64],
+    ) -> Result<Switched, SwitchError> {
+        let speeds = speeds_of(target, target.dyn_info(), t, &self.q, &self.qdot)?;
+        let kinetic_after = target.dyn_driven_kinetic_energy(t, &self.q, &speeds, inputs)?;
+        Ok(Switched {
+            q: self.q,
+            speeds,
+            qdot: self.qdot,
+            impulses: self.impulses,
+            kinetic_before: self.kinetic_before,
+            kinetic_after,
+        })
+    }
+}
+
+/// `from`'s motion meeting `contact`'s constraints with Newton's
+/// coefficient `restitution`: after the impulse the rows' residual is −e
+/// times what it was, checked.
+#[allow(clippy::too_many_arguments)]
+fn meet<A: DynModel + ?Sized, C: DynModel + ?Sized>(
+    from: &A,
+    contact: &C,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs_from: &[f64],
+    inputs_contact: &[f64],
+    restitution: f64,
+) -> Result<Met, SwitchError> {
     let (ia, ic) = (from.dyn_info(), contact.dyn_info());
     if ia.coordinates != ic.coordinates {
         return Err(SwitchError::CoordinatesDiffer);
     }
-    if !(0.0..=1.0).contains(&restitution) {
-        return Err(SwitchError::InvalidRestitution(restitution));
-    }
     let q = settle(contact, ic, t, q, inputs_contact)?;
+    let mut qdot = vec![0.0; q.len()];
+    from.dyn_driven_coordinate_rates(t, &q, u, inputs_from, &mut qdot)?;
     let kinetic_before = from.dyn_driven_kinetic_energy(t, &q, u, inputs_from)?;
     let (d, d0) = rows(contact, ic, t, &q, inputs_contact)?;
-    let (qdot, impulses) = if ic.constraints > 0 {
-        let mut before = vec![0.0; q.len()];
-        from.dyn_driven_coordinate_rates(t, &q, u, inputs_from, &mut before)?;
-        let (qdot, lambda) = impulse(from, ia, t, &q, u, inputs_from, &d, &d0, restitution)?;
-        // The rows' residual must now be −e times what it was.
-        let residual = |v: &[f64]| &d * DVector::from_column_slice(v) + &d0;
-        let scale = before.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
-        let left = (residual(&qdot) + restitution * residual(&before)).amax() / scale;
+    let scale = qdot.iter().fold(f64::MIN_POSITIVE, |m, x| m.max(x.abs()));
+    let residual = |v: &[f64]| &d * DVector::from_column_slice(v) + &d0;
+    let before = residual(&qdot);
+    let mut impulses = Vec::new();
+    if ic.constraints > 0 && before.amax() / scale > TOLERANCE {
+        let (after, lambda) = impulse(from, ia, t, &q, u, inputs_from, &d, &d0, restitution)?;
+        let left = (residual(&after) + restitution * before).amax() / scale;
         if left > 1e3 * TOLERANCE {
             return Err(SwitchError::Unattainable { residual: left });
         }
-        (qdot, lambda)
-    } else {
-        let mut qdot = vec![0.0; q.len()];
-        from.dyn_driven_coordinate_rates(t, &q, u, inputs_from, &mut qdot)?;
-        (qdot, Vec::new())
-    };
-    let speeds = speeds_of(from, ia, t, &q, &qdot)?;
-    let kinetic_after = from.dyn_driven_kinetic_energy(t, &q, &speeds, inputs_from)?;
-    Ok(Switched {
+        (qdot, impulses) = (after, lambda);
+    }
+    Ok(Met {
         q,
-        speeds,
         qdot,
         impulses,
         kinetic_before,
-        kinetic_after,
     })
 }
 
