@@ -524,6 +524,8 @@ struct PhaseOde<'p> {
     retained: Vec<usize>,
     n: usize,
     l: usize,
+    /// The reduced state and its rates, reused by every call.
+    reduced: RefCell<(Vec<f64>, Vec<f64>)>,
 }
 
 impl<'p> PhaseOde<'p> {
@@ -539,18 +541,26 @@ impl<'p> PhaseOde<'p> {
                 .collect(),
             n: info.coordinates.len(),
             l: info.speeds.len(),
+            reduced: RefCell::new((vec![0.0; info.state_len()], vec![0.0; info.state_len()])),
         }
+    }
+
+    /// The reduced state of `x`: the retained coordinates, then the speeds.
+    fn reduce<T: Copy>(&self, x: &[T], state: &mut [T]) {
+        let (n, r) = (self.n, self.retained.len());
+        for (s, &k) in state.iter_mut().zip(&self.retained) {
+            *s = x[k];
+        }
+        state[r..].copy_from_slice(&x[n..n + self.l]);
     }
 
     /// ẋ at `(t, x)`.
     fn rates(&self, t: f64, x: &[f64], dx: &mut [f64]) -> Result<(), ModelError> {
         let (n, l, r) = (self.n, self.l, self.retained.len());
         let (q, u) = (&x[..n], &x[n..n + l]);
-        let mut state: Vec<f64> = self.retained.iter().map(|&k| q[k]).collect();
-        state.extend_from_slice(u);
-        let mut reduced = vec![0.0; r + l];
-        self.prepared
-            .rhs(t, &state, &self.phase.inputs, &mut reduced)?;
+        let (state, reduced) = &mut *self.reduced.borrow_mut();
+        self.reduce(x, state);
+        self.prepared.rhs(t, state, &self.phase.inputs, reduced)?;
         self.phase
             .model
             .dyn_driven_coordinate_rates(t, q, u, &self.phase.inputs, &mut dx[..n])?;
@@ -570,15 +580,13 @@ impl<'p> PhaseOde<'p> {
             .map(|&v| Dual64::from_re(v))
             .collect();
         let mut xd: Vec<Dual64> = x.iter().map(|&v| Dual64::from_re(v)).collect();
-        let (mut qdot, mut reduced) = (
-            vec![Dual64::from_re(0.0); n],
-            vec![Dual64::from_re(0.0); r + l],
-        );
+        let zero = Dual64::from_re(0.0);
+        let (mut qdot, mut state, mut reduced) =
+            (vec![zero; n], vec![zero; r + l], vec![zero; r + l]);
         for k in 0..m {
             xd[k].eps = 1.0;
+            self.reduce(&xd, &mut state);
             let (q, u) = (&xd[..n], &xd[n..]);
-            let mut state: Vec<Dual64> = self.retained.iter().map(|&c| q[c]).collect();
-            state.extend_from_slice(u);
             let result = self
                 .prepared
                 .rhs_dual(td, &state, &inputs, &mut reduced)
