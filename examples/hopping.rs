@@ -11,39 +11,12 @@
 mod hopper;
 
 use appell::animate::{svg, Frame, SvgOptions, View};
-use appell::constraint_forces::contact_forces;
-use appell::hybrid::{Guard, Hybrid, HybridError, Phase};
+use appell::hybrid::{Hybrid, HybridError};
 use appell::integrate::Dop853;
-use appell::ModelError;
-use hopper::{HopperFlight, HopperStance, HOPPER};
+use hopper::HOPPER;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let stance = HopperStance::from_ref(&HOPPER);
-    let flight = HopperFlight::from_ref(&HOPPER);
-    // The ground pushes while the stance row's multiplier is positive.
-    let normal = move |t: f64, q: &[f64], u: &[f64]| -> Result<f64, ModelError> {
-        contact_forces(stance, t, q, u, &[])
-            .map(|f| f.multipliers[0])
-            .map_err(|_| ModelError::NonFinite {
-                what: "the normal force",
-            })
-    };
-    let phases = vec![
-        Phase {
-            name: "stance",
-            model: stance,
-            inputs: Vec::new(),
-            guards: vec![Guard::new("lift-off", 1, normal)],
-        },
-        Phase {
-            name: "flight",
-            model: flight,
-            inputs: Vec::new(),
-            guards: vec![Guard::new("touchdown", 0, |_, q: &[f64], _: &[f64]| {
-                Ok(q[1])
-            })],
-        },
-    ];
+    let phases = hopper::phases(&HOPPER);
     let names: Vec<&str> = phases.iter().map(|p| p.name).collect();
     let hybrid = Hybrid::new(phases)
         .solver(Dop853::new().rtol(1e-10).atol(1e-12))

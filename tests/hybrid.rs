@@ -5,24 +5,12 @@
 //! output, falls to zero) and at touchdown (the foot's height reaches
 //! zero, a plastic impact of the foot). Checked against closed forms.
 
-use appell::constraint_forces::contact_forces;
-use appell::hybrid::{Guard, Hybrid, Phase};
+use appell::hybrid::{Hybrid, Phase};
 use appell::integrate::Dop853;
 
 #[path = "../examples/models/hopper.rs"]
 mod hopper;
-use hopper::{HopperFlight, HopperStance, HOPPER};
-
-/// The ground's push on the foot in stance: the stance row's multiplier,
-/// signed so that it is positive while the foot presses on the ground.
-fn normal_force(t: f64, q: &[f64], u: &[f64]) -> Result<f64, appell::ModelError> {
-    let stance = HopperStance::from_ref(&HOPPER);
-    let forces =
-        contact_forces(stance, t, q, u, &[]).map_err(|_| appell::ModelError::NonFinite {
-            what: "the normal force",
-        })?;
-    Ok(forces.multipliers[0])
-}
+use hopper::HOPPER;
 
 /// The hop from `z0` at rest in stance for 3 s, at `rtol` (seven switches).
 fn hop(z0: f64, rtol: f64) -> appell::hybrid::HybridRun {
@@ -39,22 +27,11 @@ fn hop(z0: f64, rtol: f64) -> appell::hybrid::HybridRun {
 }
 
 fn phases() -> Vec<Phase<'static>> {
-    vec![
-        Phase {
-            name: "stance",
-            model: HopperStance::from_ref(&HOPPER),
-            inputs: Vec::new(),
-            guards: vec![Guard::new("lift-off", 1, normal_force)],
-        },
-        Phase {
-            name: "flight",
-            model: HopperFlight::from_ref(&HOPPER),
-            inputs: Vec::new(),
-            guards: vec![Guard::new("touchdown", 0, |_, q: &[f64], _: &[f64]| {
-                Ok(q[1])
-            })],
-        },
-    ]
+    hopper::phases(&HOPPER)
+}
+
+fn normal_force(t: f64, q: &[f64], u: &[f64]) -> Result<f64, appell::ModelError> {
+    hopper::normal_force(&HOPPER, t, q, u)
 }
 
 /// Total energy: both masses' kinetic and gravity energy and the spring's.

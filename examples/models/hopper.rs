@@ -3,7 +3,9 @@
 //! constraint left out, the foot free). `tests/hybrid.rs` and
 //! `examples/hopping.rs` switch between the two scenes.
 
-use appell::Appell;
+use appell::constraint_forces::contact_forces;
+use appell::hybrid::{Guard, Phase};
+use appell::{Appell, ModelError};
 
 /// A body of mass `big_m` at height z on a massless spring leg (stiffness
 /// k, rest length l0) ending in a foot of mass m at height f.
@@ -38,3 +40,38 @@ pub const HOPPER: Hopper = Hopper {
     l0: 0.5,
     g: 9.81,
 };
+
+/// The ground's push on the foot in stance: the stance row's multiplier
+/// (from the constraint-force output), positive while the foot presses on
+/// the ground.
+pub fn normal_force(leg: &Hopper, t: f64, q: &[f64], u: &[f64]) -> Result<f64, ModelError> {
+    contact_forces(HopperStance::from_ref(leg), t, q, u, &[])
+        .map(|forces| forces.multipliers[0])
+        .map_err(|_| ModelError::NonFinite {
+            what: "the normal force",
+        })
+}
+
+/// The two phases of a hop: stance (phase 0), left at lift-off where the
+/// normal force vanishes, and flight (phase 1), left at touchdown where the
+/// foot's height reaches zero.
+pub fn phases(leg: &Hopper) -> Vec<Phase<'_>> {
+    vec![
+        Phase {
+            name: "stance",
+            model: HopperStance::from_ref(leg),
+            inputs: Vec::new(),
+            guards: vec![Guard::new("lift-off", 1, move |t, q: &[f64], u: &[f64]| {
+                normal_force(leg, t, q, u)
+            })],
+        },
+        Phase {
+            name: "flight",
+            model: HopperFlight::from_ref(leg),
+            inputs: Vec::new(),
+            guards: vec![Guard::new("touchdown", 0, |_, q: &[f64], _: &[f64]| {
+                Ok(q[1])
+            })],
+        },
+    ]
+}
