@@ -34,6 +34,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             name: "rolling",
             model: rolling,
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![
                 Guard::new("slips forward", 1, move |t, q: &[f64], u: &[f64]| {
                     Ok(needed(t, q, u)? + limit)
@@ -47,6 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             name: "sliding forward",
             model: PushedDiscSlidingForward::from_ref(&DISC),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
                 Ok(slip(u))
             })],
@@ -55,6 +57,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             name: "sliding backward",
             model: PushedDiscSlidingBackward::from_ref(&DISC),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
                 Ok(-slip(u))
             })],

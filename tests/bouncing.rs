@@ -26,12 +26,8 @@ const BALL: Ball = Ball { m: 0.5, g: 9.81 };
 #[test]
 fn each_bounce_keeps_e_of_the_speed_and_the_bounces_end_zeno() {
     let (h, e, vx) = (1.0, 0.8, 0.3);
-    let phases = vec![Phase {
-        name: "flight",
-        model: BallFlight::from_ref(&BALL),
-        inputs: Vec::new(),
-        guards: vec![Guard::new("bounce", 0, |_, q: &[f64], _: &[f64]| Ok(q[1])).impact(&BALL, e)],
-    }];
+    let phases = vec![Phase::new("flight", BallFlight::from_ref(&BALL))
+        .guard(Guard::new("bounce", 0, |_, q: &[f64], _: &[f64]| Ok(q[1])).impact(&BALL, e))];
     // Closed form: the first impact at √(2h/g) with speed g t, each
     // rebound at e times the impact speed, 2 v/g in the air; the bounces
     // accumulate at t∞ = t1 + 2 e v1 / (g (1 − e)).
@@ -79,6 +75,7 @@ fn bad_settings_are_typed_errors() {
             name: "flight",
             model: flight,
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![
                 Guard::new("bounce", 0, |_, q: &[f64], _: &[f64]| Ok(q[1])).impact(&BALL, 0.5)
             ],

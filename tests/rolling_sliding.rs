@@ -37,6 +37,7 @@ fn phases(disc: &PushedDisc) -> Vec<Phase<'_>> {
             name: "rolling",
             model: PushedDiscRolling::from_ref(disc),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![
                 Guard::new("slips forward", 1, move |t, q: &[f64], u: &[f64]| {
                     Ok(needed_friction(disc, t, q, u)? + limit)
@@ -50,6 +51,7 @@ fn phases(disc: &PushedDisc) -> Vec<Phase<'_>> {
             name: "sliding forward",
             model: PushedDiscSlidingForward::from_ref(disc),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
                 Ok(slip(disc, u))
             })],
@@ -58,6 +60,7 @@ fn phases(disc: &PushedDisc) -> Vec<Phase<'_>> {
             name: "sliding backward",
             model: PushedDiscSlidingBackward::from_ref(disc),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
                 Ok(-slip(disc, u))
             })],

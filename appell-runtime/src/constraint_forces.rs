@@ -331,6 +331,34 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
     u: &[f64],
     inputs: &[f64],
 ) -> Result<ConstraintForces, OracleError> {
+    contact_forces_parts(model, t, q, u, inputs, true).map(|(forces, _)| forces)
+}
+
+/// What [`contact_forces_parts`] found on the way: the motion, and each
+/// contact's normal direction where the declaration gives one.
+pub(crate) struct ContactParts {
+    /// q̇.
+    pub qdot: Vec<f64>,
+    /// The bodies' motion at the oracle's q̈.
+    pub motion: BodyMotion,
+    /// Each contact's unit normal (ground into body), if it has one.
+    pub normals: Vec<Option<[f64; 3]>>,
+    /// Whether every constraint row's reaction is placed (rolling rows,
+    /// holonomic rows found to be normal forces at a contact).
+    pub located: bool,
+}
+
+/// [`contact_forces_dyn`], with the momentum balances for the normals the
+/// coordinates carry only when `balance` (a caller that has other
+/// unknown forces balances them all together).
+pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+    balance: bool,
+) -> Result<(ConstraintForces, ContactParts), OracleError> {
     let info = model.dyn_info();
     let (n, m) = (info.coordinates.len(), info.constraints);
     if info.row_sources.len() != m {
@@ -496,7 +524,7 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
     let unknown: Vec<usize> = (0..nc)
         .filter(|&c| normals[c].is_some() && matches!(contacts[c].normal, Normal::Unavailable(_)))
         .collect();
-    if !unknown.is_empty() && located.iter().all(|&x| x) {
+    if balance && !unknown.is_empty() && located.iter().all(|&x| x) {
         if let Some(values) = balance_normals(
             model, t, q, &qdot, inputs, &motion, &contacts, &unknown, &normals,
         )? {
@@ -514,12 +542,19 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
     for c in &contacts {
         finite(c.force.iter().copied(), "a contact force")?;
     }
-    Ok(ConstraintForces {
+    let forces = ConstraintForces {
         qddot: sol.qddot,
         multipliers: sol.multipliers,
         rows,
         contacts,
-    })
+    };
+    let parts = ContactParts {
+        qdot,
+        motion,
+        normals,
+        located: located.iter().all(|&x| x),
+    };
+    Ok((forces, parts))
 }
 
 /// For every contact, ∂v_P/∂q̇_r (r < n) and the time part (r = n) of the
@@ -576,6 +611,61 @@ fn balance_normals<K: DynModel + ?Sized>(
     unknown: &[usize],
     normals: &[Option<[f64; 3]>],
 ) -> Result<Option<Vec<f64>>, OracleError> {
+    // Moments about the first unknown contact keep the numbers small.
+    let o = contacts[unknown[0]].position;
+    let known: Vec<([f64; 3], [f64; 3])> = contacts.iter().map(|c| (c.position, c.force)).collect();
+    let balance = momentum_residual(model, t, q, qdot, inputs, motion, &known, o)?;
+    let size = balance.size;
+    let k = unknown.len();
+    let mut a = DMatrix::<f64>::zeros(6, k);
+    for (col, &c) in unknown.iter().enumerate() {
+        let dir = normals[c].expect("unknown contacts have a direction");
+        let arm = cross(sub(contacts[c].position, o), dir);
+        for i in 0..3 {
+            a[(i, col)] = dir[i];
+            a[(3 + i, col)] = arm[i];
+        }
+    }
+    let b = DVector::from_column_slice(&balance.residual);
+    let svd = a.clone().svd(true, true);
+    let smax = svd.singular_values.max();
+    let smin = svd.singular_values.min();
+    if smin.is_nan() || smin <= 1e-6 * smax {
+        return Ok(None);
+    }
+    let Ok(x) = svd.solve(&b, 0.0) else {
+        return Ok(None);
+    };
+    let resid = (&a * &x - &b).norm();
+    if !x.iter().all(|v| v.is_finite()) || resid > BALANCE_TOLERANCE * size.max(f64::MIN_POSITIVE) {
+        return Ok(None);
+    }
+    Ok(Some(x.iter().copied().collect()))
+}
+
+/// What the system's momentum balances leave over, about a point `o`:
+/// Σ m a − Σ F (linear) and Σ (r × m a + I α + ω × I ω) − Σ (r × F + L)
+/// (angular), the applied loads and the `known` external forces (point,
+/// force) on the right; zero when those forces are all there is.
+pub(crate) struct MomentumResidual {
+    /// Linear, then angular, N components.
+    pub residual: [f64; 6],
+    /// The largest term that went into it, for relative tolerances.
+    pub size: f64,
+}
+
+/// [`MomentumResidual`] at a motion (q̇, and the accelerations in `motion`).
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn momentum_residual<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q: &[f64],
+    qdot: &[f64],
+    inputs: &[f64],
+    motion: &BodyMotion,
+    known: &[([f64; 3], [f64; 3])],
+    o: [f64; 3],
+) -> Result<MomentumResidual, OracleError> {
     let info = model.dyn_info();
     let nb = info.bodies.len();
     let mut masses = vec![0.0; nb];
@@ -588,8 +678,6 @@ fn balance_normals<K: DynModel + ?Sized>(
     let mut forces = vec![[0.0; 3]; nf];
     let mut torques = vec![[0.0; 3]; nt];
     model.dyn_load_values(t, q, qdot, inputs, &mut forces, &mut torques)?;
-    // Moments about the first unknown contact keep the numbers small.
-    let o = contacts[unknown[0]].position;
     let mut lin = [0.0; 3];
     let mut ang = [0.0; 3];
     let mut size = 0.0_f64;
@@ -620,34 +708,13 @@ fn balance_normals<K: DynModel + ?Sized>(
     for tq in &torques {
         acc([0.0; 3], scale(*tq, -1.0), &mut lin, &mut ang);
     }
-    for c in contacts {
-        let f = scale(c.force, -1.0);
-        acc(f, cross(sub(c.position, o), f), &mut lin, &mut ang);
+    for &(point, force) in known {
+        let f = scale(force, -1.0);
+        acc(f, cross(sub(point, o), f), &mut lin, &mut ang);
     }
     finite(lin.iter().chain(&ang).copied(), "the momentum balance")?;
-    let k = unknown.len();
-    let mut a = DMatrix::<f64>::zeros(6, k);
-    for (col, &c) in unknown.iter().enumerate() {
-        let dir = normals[c].expect("unknown contacts have a direction");
-        let arm = cross(sub(contacts[c].position, o), dir);
-        for i in 0..3 {
-            a[(i, col)] = dir[i];
-            a[(3 + i, col)] = arm[i];
-        }
-    }
-    let b = DVector::from_column_slice(&[lin[0], lin[1], lin[2], ang[0], ang[1], ang[2]]);
-    let svd = a.clone().svd(true, true);
-    let smax = svd.singular_values.max();
-    let smin = svd.singular_values.min();
-    if smin.is_nan() || smin <= 1e-6 * smax {
-        return Ok(None);
-    }
-    let Ok(x) = svd.solve(&b, 0.0) else {
-        return Ok(None);
-    };
-    let resid = (&a * &x - &b).norm();
-    if !x.iter().all(|v| v.is_finite()) || resid > BALANCE_TOLERANCE * size.max(f64::MIN_POSITIVE) {
-        return Ok(None);
-    }
-    Ok(Some(x.iter().copied().collect()))
+    Ok(MomentumResidual {
+        residual: [lin[0], lin[1], lin[2], ang[0], ang[1], ang[2]],
+        size,
+    })
 }

@@ -57,6 +57,9 @@ pub struct Guard<'a> {
     /// An impact first, against the constraints of a scene, with a
     /// coefficient of restitution (see [`Guard::impact`]).
     pub impact: Option<(&'a dyn DynModel, f64)>,
+    /// Whether the guard ends a phase entered with it below zero (see
+    /// [`Guard::after_rising`]).
+    pub on_entry: bool,
 }
 
 impl<'a> Guard<'a> {
@@ -72,7 +75,17 @@ impl<'a> Guard<'a> {
             to,
             value: Box::new(value),
             impact: None,
+            on_entry: true,
         }
+    }
+
+    /// A guard that never ends the phase it starts: below zero on entry,
+    /// it waits until it has been positive and fires where it comes down
+    /// again. For guards below zero on entry by design: a slip speed less
+    /// a threshold, at the start of a slide whose slip starts at zero.
+    pub fn after_rising(mut self) -> Self {
+        self.on_entry = false;
+        self
     }
 
     /// Makes the switch an impact against `contact`'s constraints with
@@ -87,16 +100,66 @@ impl<'a> Guard<'a> {
     }
 }
 
+/// Inputs computed from the motion: called with `(t, q, u, inputs)`, the
+/// inputs starting from the phase's own.
+pub type StateInputs<'a> =
+    Box<dyn Fn(f64, &[f64], &[f64], &mut [f64]) -> Result<(), ModelError> + 'a>;
+
 /// One scene of a hybrid run.
 pub struct Phase<'a> {
     /// Its name, for the log.
     pub name: &'static str,
     /// The scene (the same coordinates as every other phase).
     pub model: &'a dyn DynModel,
-    /// Its inputs, held constant.
+    /// Its inputs, held constant unless `state_inputs` sets them.
     pub inputs: Vec<f64>,
     /// The ways out of it.
     pub guards: Vec<Guard<'a>>,
+    /// Inputs that follow the motion, set at every evaluation of the
+    /// phase's equations and at its switches: a sliding contact's normal
+    /// force ([`crate::sliding::normal_inputs`]), a feedback law. Radau5's
+    /// Jacobian holds them at their values for the state it is taken at.
+    pub state_inputs: Option<StateInputs<'a>>,
+}
+
+impl<'a> Phase<'a> {
+    /// A phase named `name` of scene `model`, without inputs or guards.
+    pub fn new(name: &'static str, model: &'a dyn DynModel) -> Self {
+        Phase {
+            name,
+            model,
+            inputs: vec![0.0; model.dyn_info().inputs.len()],
+            guards: Vec::new(),
+            state_inputs: None,
+        }
+    }
+
+    /// Its inputs (held constant unless [`Phase::state_inputs`] sets them).
+    pub fn inputs(mut self, inputs: Vec<f64>) -> Self {
+        self.inputs = inputs;
+        self
+    }
+
+    /// One more way out.
+    pub fn guard(mut self, guard: Guard<'a>) -> Self {
+        self.guards.push(guard);
+        self
+    }
+
+    /// Inputs that follow the motion (see the field).
+    pub fn state_inputs(mut self, f: StateInputs<'a>) -> Self {
+        self.state_inputs = Some(f);
+        self
+    }
+
+    /// The inputs at `(t, q, u)`.
+    fn inputs_at(&self, t: f64, q: &[f64], u: &[f64]) -> Result<Vec<f64>, ModelError> {
+        let mut inputs = self.inputs.clone();
+        if let Some(f) = &self.state_inputs {
+            f(t, q, u, &mut inputs)?;
+        }
+        Ok(inputs)
+    }
 }
 
 /// One switch of a hybrid run.
@@ -455,6 +518,9 @@ impl<'a> Hybrid<'a> {
         let phase = &self.phases[now.phase];
         let mut worst: Option<(usize, f64)> = None;
         for (k, guard) in phase.guards.iter().enumerate() {
+            if !guard.on_entry {
+                continue;
+            }
             let v = (guard.value)(now.t, &now.q, &now.u).map_err(HybridError::Guard)?;
             if v < -self.guard_tolerance && worst.is_none_or(|(_, w)| v < w) {
                 worst = Some((k, v));
@@ -468,6 +534,12 @@ impl<'a> Hybrid<'a> {
         let from = &self.phases[now.phase];
         let g = &from.guards[guard];
         let to = &self.phases[g.to];
+        // The target's state inputs are not known before its speeds are;
+        // the map reads its constant ones (they matter to driven
+        // constraints only).
+        let inputs_from = from
+            .inputs_at(now.t, &now.q, &now.u)
+            .map_err(|e| HybridError::Switch(SwitchError::Model(e)))?;
         let (q, u, mut impulses, mut lost) = match g.impact {
             Some((contact, e)) => {
                 let hit = impact_state(
@@ -476,7 +548,7 @@ impl<'a> Hybrid<'a> {
                     now.t,
                     &now.q,
                     &now.u,
-                    &from.inputs,
+                    &inputs_from,
                     &[],
                     e,
                 )
@@ -492,7 +564,7 @@ impl<'a> Hybrid<'a> {
             now.t,
             &q,
             &u,
-            &from.inputs,
+            &inputs_from,
             &to.inputs,
         )
         .map_err(HybridError::Switch)?;
@@ -526,6 +598,8 @@ struct PhaseOde<'p> {
     l: usize,
     /// The reduced state and its rates, reused by every call.
     reduced: RefCell<(Vec<f64>, Vec<f64>)>,
+    /// The inputs, reused by every call.
+    inputs: RefCell<Vec<f64>>,
 }
 
 impl<'p> PhaseOde<'p> {
@@ -542,6 +616,7 @@ impl<'p> PhaseOde<'p> {
             n: info.coordinates.len(),
             l: info.speeds.len(),
             reduced: RefCell::new((vec![0.0; info.state_len()], vec![0.0; info.state_len()])),
+            inputs: RefCell::new(phase.inputs.clone()),
         }
     }
 
@@ -559,11 +634,16 @@ impl<'p> PhaseOde<'p> {
         let (n, l, r) = (self.n, self.l, self.retained.len());
         let (q, u) = (&x[..n], &x[n..n + l]);
         let (state, reduced) = &mut *self.reduced.borrow_mut();
+        let inputs = &mut *self.inputs.borrow_mut();
+        if let Some(f) = &self.phase.state_inputs {
+            inputs.copy_from_slice(&self.phase.inputs);
+            f(t, q, u, inputs)?;
+        }
         self.reduce(x, state);
-        self.prepared.rhs(t, state, &self.phase.inputs, reduced)?;
+        self.prepared.rhs(t, state, inputs, reduced)?;
         self.phase
             .model
-            .dyn_driven_coordinate_rates(t, q, u, &self.phase.inputs, &mut dx[..n])?;
+            .dyn_driven_coordinate_rates(t, q, u, inputs, &mut dx[..n])?;
         dx[n..n + l].copy_from_slice(&reduced[r..]);
         Ok(())
     }
@@ -573,9 +653,10 @@ impl<'p> PhaseOde<'p> {
         let (n, l, r) = (self.n, self.l, self.retained.len());
         let m = n + l;
         let td = Dual64::from_re(t);
+        let (q, u) = (&x[..n], &x[n..m]);
         let inputs: Vec<Dual64> = self
             .phase
-            .inputs
+            .inputs_at(t, q, u)?
             .iter()
             .map(|&v| Dual64::from_re(v))
             .collect();

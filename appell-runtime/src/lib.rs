@@ -42,6 +42,8 @@ pub mod oracle;
 pub mod precision;
 mod scalar;
 #[cfg(feature = "std")]
+pub mod sliding;
+#[cfg(feature = "std")]
 pub mod switch;
 
 pub use model::{

@@ -61,6 +61,7 @@ pub fn phases(leg: &Hopper) -> Vec<Phase<'_>> {
             name: "stance",
             model: HopperStance::from_ref(leg),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![Guard::new("lift-off", 1, move |t, q: &[f64], u: &[f64]| {
                 normal_force(leg, t, q, u)
             })],
@@ -69,6 +70,7 @@ pub fn phases(leg: &Hopper) -> Vec<Phase<'_>> {
             name: "flight",
             model: HopperFlight::from_ref(leg),
             inputs: Vec::new(),
+            state_inputs: None,
             guards: vec![Guard::new("touchdown", 0, |_, q: &[f64], _: &[f64]| {
                 Ok(q[1])
             })],

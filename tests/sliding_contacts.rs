@@ -1,0 +1,337 @@
+//! The rolling disc, pushed beyond its friction limit: it slides, its
+//! normal force found from the momentum balances at every evaluation
+//! (`appell::sliding`), and grips again where the slip dies out.
+
+#[path = "../examples/models/sliding_disc.rs"]
+mod sliding_disc;
+
+use appell::hybrid::{Hybrid, HybridRun, Phase};
+use appell::integrate::Dop853;
+use appell::sliding::{sliding_normals, SlidingContact, SlidingError};
+use appell::{DynModel, Model};
+use sliding_disc::{
+    friction_margin, phases, slip, PushedRollingDisc, PushedRollingDiscRolling,
+    PushedRollingDiscSliding, SlidingDisc, DISC, GRIP_SPEED,
+};
+
+/// Rolling upright at 2.25 m/s (spin 15 rad/s), leaning 0.05 rad.
+const Q0: [f64; 5] = [0.0, 0.05, 0.0, 0.0, 0.0];
+const U0: [f64; 3] = [0.0, 0.0, 15.0];
+
+fn contact(disc: &PushedRollingDisc) -> SlidingContact<'_> {
+    SlidingContact::at_rolling_contact(disc, 0, 0, [0.0, 0.0, 1.0])
+}
+
+/// A sliding state from a small generator: coordinates and five speeds.
+fn sliding_states(count: usize) -> Vec<(f64, [f64; 5], [f64; 5])> {
+    let mut seed = 0x2545_f491_4f6c_dd1du64;
+    let mut next = move || {
+        seed ^= seed << 13;
+        seed ^= seed >> 7;
+        seed ^= seed << 17;
+        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
+    };
+    (0..count)
+        .map(|_| {
+            let t = 1.5 * next().abs();
+            let q = [3.0 * next(), 0.6 * next(), 3.0 * next(), next(), next()];
+            let u = [next(), next(), 20.0 * next(), 2.0 * next(), 2.0 * next()];
+            (t, q, u)
+        })
+        .collect()
+}
+
+#[test]
+fn the_sliding_scene_is_the_disc_written_with_sliding_alone() {
+    let scene = PushedRollingDiscSliding::from_ref(&DISC);
+    let alone = DISC.sliding_alone();
+    // The same equations at the same cost.
+    assert_eq!(
+        PushedRollingDiscSliding::info().rhs_ops,
+        SlidingDisc::info().rhs_ops
+    );
+    assert_eq!(
+        PushedRollingDiscSliding::info().speeds,
+        SlidingDisc::info().speeds
+    );
+    let (ps, pa) = (scene.dyn_prepare(), alone.dyn_prepare());
+    let mut worst = 0.0f64;
+    for (t, q, u) in sliding_states(50) {
+        let state = [q[0], q[1], u[0], u[1], u[2], u[3], u[4]];
+        let (mut a, mut b) = ([0.0; 7], [0.0; 7]);
+        ps.rhs(t, &state, &[7.3], &mut a).unwrap();
+        pa.rhs(t, &state, &[7.3], &mut b).unwrap();
+        for (x, y) in a.iter().zip(&b) {
+            worst = worst.max((x - y).abs() / (1.0 + y.abs()));
+        }
+    }
+    println!("sliding scene against the model written alone: {worst:.1e}");
+    assert!(worst < 1e-14, "{worst:e}");
+}
+
+/// The disc's only support is the contact, so its normal force is the
+/// vertical momentum balance m (g + z̈), with z = r cos(lean) the centre's
+/// height: z̈ = −r (cos(lean) leaṅ² + sin(lean) lean̈), lean̈ from the
+/// sliding equations at that normal force.
+#[test]
+fn the_normal_force_is_the_vertical_momentum_balance() {
+    let scene = PushedRollingDiscSliding::from_ref(&DISC);
+    let prepared = scene.dyn_prepare();
+    let mut worst = 0.0f64;
+    for (t, q, u) in sliding_states(50) {
+        let found = sliding_normals(scene, t, &q, &u, &[0.0], &[contact(&DISC)]).unwrap();
+        let n = found.forces[0];
+        let state = [q[0], q[1], u[0], u[1], u[2], u[3], u[4]];
+        let mut rates = [0.0; 7];
+        prepared.rhs(t, &state, &[n], &mut rates).unwrap();
+        let (lean, lean_rate, lean_accel) = (q[1], u[1], rates[3]);
+        let zdd = -DISC.r * (lean.cos() * lean_rate * lean_rate + lean.sin() * lean_accel);
+        let balance = DISC.m * (DISC.g + zdd);
+        worst = worst.max((n - balance).abs() / balance.abs());
+        assert!(found.residual < 1e-12, "{found:?}");
+        assert!(found.feedback[0] < 1.0 && found.rolling.is_empty());
+    }
+    println!("N against m (g + z̈): worst relative difference {worst:.1e}");
+    assert!(worst < 1e-12, "{worst:e}");
+    // At rest, upright, unpushed (sin 0 = 0): the weight.
+    let rest = sliding_normals(scene, 0.0, &[0.0; 5], &[0.0; 5], &[0.0], &[contact(&DISC)]);
+    let n = rest.unwrap().forces[0];
+    assert!((n - DISC.m * DISC.g).abs() < 1e-13 * DISC.m * DISC.g, "{n}");
+}
+
+/// With μ = 2, a disc leaning 0.4 rad and slipping at 45° to its plane
+/// has friction that feeds back into its own normal force by more than
+/// one: no normal force is consistent (Painlevé). The feedback grows in
+/// proportion to μ.
+#[test]
+fn friction_that_feeds_back_too_strongly_is_painleves_paradox() {
+    let q = [0.0, 0.4, 0.0, 0.0, 0.0];
+    let u = [
+        0.0,
+        0.0,
+        0.0,
+        (0.25 * std::f64::consts::PI).cos(),
+        0.5f64.sqrt(),
+    ];
+    let with_mu = |mu: f64| PushedRollingDisc {
+        mu,
+        push: 0.0,
+        ..DISC
+    };
+    let (low, high) = (with_mu(1.0), with_mu(2.0));
+    let found = sliding_normals(
+        PushedRollingDiscSliding::from_ref(&low),
+        0.0,
+        &q,
+        &u,
+        &[0.0],
+        &[contact(&low)],
+    )
+    .unwrap();
+    let kappa = found.feedback[0];
+    assert!(kappa > 0.5 && kappa < 1.0, "{kappa}");
+    let err = sliding_normals(
+        PushedRollingDiscSliding::from_ref(&high),
+        0.0,
+        &q,
+        &u,
+        &[0.0],
+        &[contact(&high)],
+    )
+    .unwrap_err();
+    match err {
+        SlidingError::Paradox { contact, feedback } => {
+            assert_eq!(contact, 0);
+            assert!(
+                (feedback - 2.0 * kappa).abs() < 1e-12 * feedback,
+                "{feedback} {kappa}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // In a hybrid run the paradox is a typed error of the phase's rates.
+    let as_model: appell::ModelError = SlidingError::Paradox {
+        contact: 0,
+        feedback: 1.2,
+    }
+    .into();
+    assert!(matches!(as_model, appell::ModelError::Contact { .. }));
+}
+
+#[test]
+fn a_sliding_contact_declared_wrongly_is_a_typed_error() {
+    let scene = PushedRollingDiscSliding::from_ref(&DISC);
+    let (q, u) = ([0.0; 5], [0.0; 5]);
+    let call = |c: Vec<SlidingContact>, inputs: &[f64]| {
+        sliding_normals(scene, 0.0, &q, &u, inputs, &c).unwrap_err()
+    };
+    let bad = |e: SlidingError| matches!(e, SlidingError::BadContact(_));
+    let z = [0.0, 0.0, 1.0];
+    assert!(bad(call(
+        vec![SlidingContact::at_rolling_contact(&DISC, 0, 1, z)],
+        &[0.0]
+    )));
+    assert!(bad(call(
+        vec![SlidingContact::at_rolling_contact(
+            &DISC,
+            0,
+            0,
+            [0.0, 0.0, 2.0]
+        )],
+        &[0.0]
+    )));
+    assert!(bad(call(vec![contact(&DISC), contact(&DISC)], &[0.0])));
+    assert!(bad(call(vec![contact(&DISC)], &[])));
+    // A contact the model does not have.
+    let err = call(
+        vec![SlidingContact::at_rolling_contact(&DISC, 3, 0, z)],
+        &[0.0],
+    );
+    assert!(
+        matches!(
+            err,
+            SlidingError::Oracle(appell::oracle::OracleError::Model(
+                appell::ModelError::Contact { .. }
+            ))
+        ),
+        "{err:?}"
+    );
+}
+
+fn run(t_end: f64) -> HybridRun {
+    Hybrid::new(phases(&DISC))
+        .solver(Dop853::new().rtol(1e-11).atol(1e-13).event_tol(1e-13))
+        .run::<10>(0, 0.0, &Q0, &U0, t_end)
+        .expect("the run completes")
+}
+
+/// The rolling scene alone from (t0, q0, u0) to t1.
+fn roll(t0: f64, q0: &[f64], u0: &[f64], t1: f64) -> (Vec<f64>, Vec<f64>) {
+    let rolling = PushedRollingDiscRolling::from_ref(&DISC);
+    let end = Hybrid::new(vec![Phase::new("rolling", rolling)])
+        .solver(Dop853::new().rtol(1e-13).atol(1e-15))
+        .run::<10>(0, t0, q0, u0, t1)
+        .expect("rolling")
+        .end;
+    (end.q, end.u)
+}
+
+#[test]
+fn the_disc_slides_where_rolling_needs_mu_n_and_grips_where_the_slip_dies() {
+    let run = run(3.0);
+    for s in &run.switches {
+        println!(
+            "t = {:.9} s: {} -> {} ({}), impulses {:?}, energy lost {:.3e} J",
+            s.t, s.from, s.to, s.reason, s.impulses, s.energy_lost
+        );
+    }
+    let reasons: Vec<&str> = run.switches.iter().map(|s| s.reason).collect();
+    assert_eq!(reasons, ["slips", "grips", "slips", "grips"]);
+
+    // The first slip: where the friction rolling needs reaches μ N, by a
+    // bisection of the constraint-force output along the rolling motion.
+    let slip_at = run.switches[0].t;
+    let (mut a, mut b) = (slip_at - 0.013, slip_at + 0.007);
+    let (mut qa, mut ua) = roll(0.0, &Q0, &U0, a);
+    while b - a > 1e-10 {
+        let mid = 0.5 * (a + b);
+        let (qm, um) = roll(a, &qa, &ua, mid);
+        if friction_margin(&DISC, mid, &qm, &um).unwrap() > 0.0 {
+            (a, qa, ua) = (mid, qm, um);
+        } else {
+            b = mid;
+        }
+    }
+    println!(
+        "the slip: {slip_at:.12} s, bisection {a:.12} s, {:.1e} s apart",
+        (slip_at - a).abs()
+    );
+    assert!((slip_at - a).abs() < 1e-9, "{slip_at} against {a}");
+
+    for s in &run.switches {
+        let at = run
+            .samples
+            .iter()
+            .rposition(|x| x.t == s.t && x.phase == s.from)
+            .map(|k| run.samples[k].clone())
+            .expect("the state before the switch is sampled");
+        let after = run
+            .samples
+            .iter()
+            .find(|x| x.t == s.t && x.phase == s.to)
+            .expect("the state after the switch is sampled");
+        if s.reason == "slips" {
+            // Released: nothing jumps.
+            assert!(
+                s.impulses.is_empty() && s.energy_lost.abs() < 1e-13,
+                "{s:?}"
+            );
+            assert_eq!(&after.u[..3], &at.u[..3]);
+        } else {
+            // Gripping at the slip speed GRIP_SPEED: a plastic impulse Λ
+            // on the two rolling rows takes the slip v to zero and the
+            // energy ½ |Λ · v| with it.
+            let v = slip(&DISC, s.t, &at.q, &at.u).unwrap();
+            let speed = v[0].hypot(v[1]);
+            assert!((speed - GRIP_SPEED).abs() < 1e-9 * GRIP_SPEED, "{speed}");
+            let rolling = PushedRollingDiscRolling::from_ref(&DISC);
+            let mut qdot = [0.0; 5];
+            rolling
+                .dyn_coordinate_rates(s.t, &after.q, &after.u, &mut qdot)
+                .unwrap();
+            let left = slip(&DISC, s.t, &after.q, &qdot).unwrap();
+            assert!(left[0].hypot(left[1]) < 1e-13, "{left:?}");
+            let closed = -0.5 * (s.impulses[0] * v[0] + s.impulses[1] * v[1]);
+            println!(
+                "grip at {:.6} s: lost {:.6e} J, ½|Λ·v| = {closed:.6e} J, relative difference {:.1e}",
+                s.t,
+                s.energy_lost,
+                (s.energy_lost - closed).abs() / closed
+            );
+            // The kinetic energy is about 60 J: the difference is its
+            // round-off.
+            assert!(
+                (s.energy_lost - closed).abs() < 1e-13,
+                "{} against {closed}",
+                s.energy_lost
+            );
+        }
+    }
+}
+
+/// The sliding phase of the hybrid run is the motion of the disc written
+/// with sliding alone, from the same start.
+#[test]
+fn the_sliding_phase_follows_the_disc_written_with_sliding_alone() {
+    let run = run(1.5);
+    let (start, end) = (&run.switches[0], &run.switches[1]);
+    let first = |t: f64, phase: usize| {
+        run.samples
+            .iter()
+            .find(|x| x.t == t && x.phase == phase)
+            .expect("sampled")
+            .clone()
+    };
+    let (s0, s1) = (first(start.t, 1), first(end.t, 1));
+    let alone = DISC.sliding_alone();
+    let c = SlidingContact::at_rolling_contact(&DISC, 0, 0, [0.0, 0.0, 1.0]);
+    let phase = Phase::new("sliding alone", &alone)
+        .state_inputs(appell::sliding::normal_inputs(&alone, vec![c]));
+    let own = Hybrid::new(vec![phase])
+        .solver(Dop853::new().rtol(1e-11).atol(1e-13))
+        .run::<10>(0, s0.t, &s0.q, &s0.u, s1.t)
+        .expect("sliding alone")
+        .end;
+    let worst = own
+        .q
+        .iter()
+        .zip(&s1.q)
+        .chain(own.u.iter().zip(&s1.u))
+        .map(|(a, b)| (a - b).abs() / (1.0 + b.abs()))
+        .fold(0.0f64, f64::max);
+    println!(
+        "sliding {:.6} s to {:.6} s: the scene and the model alone differ by {worst:.1e}",
+        s0.t, s1.t
+    );
+    assert!(worst < 1e-8, "{worst:e}");
+}
