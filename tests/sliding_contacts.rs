@@ -8,7 +8,7 @@ mod sliding_disc;
 use appell::hybrid::{Hybrid, HybridRun, Phase};
 use appell::integrate::Dop853;
 use appell::sliding::{sliding_normals, SlidingContact, SlidingError};
-use appell::{DynModel, Model};
+use appell::{Appell, DynModel, Model};
 use sliding_disc::{
     friction_margin, phases, slip, PushedRollingDisc, PushedRollingDiscRolling,
     PushedRollingDiscSliding, SlidingDisc, DISC, GRIP_SPEED,
@@ -334,4 +334,80 @@ fn the_sliding_phase_follows_the_disc_written_with_sliding_alone() {
         s0.t, s1.t
     );
     assert!(worst < 1e-8, "{worst:e}");
+}
+
+/// A wheelbarrow pushed along the ground: a wheel of radius `r` rolling at
+/// its front, a frame (a particle `m_f` at `d` ahead of the axle and `h`
+/// above the ground) resting on a skid `l` behind the axle, pushed at a
+/// handle `l` behind the axle and `hy` high. The wheel's normal force is
+/// held by the coordinates and the skid's drives the skid's friction: two
+/// unknown normal forces, one of them fed back. (The lateral position `z`
+/// gives the wheel's contact a second rolling row, so that its normal is
+/// the one direction its rows leave out.)
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(x, z, theta), speeds(x), positive(r, m_w, m_f))]
+#[appell(frame(W = N.rotate_z(theta)))]
+#[appell(point(C = O + x * N.x + r * N.y + z * N.z), point(P = C - r * N.y))]
+#[appell(point(G = C + d * N.x + (h - r) * N.y), point(S = C - l * N.x - r * N.y),
+         point(H = C - l * N.x + (hy - r) * N.y))]
+#[appell(body(wheel, center = C, frame = W, mass = m_w,
+              inertia = principal(m_w * r * r / 4, m_w * r * r / 4, m_w * r * r / 2)))]
+#[appell(particle(G, mass = m_f))]
+#[appell(rolls(wheel, contact = P))]
+#[appell(gravity(-g * N.y))]
+#[appell(force(H, push * N.x, effect = push))]
+#[appell(inputs(n_skid))]
+#[appell(friction(S, mu = mu, normal = n_skid, plane = N.y, smoothing = eps, effect = skid))]
+struct Wheelbarrow {
+    r: f64,
+    m_w: f64,
+    m_f: f64,
+    d: f64,
+    h: f64,
+    l: f64,
+    hy: f64,
+    g: f64,
+    mu: f64,
+    eps: f64,
+    push: f64,
+}
+
+/// The wheelbarrow's closed forms, moving forward: with M = m_w + m_f +
+/// I_w/r² and k = r m_w + I_w/r + h m_f, M a = F − μ N_s along the ground,
+/// and the moments about the wheel's contact give
+/// l N_s = −d m_f g − hy F + k a; the wheel carries the rest of the weight.
+/// The skid's own feedback is ∂N_s/∂N_s through a: −μ k/(M l).
+#[test]
+fn a_rolling_wheel_and_a_sliding_skid_share_the_load_as_the_closed_form_says() {
+    let b = Wheelbarrow {
+        r: 0.2,
+        m_w: 2.0,
+        m_f: 10.0,
+        d: -0.4,
+        h: 0.5,
+        l: 1.0,
+        hy: 0.8,
+        g: 9.81,
+        mu: 0.4,
+        eps: 1e-9,
+        push: 30.0,
+    };
+    let i_w = b.m_w * b.r * b.r / 2.0;
+    let big_m = b.m_w + b.m_f + i_w / (b.r * b.r);
+    let k = b.r * b.m_w + i_w / b.r + b.h * b.m_f;
+    let n_skid = (-b.d * b.m_f * b.g - b.hy * b.push + k * b.push / big_m)
+        / (b.l * (1.0 + b.mu * k / (big_m * b.l)));
+    let n_wheel = (b.m_w + b.m_f) * b.g - n_skid;
+    let kappa = -b.mu * k / (big_m * b.l);
+    let l = b.l;
+    let skid = SlidingContact::new(0, [0.0, 1.0, 0.0], move |_, q: &[f64]| {
+        [q[0] - l, 0.0, q[1]]
+    });
+    let found = sliding_normals(&b, 0.3, &[0.7, 0.1, -3.5], &[1.2], &[0.0], &[skid]).unwrap();
+    println!("{found:?}: closed forms N_s = {n_skid}, N_w = {n_wheel}, κ = {kappa}");
+    let rel = |a: f64, b: f64| (a - b).abs() / b.abs();
+    assert!(rel(found.forces[0], n_skid) < 1e-12);
+    assert!(rel(found.rolling[0], n_wheel) < 1e-12);
+    assert!(rel(found.feedback[0], kappa) < 1e-12);
+    assert!(found.residual < 1e-12);
 }

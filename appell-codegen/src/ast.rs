@@ -157,8 +157,22 @@ pub struct RollsDef {
     pub along: Option<Vec<Expr>>,
     /// The effect it belongs to (`effect = name`), as for a constraint.
     pub effect: Option<Ident>,
+    /// The sliding friction that takes the contact's place where a scene
+    /// drops it (`slides = effect, mu = μ, normal = N, ...`).
+    pub slides: Option<SlidesDef>,
     /// The item's tokens, for errors.
     pub at: proc_macro2::TokenStream,
+}
+
+/// A rolling contact's sliding friction: `friction(P, ...)` at the
+/// contact, on the rolling body, in effect `effect`.
+#[derive(Clone, Debug)]
+pub struct SlidesDef {
+    /// The friction's effect (`slides = name`).
+    pub effect: Ident,
+    /// The friction's properties (`mu`, `normal`, `smoothing`, `viscous`,
+    /// `plane`), by name.
+    pub values: std::collections::BTreeMap<String, Expr>,
 }
 
 /// One privileged speed: a coordinate's name (its rate, Method II) or

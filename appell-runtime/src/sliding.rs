@@ -17,7 +17,7 @@
 //!    turn, the system's linear and angular momentum balances leave an
 //!    affine residual R(N) = R₀ + K N. This costs k + 1 evaluations for k
 //!    contacts.
-//! 2. The normal forces must close that residual: A N = R₀ + K N, with A's
+//! 2. The normal forces must close that residual: W N = R₀ + K N, with W's
 //!    columns each contact's normal and its moment. Rolling contacts of
 //!    the scene whose normal force no multiplier carries join as further
 //!    unknowns, with no feedback. The six equations are solved by least
@@ -25,11 +25,13 @@
 //! 3. One more evaluation at the solution reports the residual that is
 //!    left.
 //!
-//! A contact's own feedback κ is the normal force its friction demands per
-//! unit of normal force, n̂ · K's column. Where κ ≥ 1, friction pushes the
-//! contact into the ground faster than the normal force can answer. No
-//! normal force is then consistent, or several are (Painlevé's paradox).
-//! This is reported as [`SlidingError::Paradox`], never solved through.
+//! A contact's own feedback κ is the normal force its friction demands of
+//! itself per unit of normal force, through all the balances: (W⁺ K)_ii,
+//! with W's columns the unknowns' wrenches. Where κ ≥ 1, friction pushes
+//! the contact into the ground faster than the normal force can answer.
+//! No normal force is then consistent, or several are (Painlevé's
+//! paradox). This is reported as [`SlidingError::Paradox`], never solved
+//! through.
 //!
 //! Limits: every other constraint reaction must be placed (rolling rows
 //! at their contacts). A scene with loop-closing holonomic rows or
@@ -39,7 +41,10 @@
 //! its magnitude.
 //!
 //! [`crate::hybrid::Phase::state_inputs`] runs this at every evaluation of
-//! a phase: see [`normal_inputs`].
+//! a phase: see [`normal_inputs`]. The guide's scenes page
+//! (`docs/guide/scenes.md`, "Sliding contacts") has a runnable example on
+//! a derived disc, and `tests/sliding_contacts.rs` checks it against
+//! closed forms.
 
 use nalgebra::{DMatrix, DVector};
 
@@ -116,7 +121,8 @@ pub struct SlidingNormals {
     /// would be pulled down: it lifts off.
     pub forces: Vec<f64>,
     /// Each sliding contact's feedback κ: the normal force its friction
-    /// demands per unit normal force (below 1, or the call fails).
+    /// demands of itself per unit normal force, through all the balances
+    /// (below 1, or the call fails).
     pub feedback: Vec<f64>,
     /// The normal forces at the scene's rolling contacts that no
     /// multiplier carries, solved together with the sliding ones (in
@@ -252,47 +258,20 @@ pub fn sliding_normals<K: DynModel + ?Sized>(
             residual: 0.0,
         });
     }
-    let mut a = DMatrix::<f64>::zeros(6, columns);
-    let mut feedback = Vec::with_capacity(k);
-    let wrench = |point: [f64; 3], n: [f64; 3]| {
-        let arm = cross(sub(point, o), n);
-        [n[0], n[1], n[2], arm[0], arm[1], arm[2]]
-    };
-    for (i, c) in contacts.iter().enumerate() {
-        let w = wrench(points[i], c.normal);
-        let fed: Vec<f64> = (0..6)
-            .map(|r| residuals[i + 1][r] - residuals[0][r])
-            .collect();
-        feedback.push(dot(c.normal, [fed[0], fed[1], fed[2]]));
-        for r in 0..6 {
-            a[(r, i)] = w[r] - fed[r];
-        }
-    }
-    for (j, &(point, n)) in rolling.iter().enumerate() {
-        let w = wrench(point, n);
-        for r in 0..6 {
-            a[(r, k + j)] = w[r];
-        }
-    }
-    if let Some((contact, &kappa)) = feedback
+    let wrenches: Vec<[f64; 6]> = contacts
         .iter()
-        .enumerate()
-        .find(|(_, &f)| f.is_nan() || f >= 1.0)
-    {
-        return Err(SlidingError::Paradox {
-            contact,
-            feedback: kappa,
-        });
-    }
-    let b = DVector::from_column_slice(&residuals[0]);
-    let svd = a.svd(true, true);
-    let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
-    if smin.is_nan() || smin <= 1e-9 * smax {
-        return Err(SlidingError::NotDetermined);
-    }
-    let x = svd
-        .solve(&b, 0.0)
-        .map_err(|_| SlidingError::NotDetermined)?;
+        .zip(&points)
+        .map(|(c, &p)| (p, c.normal))
+        .chain(rolling.iter().copied())
+        .map(|(point, n)| {
+            let arm = cross(sub(point, o), n);
+            [n[0], n[1], n[2], arm[0], arm[1], arm[2]]
+        })
+        .collect();
+    let fed: Vec<[f64; 6]> = (0..k)
+        .map(|i| core::array::from_fn(|r| residuals[i + 1][r] - residuals[0][r]))
+        .collect();
+    let (x, feedback) = solve_normals(&wrenches, &fed, &residuals[0])?;
     for (i, c) in contacts.iter().enumerate() {
         trial[c.input] = x[i];
     }
@@ -320,6 +299,52 @@ pub fn sliding_normals<K: DynModel + ?Sized>(
         rolling: x.iter().skip(k).copied().collect(),
         residual,
     })
+}
+
+/// The normal forces x that close the balance W x = R₀ + K x₁..ₖ (W's
+/// columns the unknowns' wrenches, sliding contacts first; K's the
+/// residual each sliding contact's unit normal force feeds back), and
+/// each sliding contact's own feedback κ_i = (W⁺ K)_ii: the normal force
+/// its friction demands of itself per unit, through all the balances.
+fn solve_normals(
+    wrenches: &[[f64; 6]],
+    fed: &[[f64; 6]],
+    r0: &[f64; 6],
+) -> Result<(DVector<f64>, Vec<f64>), SlidingError> {
+    let (columns, k) = (wrenches.len(), fed.len());
+    let w = DMatrix::from_fn(6, columns, |r, c| wrenches[c][r]);
+    let kmat = DMatrix::from_fn(6, k, |r, c| fed[c][r]);
+    let determined = |m: &DMatrix<f64>| {
+        let svd = m.clone().svd(true, true);
+        let (smax, smin) = (svd.singular_values.max(), svd.singular_values.min());
+        (smin.is_finite() && smin > 1e-9 * smax).then_some(svd)
+    };
+    let wsvd = determined(&w).ok_or(SlidingError::NotDetermined)?;
+    let demanded = wsvd
+        .solve(&kmat, 0.0)
+        .map_err(|_| SlidingError::NotDetermined)?;
+    let feedback: Vec<f64> = (0..k).map(|i| demanded[(i, i)]).collect();
+    if let Some((contact, &kappa)) = feedback
+        .iter()
+        .enumerate()
+        .find(|(_, &f)| f.is_nan() || f >= 1.0)
+    {
+        return Err(SlidingError::Paradox {
+            contact,
+            feedback: kappa,
+        });
+    }
+    let mut a = w;
+    for c in 0..k {
+        for r in 0..6 {
+            a[(r, c)] -= kmat[(r, c)];
+        }
+    }
+    let x = determined(&a)
+        .ok_or(SlidingError::NotDetermined)?
+        .solve(&DVector::from_column_slice(r0), 0.0)
+        .map_err(|_| SlidingError::NotDetermined)?;
+    Ok((x, feedback))
 }
 
 /// The contacts' inputs exist and their normals are unit vectors.

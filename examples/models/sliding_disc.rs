@@ -22,7 +22,9 @@ use appell::sliding::{normal_inputs, SlidingContact};
 use appell::{Appell, Model, ModelError};
 
 /// The pushed disc, rolling (`rolls(..., effect = rolling)`) or sliding
-/// with Coulomb friction μ N at the contact (effect `sliding`).
+/// with Coulomb friction μ N at the contact (`slides = sliding`: the
+/// contact's friction, in effect `sliding`, where a scene drops the
+/// rolling).
 #[allow(clippy::duplicated_attributes)] // the scenes name effects alike
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(
@@ -33,11 +35,11 @@ use appell::{Appell, Model, ModelError};
 #[appell(frame(A = N.rotate_z(yaw)), frame(B = A.rotate_x(lean)), frame(C = B.rotate_y(spin)))]
 #[appell(point(D = O + x * N.x + y * N.y + r * cos(lean) * N.z), point(P = D - r * B.z))]
 #[appell(body(disc, center = D, frame = C, mass = m, inertia = principal(m * r * r / 4, m * r * r / 2, m * r * r / 4)))]
-#[appell(rolls(disc, contact = P, effect = rolling))]
+#[appell(rolls(disc, contact = P, effect = rolling,
+               slides = sliding, mu = mu, normal = normal, smoothing = eps))]
 #[appell(gravity(-g * N.z))]
 #[appell(force(D, push * sin(omega * t) * A.x, effect = push))]
 #[appell(inputs(normal))]
-#[appell(friction(P, mu = mu, normal = normal, smoothing = eps, frame = C, center = D, effect = sliding))]
 #[appell(scene(rolling, effects(gravity, push, rolling)))]
 #[appell(scene(
     sliding,
@@ -62,9 +64,9 @@ pub struct PushedRollingDisc {
     pub omega: f64,
 }
 
-/// The sliding disc alone: the same disc, push and friction, with the
-/// sliding constraint set (none besides the ground's height) and all five
-/// speeds.
+/// The sliding disc alone: the same disc, push and friction (written out
+/// as `friction(P, ...)` on the disc at its contact), with the sliding
+/// constraint set (none besides the ground's height) and all five speeds.
 #[derive(Appell, Clone, Debug, PartialEq)]
 #[appell(
     coordinates(yaw, lean, spin, x, y),

@@ -209,7 +209,6 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
 /// (P − C) × F on B: the loads returned are that force and that torque.
 pub(super) fn parse_friction(s: ParseStream) -> syn::Result<(LoadDef, Option<LoadDef>)> {
     let p: Ident = s.parse()?;
-    let span = p.span();
     let mut values = std::collections::BTreeMap::new();
     let mut effect = None;
     let allowed = [
@@ -234,6 +233,19 @@ pub(super) fn parse_friction(s: ParseStream) -> syn::Result<(LoadDef, Option<Loa
             ));
         }
     }
+    friction_loads(p, values, effect)
+}
+
+/// The loads of a friction at `p` with `values` (`normal`, `mu`, `plane`,
+/// `smoothing`, `viscous`, `frame`, `center`) in `effect` (default
+/// `friction`): a force at P, or a force at the centre and its moment on
+/// the frame.
+pub(super) fn friction_loads(
+    p: Ident,
+    mut values: std::collections::BTreeMap<String, Expr>,
+    effect: Option<Ident>,
+) -> syn::Result<(LoadDef, Option<LoadDef>)> {
+    let span = p.span();
     let n = values
         .remove("plane")
         .unwrap_or_else(|| Expr::Axis(Ident::new("N", span), 2, span));

@@ -203,16 +203,23 @@ pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
 pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::Result<RollsDef> {
     let body: Ident = s.parse()?;
     let (mut contact, mut along, mut effect) = (None, None, None);
+    let (mut slides, mut friction) = (None, std::collections::BTreeMap::new());
+    let mut first_friction_key = None;
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
             "contact" => contact = Some(expr_ident(&v)?),
             "effect" => effect = Some(expr_ident(&v)?),
+            "slides" => slides = Some(expr_ident(&v)?),
+            key @ ("mu" | "normal" | "smoothing" | "viscous" | "plane") => {
+                first_friction_key.get_or_insert(k.clone());
+                friction.insert(key.to_string(), convert(&v)?);
+            }
             "along" => match &v {
                 syn::Expr::Array(a) => along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?),
                 other => return Err(syn::Error::new(other.span(), "`along` takes a list of directions: `along = [A.x, A.y]`")),
             },
             other => {
-                return Err(syn::Error::new(k.span(), format!("unknown rolling property `{other}`; use `contact = P` and optionally `along = [u, v]` and `effect = name`")))
+                return Err(syn::Error::new(k.span(), format!("unknown rolling property `{other}`; use `contact = P` and optionally `along = [u, v]`, `effect = name` and the sliding friction `slides = name, mu = μ, normal = N` (`smoothing`, `viscous`, `plane`)")))
             }
         }
     }
@@ -222,11 +229,25 @@ pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::
             "`rolls` needs `contact = P`, the contact point",
         )
     })?;
+    let slides = match (slides, first_friction_key) {
+        (Some(effect), _) => Some(SlidesDef {
+            effect,
+            values: friction,
+        }),
+        (None, Some(key)) => {
+            return Err(syn::Error::new(
+                key.span(),
+                format!("`{key}` is a property of the contact's sliding friction: name its effect with `slides = name` (the effect a scene names where it drops the rolling)"),
+            ))
+        }
+        (None, None) => None,
+    };
     Ok(RollsDef {
         body,
         contact,
         along,
         effect,
+        slides,
         at,
     })
 }

@@ -121,7 +121,58 @@ pub fn parse_in(
         }
     }
     add_joint_speeds(&mut ast);
+    add_rolling_friction(cx, &mut ast);
     ast
+}
+
+/// Each rolling contact's sliding friction (`slides = effect, ...`) as
+/// `friction(P, ..., frame = B, center = C, effect)` on the rolling body,
+/// across the surface the contact's `along` directions span (N.z unless
+/// `plane` or `along` says otherwise). A body not declared is left to
+/// resolution to report.
+fn add_rolling_friction(cx: &Ctxt, ast: &mut ModelAst) {
+    for r in &ast.rolls {
+        let Some(slides) = &r.slides else { continue };
+        let Some(body) = ast.bodies.iter().find(|b| b.name == r.body) else {
+            continue;
+        };
+        let Some(frame) = &body.frame else {
+            cx.error_at(
+                r.body.span(),
+                "a sliding contact needs a rigid body (with a frame), not a particle",
+            );
+            continue;
+        };
+        let mut values = slides.values.clone();
+        let span = r.contact.span();
+        values.insert("frame".into(), Expr::Name(frame.clone()));
+        values.insert("center".into(), Expr::Name(body.center.clone()));
+        let pair = r
+            .along
+            .as_deref()
+            .and_then(|a| <&[Expr; 2]>::try_from(a).ok());
+        if let (false, Some([e1, e2])) = (values.contains_key("plane"), pair) {
+            // The unit normal e1 × e2 / |e1 × e2|.
+            let call = |f: &str, args: Vec<Expr>| Expr::Call(Ident::new(f, span), args, span);
+            let n = call("cross", vec![e1.clone(), e2.clone()]);
+            let length = call("sqrt", vec![call("dot", vec![n.clone(), n.clone()])]);
+            let inverse = Expr::Binary(
+                crate::ast::BinOp::Div,
+                Box::new(Expr::Int(1, span)),
+                Box::new(length),
+                span,
+            );
+            let unit = Expr::Binary(crate::ast::BinOp::Mul, Box::new(inverse), Box::new(n), span);
+            values.insert("plane".into(), unit);
+        }
+        match elements::friction_loads(r.contact.clone(), values, Some(slides.effect.clone())) {
+            Ok((force, torque)) => {
+                ast.forces.push(force);
+                ast.torques.extend(torque);
+            }
+            Err(e) => cx.syn_error(e),
+        }
+    }
 }
 
 /// The joints' coordinates' rates as privileged speeds, after those of
