@@ -297,3 +297,54 @@ fn a_brake_locks_a_joint_in_the_scenes_that_name_it() {
     );
     assert!(engaged.energy_lost() < engaged.kinetic_before);
 }
+
+/// The braked arm written with the joint property `lock = brake`, which
+/// stands for the elbow marked `dependent` and
+/// `nonholonomic(dt(elbow) == 0, effect = brake)`.
+#[derive(Appell, Clone, Debug, PartialEq)]
+#[appell(joint(shoulder, revolute(z), parent = N, child = L1))]
+#[appell(joint(elbow, revolute(z), parent = L1, child = L2, xyz = [0.5, 0, 0], lock = brake))]
+#[appell(body(upper, frame = L1, mass = m, center = origin(L1) + 0.25 * L1.x, inertia = principal(0.01, 0.02, 0.02)))]
+#[appell(body(lower, frame = L2, mass = m, center = origin(L2) + 0.25 * L2.x, inertia = principal(0.01, 0.02, 0.02)))]
+#[appell(gravity(-g * N.y))]
+#[appell(scene(free, effects(gravity), speeds(shoulder, elbow)))]
+struct LockedArm {
+    m: f64,
+    g: f64,
+}
+
+/// The largest difference between the rhs of `a` and of `b` at `x`.
+fn rhs_difference<A: Model, B: Model>(a: &A, b: &B, x: &[f64]) -> f64 {
+    let (a, b) = (rhs(a, x), rhs(b, x));
+    a.iter()
+        .zip(&b)
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max)
+}
+
+#[test]
+fn a_locked_joint_is_the_brake_written_by_hand() {
+    let shape = |i: &appell::ModelInfo| {
+        let rows = (i.constraints, i.row_sources, i.effects);
+        (i.speeds, i.dependent, i.retained, rows)
+    };
+    assert_eq!(shape(BrakedArm::info()), shape(LockedArm::info()));
+    assert_eq!(shape(BrakedArmFree::info()), shape(LockedArmFree::info()));
+    let mut rng = Rng(31);
+    let mut worst: f64 = 0.0;
+    for _ in 0..50 {
+        let (m, g) = (rng.uniform(0.5, 3.0), rng.uniform(1.0, 10.0));
+        let (by_hand, locked) = (BrakedArm { m, g }, LockedArm { m, g });
+        let mut draw = |n: usize| (0..n).map(|_| rng.uniform(-2.0, 2.0)).collect::<Vec<_>>();
+        let x = draw(BrakedArm::info().state_len());
+        worst = worst.max(rhs_difference(&by_hand, &locked, &x));
+        let x = draw(BrakedArmFree::info().state_len());
+        let free = (
+            BrakedArmFree::from_ref(&by_hand),
+            LockedArmFree::from_ref(&locked),
+        );
+        worst = worst.max(rhs_difference(free.0, free.1, &x));
+    }
+    println!("locked against written by hand, braked and free: {worst:e}");
+    assert!(worst <= 1e-13, "{worst:e}");
+}

@@ -135,6 +135,37 @@ fn an_actuated_joint_is_an_input_and_a_torque_pair() {
     );
 }
 
+#[test]
+fn a_locked_joint_is_a_dependent_joint_and_a_rate_constraint_of_its_effect() {
+    let scenes = "#[appell(scene(loose, effects(gravity), speeds(j1, j2, s)))]
+        #[appell(scene(braked, effects(gravity, brake), speeds(j1, s)))]";
+    same_expansion(
+        &format!(
+            r#"
+        #[appell(joint(j1, revolute(z), parent = N, child = L1))]
+        #[appell(joint(j2, revolute(y), parent = L1, child = L2, xyz = [0, 0, l], lock = brake))]
+        #[appell(joint(s, prismatic(z), parent = L2, child = L3, lock = clutch))]
+        #[appell(body(b2, center = L2_origin + c * L2.x, frame = L2, mass = m, inertia = principal(i1, i2, i3)))]
+        #[appell(body(b3, center = L3_origin + c * L3.x, frame = L3, mass = m, inertia = principal(i1, i2, i3)))]
+        #[appell(gravity(-g * N.z))]
+        {scenes}
+        {STRUCT}"#
+        ),
+        &format!(
+            r#"
+        #[appell(joint(j1, revolute(z), parent = N, child = L1))]
+        #[appell(joint(j2, revolute(y), parent = L1, child = L2, xyz = [0, 0, l], dependent))]
+        #[appell(joint(s, prismatic(z), parent = L2, child = L3, dependent))]
+        #[appell(body(b2, center = L2_origin + c * L2.x, frame = L2, mass = m, inertia = principal(i1, i2, i3)))]
+        #[appell(body(b3, center = L3_origin + c * L3.x, frame = L3, mass = m, inertia = principal(i1, i2, i3)))]
+        #[appell(gravity(-g * N.z))]
+        #[appell(nonholonomic(dt(j2) == 0, effect = brake), nonholonomic(dt(s) == 0, effect = clutch))]
+        {scenes}
+        {STRUCT}"#
+        ),
+    );
+}
+
 fn four_bar(marks: [&str; 3]) -> String {
     let [m1, m2, m3] = marks;
     expand_str(&format!(
@@ -192,6 +223,15 @@ fn bad_joints_say_what_to_write() {
     assert!(e.contains("has no origin"), "{e}");
     let e = error_of("#[appell(joint(j, planar([1, 0, 0]), parent = N, child = A))]");
     assert!(e.contains("a planar joint's normal"), "{e}");
+    let e = error_of("#[appell(joint(j, spherical, parent = N, child = A, lock = brake))]");
+    assert!(
+        e.contains("`lock` is for revolute and prismatic joints"),
+        "{e}"
+    );
+    let e = error_of("#[appell(joint(j, revolute(z), parent = N, child = A, lock = 2))]");
+    assert!(e.contains("`lock` names the effect"), "{e}");
+    let e = error_of("#[appell(joint(j, revolute(z), parent = N, child = A, lock = a, lock = b))]");
+    assert!(e.contains("a joint takes one `lock`"), "{e}");
     let e = error_of("#[appell(joint(j, weld, parent = N, child = A, actuated))]");
     assert!(
         e.contains("`actuated` is for revolute and prismatic joints"),

@@ -73,12 +73,25 @@ pub struct JointDef {
     /// force along, the axis, on the child, and its reaction on the parent).
     pub actuated: bool,
     /// The joint's rates are not privileged speeds (a joint a loop closure
-    /// makes dependent).
+    /// makes dependent, or a locked one).
     pub dependent: bool,
+    /// `lock = effect`: the joint held still where `effect` acts.
+    pub lock: Option<JointLock>,
     /// Springs, dampers, friction and the motor's saturation on the joint.
     pub elements: super::elements::JointElements,
     /// The whole item, for errors.
     pub span: Span,
+}
+
+/// `lock = effect` on a one-axis joint: the velocity constraint
+/// `dt(q) == 0` on its coordinate, belonging to `effect`, so only the
+/// scenes that name the effect hold the joint still (a brake, a clutch).
+#[derive(Clone, Debug)]
+pub struct JointLock {
+    /// The effect the constraint belongs to.
+    pub effect: Ident,
+    /// `lock = effect` as written, for errors about the constraint.
+    pub at: proc_macro2::TokenStream,
 }
 
 const KINDS: &str =
@@ -98,6 +111,7 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
         rpy: None,
         actuated: false,
         dependent: false,
+        lock: None,
         elements: Default::default(),
         span,
     };
@@ -112,6 +126,7 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
             match key.to_string().as_str() {
                 "actuated" => joint.actuated = true,
                 "dependent" => joint.dependent = true,
+                "lock" => return Err(lock_needs_effect(&key)),
                 other => return Err(unknown_property(&key, other)),
             }
             continue;
@@ -127,6 +142,7 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
             "at" => joint.at = Some(super::items::expr_ident(&value)?),
             "xyz" => joint.xyz = Some(triple(&value, "xyz = [x, y, z]")?),
             "rpy" => joint.rpy = Some(triple(&value, "rpy = [roll, pitch, yaw]")?),
+            "lock" => set_lock(&mut joint, &key, &value)?,
             other => return Err(unknown_property(&key, other)),
         }
     }
@@ -167,11 +183,62 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
     Ok(joint)
 }
 
+/// What to write instead of `lock` on a joint of more (or no) axes; None
+/// for a one-axis joint.
+fn cannot_lock(joint: &JointDef) -> Option<String> {
+    let rates = |names: &[&str]| {
+        let q = |s: &&str| format!("`nonholonomic(dt({}{s}) == 0, effect = brake)`", joint.name);
+        names.iter().map(q).collect::<Vec<_>>().join(", ")
+    };
+    let written =
+        |rows: String| format!("hold this joint still with {rows}, and mark it `dependent`");
+    match joint.kind {
+        JointKind::Revolute(_) | JointKind::Prismatic(_) => None,
+        JointKind::Cylindrical(_) => Some(written(rates(&["_angle", "_slide"]))),
+        JointKind::Planar(_) => Some(written(rates(&["_x", "_y", "_angle"]))),
+        JointKind::Weld => Some("a weld joint does not move: there is nothing to lock".into()),
+        JointKind::Spherical | JointKind::Free => Some(
+            "a spherical or free joint's angular velocity components are always privileged speeds of the model, so no constraint holds it still; write the locked mechanism as a model of its own, with a `weld` joint".into(),
+        ),
+    }
+}
+
+fn lock_needs_effect(at: impl quote::ToTokens) -> syn::Error {
+    syn::Error::new_spanned(
+        at,
+        "`lock` names the effect that holds the joint still: `lock = brake`, kept by the scenes that name `brake`",
+    )
+}
+
 fn unknown_property(key: &Ident, other: &str) -> syn::Error {
     syn::Error::new(
         key.span(),
-        format!("unknown joint property `{other}`; a joint has `parent`, `child`, `xyz`, `rpy`, `at`, the elements `stiffness`, `rest`, `damping`, `friction`, `friction_smoothing`, `saturation` and the flags `actuated`, `dependent`"),
+        format!("unknown joint property `{other}`; a joint has `parent`, `child`, `xyz`, `rpy`, `at`, `lock`, the elements `stiffness`, `rest`, `damping`, `friction`, `friction_smoothing`, `saturation` and the flags `actuated`, `dependent`"),
     )
+}
+
+/// `lock = effect`: one effect, a plain name, on a one-axis joint; the
+/// locked joint's rate is not a privileged speed.
+fn set_lock(joint: &mut JointDef, key: &Ident, value: &syn::Expr) -> syn::Result<()> {
+    if let Some(hint) = cannot_lock(joint) {
+        return Err(syn::Error::new(
+            key.span(),
+            format!("`lock` is for revolute and prismatic joints; {hint}"),
+        ));
+    }
+    if joint.lock.is_some() {
+        return Err(syn::Error::new(
+            key.span(),
+            "a joint takes one `lock`: name its effect in every scene that holds the joint still",
+        ));
+    }
+    let effect = super::items::expr_ident(value).map_err(|_| lock_needs_effect(value))?;
+    joint.lock = Some(JointLock {
+        at: quote::quote!(#key = #effect),
+        effect,
+    });
+    joint.dependent = true;
+    Ok(())
 }
 
 fn parse_kind(e: &syn::Expr) -> syn::Result<JointKind> {
@@ -274,6 +341,8 @@ pub(super) struct Lowered {
     pub speed_definitions: Vec<SpeedDef>,
     /// Holonomic constraints (a quaternion's unit norm).
     pub holonomic: Vec<ConstraintDef>,
+    /// Velocity constraints (a lock's `dt(q) == 0`).
+    pub nonholonomic: Vec<ConstraintDef>,
 }
 
 /// The joint's frames, points, coordinates, privileged speeds, inputs and
@@ -305,6 +374,7 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         torques: Vec::new(),
         speed_definitions: Vec::new(),
         holonomic: Vec::new(),
+        nonholonomic: Vec::new(),
     };
     // The joint frame: the parent's axes turned by rpy, when it turns them.
     let rpy = j.rpy.as_ref().map(rpy_rotations).unwrap_or_default();
@@ -426,7 +496,23 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
             at,
         );
     }
+    if let Some(lock) = &j.lock {
+        out.nonholonomic.push(locked(&j.name, lock));
+    }
     Ok(out)
+}
+
+/// `dt(q) == 0` on a locked joint's coordinate `q`, of the lock's effect.
+fn locked(q: &Ident, lock: &JointLock) -> ConstraintDef {
+    let span = lock.effect.span();
+    let rate = Expr::Call(Ident::new("dt", span), vec![Expr::Name(q.clone())], span);
+    ConstraintDef {
+        lhs: rate,
+        rhs: Expr::Int(0, span),
+        along: None,
+        effect: Some(lock.effect.clone()),
+        at: lock.at.clone(),
+    }
 }
 
 /// A ball's quaternion coordinates, its unit-norm constraint and its

@@ -194,7 +194,8 @@ fn add_joint_speeds(ast: &mut ModelAst) {
     }
 }
 
-/// Adds a joint's frames, points, coordinates, speeds, inputs and loads.
+/// Adds a joint's frames, points, coordinates, speeds, inputs, loads and
+/// constraints.
 pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
     let parent_origin = if joint.parent == "N" {
         Some(Ident::new("O", joint.parent.span()))
@@ -216,6 +217,7 @@ pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Re
     ast.forces.extend(lowered.forces);
     ast.torques.extend(lowered.torques);
     ast.holonomic.extend(lowered.holonomic);
+    ast.nonholonomic.extend(lowered.nonholonomic);
     if !lowered.speed_definitions.is_empty() {
         let (list, _) = ast
             .speeds

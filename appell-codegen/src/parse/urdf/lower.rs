@@ -153,6 +153,7 @@ pub(super) fn lower(
             xyz: Some(joints[j].xyz.clone()),
             rpy: Some(joints[j].rpy.clone()),
             dependent: mimic,
+            lock: None,
             elements: Default::default(),
             span,
         };
