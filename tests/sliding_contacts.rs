@@ -411,3 +411,142 @@ fn a_rolling_wheel_and_a_sliding_skid_share_the_load_as_the_closed_form_says() {
     assert!(rel(found.feedback[0], kappa) < 1e-12);
     assert!(found.residual < 1e-12);
 }
+
+#[path = "../examples/models/slipping_axle.rs"]
+mod slipping_axle;
+
+use slipping_axle::{
+    margins, slip_at, SlippingAxleGripping, SlippingAxleSlipping, AXLE, WHEEL_2_MU,
+};
+
+/// Rolling straight downhill at 1.5 m/s.
+const AXLE_Q0: [f64; 5] = [0.0; 5];
+const AXLE_U0: [f64; 2] = [0.0, 5.0];
+
+fn axle_run(t_end: f64) -> HybridRun {
+    Hybrid::new(slipping_axle::phases(&AXLE))
+        .solver(Dop853::new().rtol(1e-11).atol(1e-13).event_tol(1e-13))
+        .sample_every(0.05)
+        .run::<10>(0, 0.0, &AXLE_Q0, &AXLE_U0, t_end)
+        .expect("the run completes")
+}
+
+/// The wheel-axle with wheel 1 on ice: it slips where the drive asks more
+/// than μ N₁, grips again where its slip dies, and wheel 2 grips
+/// throughout. Its normal forces always carry the weight's normal part
+/// between them (nothing moves vertically), and the slip formula the
+/// guard uses vanishes wherever both wheels grip.
+#[test]
+fn on_a_slope_the_wheel_on_ice_slips_while_the_other_rolls() {
+    let run = axle_run(4.0);
+    for s in &run.switches {
+        println!(
+            "t = {:.9} s: {} -> {} ({}), impulses {:?}, energy lost {:.3e} J",
+            s.t, s.from, s.to, s.reason, s.impulses, s.energy_lost
+        );
+    }
+    let reasons: Vec<&str> = run.switches.iter().map(|s| s.reason).collect();
+    assert_eq!(reasons, ["wheel 1 slips", "wheel 1 grips"]);
+    let weight = (2.0 * AXLE.m_w + AXLE.m_a) * AXLE.g * AXLE.alpha.cos();
+    let support = |s: &appell::hybrid::Sample| {
+        let tau = slipping_axle::torque(s.t);
+        if s.phase == 0 {
+            let scene = SlippingAxleGripping::from_ref(&AXLE);
+            let c = SlidingContact::support_at_rolling_contact(&AXLE, 0, [0.0, 0.0, 1.0]);
+            sliding_normals(scene, s.t, &s.q, &s.u, &[tau], &[c]).unwrap()
+        } else {
+            let scene = SlippingAxleSlipping::from_ref(&AXLE);
+            let c = SlidingContact::at_rolling_contact(&AXLE, 0, 1, [0.0, 0.0, 1.0]);
+            sliding_normals(scene, s.t, &s.q, &s.u, &[tau, 0.0], &[c]).unwrap()
+        }
+    };
+    let (mut worst_sum, mut worst_slip, mut low_margin) = (0.0f64, 0.0f64, f64::INFINITY);
+    let (mut n_low, mut n_high) = (f64::INFINITY, 0.0f64);
+    for s in &run.samples {
+        let found = support(s);
+        let (n1, n2) = (found.forces[0], found.rolling[0]);
+        worst_sum = worst_sum.max((n1 + n2 - weight).abs() / weight);
+        (n_low, n_high) = (n_low.min(n1), n_high.max(n1));
+        if s.phase == 0 {
+            let scene = SlippingAxleGripping::from_ref(&AXLE);
+            let mut qdot = [0.0; 5];
+            scene
+                .dyn_driven_coordinate_rates(
+                    s.t,
+                    &s.q,
+                    &s.u,
+                    &[slipping_axle::torque(s.t)],
+                    &mut qdot,
+                )
+                .unwrap();
+            let v = slip_at(&AXLE, &s.q, &qdot);
+            worst_slip = worst_slip.max(v[0].hypot(v[1]));
+            let m = margins(&AXLE, s.t, &s.q, &s.u, slipping_axle::torque(s.t)).unwrap();
+            low_margin = low_margin.min(m[1]);
+        }
+    }
+    println!(
+        "N1 + N2 against the weight: {worst_sum:.1e}; N1 from {n_low:.3} N to {n_high:.3} N; \
+         slip while gripping {worst_slip:.1e} m/s; wheel 2's smallest margin {low_margin:.3} N"
+    );
+    assert!(worst_sum < 1e-12, "{worst_sum:e}");
+    assert!(worst_slip < 1e-12, "{worst_slip:e}");
+    assert!(low_margin > 0.0, "wheel 2 would slip (μ = {WHEEL_2_MU})");
+    // The gyroscopic moment of the spinning wheels moves load between them.
+    assert!(n_high - n_low > 5.0, "{n_low} {n_high}");
+
+    // The slip: where μ N₁ runs out, by a bisection of the same margin
+    // along the gripping motion alone.
+    let slip_at_t = run.switches[0].t;
+    let gripping = |t0: f64, q0: &[f64], u0: &[f64], t1: f64| {
+        let phase = Phase::new("gripping", SlippingAxleGripping::from_ref(&AXLE)).state_inputs(
+            Box::new(|t, _, _, inputs: &mut [f64]| {
+                inputs[0] = slipping_axle::torque(t);
+                Ok(())
+            }),
+        );
+        let end = Hybrid::new(vec![phase])
+            .solver(Dop853::new().rtol(1e-13).atol(1e-15))
+            .run::<10>(0, t0, q0, u0, t1)
+            .expect("gripping")
+            .end;
+        (end.q, end.u)
+    };
+    let (mut a, mut b) = (slip_at_t - 0.013, slip_at_t + 0.007);
+    let (mut qa, mut ua) = gripping(0.0, &AXLE_Q0, &AXLE_U0, a);
+    while b - a > 1e-10 {
+        let mid = 0.5 * (a + b);
+        let (qm, um) = gripping(a, &qa, &ua, mid);
+        if margins(&AXLE, mid, &qm, &um, slipping_axle::torque(mid)).unwrap()[0] > 0.0 {
+            (a, qa, ua) = (mid, qm, um);
+        } else {
+            b = mid;
+        }
+    }
+    println!("wheel 1 slips at {slip_at_t:.12} s, bisection {a:.12} s");
+    assert!((slip_at_t - a).abs() < 1e-9, "{slip_at_t} against {a}");
+
+    // The grip: a plastic impulse on wheel 1's rolling row takes its slip
+    // (GRIP_SPEED along A.x) and ½ |Λ v| of energy.
+    let grip = &run.switches[1];
+    let before = run
+        .samples
+        .iter()
+        .rev()
+        .find(|x| x.t == grip.t && x.phase == 1)
+        .expect("sampled");
+    let v = slipping_axle::slip(&AXLE, grip.t, &before.q, &before.u).unwrap();
+    let phi = before.q[0];
+    let along = v[0] * phi.cos() + v[1] * phi.sin();
+    let closed = 0.5 * (grip.impulses[0] * along).abs();
+    println!(
+        "grip: lost {:.6e} J, ½|Λ v| = {closed:.6e} J",
+        grip.energy_lost
+    );
+    assert!(
+        (grip.energy_lost - closed).abs() < 1e-13,
+        "{} {closed}",
+        grip.energy_lost
+    );
+    assert!(grip.impulses[1..].iter().all(|x| x.abs() < 1e-12));
+}

@@ -334,6 +334,84 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
     contact_forces_parts(model, t, q, u, inputs, true).map(|(forces, _)| forces)
 }
 
+/// Contact `c`'s reaction from its rolling rows, and its unit normal (from
+/// the ground into the body) where the declaration gives one; the normal
+/// force itself is left to the callers.
+#[allow(clippy::too_many_arguments)]
+fn rolling_contact(
+    info: &ModelInfo,
+    c: usize,
+    ci: &crate::model::ContactInfo,
+    points: &[[f64; 3]],
+    directions: &[[f64; 3]],
+    multipliers: &[f64],
+    motion: &BodyMotion,
+) -> Result<(ContactForce, Option<[f64; 3]>), OracleError> {
+    if ci.body >= info.bodies.len() {
+        return Err(OracleError::InvalidInfo(format!(
+            "contact {c} names body {} of {}",
+            ci.body,
+            info.bodies.len()
+        )));
+    }
+    let mut rolling = [0.0; 3];
+    let mut present = [false; 3];
+    let mut count = 0;
+    for (s, src) in info.row_sources.iter().enumerate() {
+        if let RowSource::Rolling { contact, direction } = *src {
+            if contact == c {
+                rolling = add(rolling, scale(directions[s], multipliers[s]));
+                if direction < 3 {
+                    present[direction] = true;
+                }
+                count += 1;
+            }
+        }
+    }
+    let raw = if ci.along {
+        let dirs: Vec<[f64; 3]> = info
+            .row_sources
+            .iter()
+            .zip(directions)
+            .filter(|(src, _)| matches!(src, RowSource::Rolling { contact, .. } if *contact == c))
+            .map(|(_, d)| *d)
+            .collect();
+        (dirs.len() == 2).then(|| cross(dirs[0], dirs[1]))
+    } else {
+        let missing: Vec<usize> = (0..3).filter(|&i| !present[i]).collect();
+        (missing.len() == 1 && count == 2).then(|| {
+            let mut e = [0.0; 3];
+            e[missing[0]] = 1.0;
+            e
+        })
+    };
+    let arm = sub(motion.position[ci.body], points[c]);
+    let (normal, dir) = match raw {
+        None => (Normal::Unavailable(NormalUnavailable::NoDirection), None),
+        Some(v) => {
+            let (len, side) = (norm(v), dot(v, arm));
+            if len == 0.0 || side.abs() <= 1e-9 * len * norm(arm) {
+                (Normal::Unavailable(NormalUnavailable::Unorientable), None)
+            } else {
+                let unit = scale(v, side.signum() / len);
+                (
+                    Normal::Unavailable(NormalUnavailable::NotDetermined),
+                    Some(unit),
+                )
+            }
+        }
+    };
+    let contact = ContactForce {
+        body: ci.body,
+        point: ci.point,
+        position: points[c],
+        rolling,
+        force: rolling,
+        normal,
+    };
+    Ok((contact, dir))
+}
+
 /// What [`contact_forces_parts`] found on the way: the motion, and each
 /// contact's normal direction where the declaration gives one.
 pub(crate) struct ContactParts {
@@ -396,71 +474,10 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
     let mut contacts: Vec<ContactForce> = Vec::with_capacity(nc);
     let mut normals: Vec<Option<[f64; 3]>> = Vec::with_capacity(nc);
     for (c, ci) in info.contacts.iter().enumerate() {
-        if ci.body >= info.bodies.len() {
-            return Err(OracleError::InvalidInfo(format!(
-                "contact {c} names body {} of {}",
-                ci.body,
-                info.bodies.len()
-            )));
-        }
-        let mut rolling = [0.0; 3];
-        let mut present = [false; 3];
-        let mut count = 0;
-        for (s, src) in info.row_sources.iter().enumerate() {
-            if let RowSource::Rolling { contact, direction } = *src {
-                if contact == c {
-                    rolling = add(rolling, scale(directions[s], sol.multipliers[s]));
-                    if direction < 3 {
-                        present[direction] = true;
-                    }
-                    count += 1;
-                }
-            }
-        }
-        let raw = if ci.along {
-            let dirs: Vec<[f64; 3]> = info
-                .row_sources
-                .iter()
-                .zip(&directions)
-                .filter(
-                    |(src, _)| matches!(src, RowSource::Rolling { contact, .. } if *contact == c),
-                )
-                .map(|(_, d)| *d)
-                .collect();
-            (dirs.len() == 2).then(|| cross(dirs[0], dirs[1]))
-        } else {
-            let missing: Vec<usize> = (0..3).filter(|&i| !present[i]).collect();
-            (missing.len() == 1 && count == 2).then(|| {
-                let mut e = [0.0; 3];
-                e[missing[0]] = 1.0;
-                e
-            })
-        };
-        let arm = sub(motion.position[ci.body], points[c]);
-        let (normal, dir) = match raw {
-            None => (Normal::Unavailable(NormalUnavailable::NoDirection), None),
-            Some(v) => {
-                let (len, side) = (norm(v), dot(v, arm));
-                if len == 0.0 || side.abs() <= 1e-9 * len * norm(arm) {
-                    (Normal::Unavailable(NormalUnavailable::Unorientable), None)
-                } else {
-                    let unit = scale(v, side.signum() / len);
-                    (
-                        Normal::Unavailable(NormalUnavailable::NotDetermined),
-                        Some(unit),
-                    )
-                }
-            }
-        };
+        let (contact, dir) =
+            rolling_contact(info, c, ci, &points, &directions, &sol.multipliers, &motion)?;
+        contacts.push(contact);
         normals.push(dir);
-        contacts.push(ContactForce {
-            body: ci.body,
-            point: ci.point,
-            position: points[c],
-            rolling,
-            force: rolling,
-            normal,
-        });
     }
 
     // Holonomic rows that are normal forces at a contact.
@@ -483,28 +500,12 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
         let jac = point_jacobians(model, info, t, q, &points)?;
         for &(s, index) in &holonomic_rows {
             let row = &dmat[s * n..(s + 1) * n];
-            let row_norm = row.iter().map(|x| x * x).sum::<f64>().sqrt();
             for c in 0..nc {
                 let Some(dir) = normals[c] else { continue };
                 if !matches!(contacts[c].normal, Normal::Unavailable(_)) {
                     continue;
                 }
-                // g_r = n̂ · ∂v_P/∂q̇_r (and the time column for d).
-                let g: Vec<f64> = (0..=n).map(|r| dot(jac[c][r], dir)).collect();
-                let gg: f64 = g[..n].iter().map(|x| x * x).sum();
-                if gg == 0.0 {
-                    continue;
-                }
-                let k = row.iter().zip(&g).map(|(a, b)| a * b).sum::<f64>() / gg;
-                let resid = row
-                    .iter()
-                    .zip(&g)
-                    .map(|(a, b)| (a - k * b).powi(2))
-                    .sum::<f64>()
-                    .sqrt();
-                let time_resid = (d0[s] - k * g[n]).abs();
-                let tol = ROW_MATCH_TOLERANCE * row_norm.max(f64::MIN_POSITIVE);
-                if resid <= tol && time_resid <= tol {
+                if let Some(k) = row_as_normal(row, d0[s], &jac[c], dir) {
                     let force = k * sol.multipliers[s];
                     contacts[c].normal = Normal::Available {
                         direction: dir,
@@ -555,6 +556,31 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
         located: located.iter().all(|&x| x),
     };
     Ok((forces, parts))
+}
+
+/// k where a holonomic row (its q̇ part `row`, its time part `time`) is k
+/// times the normal velocity along `dir` of the body's material point at
+/// a contact (`jac`: ∂v_P/∂q̇_r, then the time part), to
+/// [`ROW_MATCH_TOLERANCE`]: then its reaction is a force along `dir` there.
+fn row_as_normal(row: &[f64], time: f64, jac: &[[f64; 3]], dir: [f64; 3]) -> Option<f64> {
+    let n = row.len();
+    // g_r = n̂ · ∂v_P/∂q̇_r (and the time column for d).
+    let g: Vec<f64> = (0..=n).map(|r| dot(jac[r], dir)).collect();
+    let gg: f64 = g[..n].iter().map(|x| x * x).sum();
+    if gg == 0.0 {
+        return None;
+    }
+    let k = row.iter().zip(&g).map(|(a, b)| a * b).sum::<f64>() / gg;
+    let resid = row
+        .iter()
+        .zip(&g)
+        .map(|(a, b)| (a - k * b).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    let time_resid = (time - k * g[n]).abs();
+    let row_norm = row.iter().map(|x| x * x).sum::<f64>().sqrt();
+    let tol = ROW_MATCH_TOLERANCE * row_norm.max(f64::MIN_POSITIVE);
+    (resid <= tol && time_resid <= tol).then_some(k)
 }
 
 /// For every contact, ∂v_P/∂q̇_r (r < n) and the time part (r = n) of the

@@ -33,6 +33,10 @@
 //! paradox). This is reported as [`SlidingError::Paradox`], never solved
 //! through.
 //!
+//! A rolling contact whose declaration gives no normal (`along = [A.x]`,
+//! as one of two wheels on an axle is declared) joins as a support
+//! ([`SlidingContact::support_at_rolling_contact`]).
+//!
 //! Limits: every other constraint reaction must be placed (rolling rows
 //! at their contacts). A scene with loop-closing holonomic rows or
 //! nonholonomic rows besides rolling ones gets
@@ -56,11 +60,14 @@ use crate::oracle::OracleError;
 /// A contact point's position at `(t, q)`, N components.
 pub type PointFn<'a> = Box<dyn Fn(f64, &[f64]) -> Result<[f64; 3], ModelError> + 'a>;
 
-/// One contact where a body slides over a fixed surface.
+/// One contact whose normal force the momentum balances decide: a body
+/// sliding over a fixed surface, its friction reading the normal force
+/// from an input, or a plain support (`input: None`): a rolling contact
+/// whose declaration does not give its normal (`along = [A.x]`).
 pub struct SlidingContact<'a> {
     /// The index of the scene's input that carries the contact's normal
-    /// force (the `normal = ...` of its friction).
-    pub input: usize,
+    /// force (the `normal = ...` of its friction); `None` for a support.
+    pub input: Option<usize>,
     /// The surface's unit normal, from the ground into the body, N
     /// components.
     pub normal: [f64; 3],
@@ -77,9 +84,34 @@ impl<'a> SlidingContact<'a> {
         point: impl Fn(f64, &[f64]) -> [f64; 3] + 'a,
     ) -> Self {
         SlidingContact {
-            input,
+            input: Some(input),
             normal,
             point: Box::new(move |t, q| Ok(point(t, q))),
+        }
+    }
+
+    /// A support without friction at `point(t, q)`, normal `normal`: its
+    /// normal force is solved for with the others.
+    pub fn support(normal: [f64; 3], point: impl Fn(f64, &[f64]) -> [f64; 3] + 'a) -> Self {
+        SlidingContact {
+            input: None,
+            normal,
+            point: Box::new(move |t, q| Ok(point(t, q))),
+        }
+    }
+
+    /// A support without friction at `model`'s rolling contact `contact`:
+    /// a rolling contact of the scene whose declaration does not give its
+    /// normal (`along = [A.x]`), so that its normal force is solved for
+    /// with the others.
+    pub fn support_at_rolling_contact(
+        model: &'a dyn DynModel,
+        contact: usize,
+        normal: [f64; 3],
+    ) -> Self {
+        SlidingContact {
+            input: None,
+            ..Self::at_rolling_contact(model, contact, 0, normal)
         }
     }
 
@@ -106,7 +138,7 @@ impl<'a> SlidingContact<'a> {
             Ok(points[contact])
         };
         SlidingContact {
-            input,
+            input: Some(input),
             normal,
             point: Box::new(point),
         }
@@ -116,13 +148,13 @@ impl<'a> SlidingContact<'a> {
 /// The normal forces [`sliding_normals`] found.
 #[derive(Clone, Debug, PartialEq)]
 pub struct SlidingNormals {
-    /// Each sliding contact's normal force, in the order given. It is
+    /// Each contact's normal force, in the order given. It is
     /// positive where the ground pushes. A negative value means the body
     /// would be pulled down: it lifts off.
     pub forces: Vec<f64>,
-    /// Each sliding contact's feedback κ: the normal force its friction
-    /// demands of itself per unit normal force, through all the balances
-    /// (below 1, or the call fails).
+    /// Each contact's feedback κ: the normal force its friction demands of
+    /// itself per unit normal force, through all the balances (below 1, or
+    /// the call fails; 0 for a support).
     pub feedback: Vec<f64>,
     /// The normal forces at the scene's rolling contacts that no
     /// multiplier carries, solved together with the sliding ones (in
@@ -242,8 +274,15 @@ pub fn sliding_normals<K: DynModel + ?Sized>(
     let mut residuals: Vec<[f64; 6]> = Vec::with_capacity(k + 1);
     let mut rolling: Vec<([f64; 3], [f64; 3])> = Vec::new();
     for j in 0..=k {
+        if j > 0 && contacts[j - 1].input.is_none() {
+            // A support feeds nothing back.
+            residuals.push(residuals[0]);
+            continue;
+        }
         for (i, c) in contacts.iter().enumerate() {
-            trial[c.input] = if j == i + 1 { 1.0 } else { 0.0 };
+            if let Some(input) = c.input {
+                trial[input] = if j == i + 1 { 1.0 } else { 0.0 };
+            }
         }
         let (residual, unknown) = balance_at(model, t, q, u, &trial, o, &[])?;
         residuals.push(residual.residual);
@@ -273,7 +312,9 @@ pub fn sliding_normals<K: DynModel + ?Sized>(
         .collect();
     let (x, feedback) = solve_normals(&wrenches, &fed, &residuals[0])?;
     for (i, c) in contacts.iter().enumerate() {
-        trial[c.input] = x[i];
+        if let Some(input) = c.input {
+            trial[input] = x[i];
+        }
     }
     let placed: Vec<([f64; 3], [f64; 3])> = rolling
         .iter()
@@ -361,9 +402,9 @@ fn check_contacts<K: DynModel + ?Sized>(
         )));
     }
     for (i, c) in contacts.iter().enumerate() {
-        if c.input >= declared {
+        if c.input.is_some_and(|input| input >= declared) {
             return Err(SlidingError::BadContact(format!(
-                "contact {i} names input {}, the scene has {declared}",
+                "contact {i} names input {:?}, the scene has {declared}",
                 c.input
             )));
         }
@@ -373,9 +414,9 @@ fn check_contacts<K: DynModel + ?Sized>(
                 "contact {i}'s normal has length {len}, not 1"
             )));
         }
-        if contacts[..i].iter().any(|other| other.input == c.input) {
+        if c.input.is_some() && contacts[..i].iter().any(|other| other.input == c.input) {
             return Err(SlidingError::BadContact(format!(
-                "contacts share input {}",
+                "contacts share input {:?}",
                 c.input
             )));
         }
@@ -410,8 +451,9 @@ fn balance_at<K: DynModel + ?Sized>(
     let mut unknown = Vec::new();
     for (c, contact) in forces.contacts.iter().enumerate() {
         known.push((contact.position, contact.force));
-        if matches!(contact.normal, Normal::Unavailable(_)) {
-            let n = parts.normals[c].ok_or(SlidingError::OtherSupports)?;
+        // A contact without a normal direction (`along = [A.x]`) needs a
+        // support given for it, or the balances do not close.
+        if let (Normal::Unavailable(_), Some(n)) = (contact.normal, parts.normals[c]) {
             unknown.push((contact.position, n));
         }
     }
@@ -447,7 +489,9 @@ pub fn normal_inputs<'a>(
     Box::new(move |t, q, u, inputs: &mut [f64]| {
         let found = sliding_normals(model, t, q, u, inputs, &contacts)?;
         for (c, n) in contacts.iter().zip(&found.forces) {
-            inputs[c.input] = *n;
+            if let Some(input) = c.input {
+                inputs[input] = *n;
+            }
         }
         Ok(())
     })
