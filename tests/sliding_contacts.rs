@@ -550,3 +550,76 @@ fn on_a_slope_the_wheel_on_ice_slips_while_the_other_rolls() {
     );
     assert!(grip.impulses[1..].iter().all(|x| x.abs() < 1e-12));
 }
+
+/// The energy budget of the pushed disc over 3 s: the kinetic and
+/// potential energy gained equal the push's work, less the sliding
+/// friction's, less what the grips' impulses take. The powers are
+/// integrated by trapezoids over samples every 0.25 ms.
+#[test]
+fn the_disc_s_energy_is_the_push_s_work_less_friction_and_grips() {
+    let run = Hybrid::new(phases(&DISC))
+        .solver(Dop853::new().rtol(1e-11).atol(1e-13).event_tol(1e-13))
+        .sample_every(2.5e-4)
+        .run::<10>(0, 0.0, &Q0, &U0, 3.0)
+        .expect("the run completes");
+    let rolling = PushedRollingDiscRolling::from_ref(&DISC);
+    let sliding = PushedRollingDiscSliding::from_ref(&DISC);
+    // (T + V, push power, friction power) at a sample.
+    let state = |s: &appell::hybrid::Sample| -> (f64, f64, f64) {
+        let (qdot, t_kin, friction) = if s.phase == 0 {
+            let mut qdot = [0.0; 5];
+            rolling
+                .dyn_coordinate_rates(s.t, &s.q, &s.u, &mut qdot)
+                .unwrap();
+            (
+                qdot.to_vec(),
+                rolling.kinetic_energy(s.t, &s.q, &s.u).unwrap(),
+                0.0,
+            )
+        } else {
+            let n = sliding_normals(sliding, s.t, &s.q, &s.u, &[0.0], &[contact(&DISC)])
+                .unwrap()
+                .forces[0];
+            let v = slip(&DISC, s.t, &s.q, &s.u).unwrap();
+            let speed2 = v[0] * v[0] + v[1] * v[1];
+            let power = -DISC.mu * n * speed2 / (speed2 + DISC.eps * DISC.eps).sqrt();
+            (
+                s.u.clone(),
+                sliding.kinetic_energy(s.t, &s.q, &s.u).unwrap(),
+                power,
+            )
+        };
+        let potential = DISC.m * DISC.g * DISC.r * s.q[1].cos();
+        let push = DISC.push * (DISC.omega * s.t).sin();
+        let push_power = push * (qdot[3] * s.q[0].cos() + qdot[4] * s.q[0].sin());
+        (t_kin + potential, push_power, friction)
+    };
+    let (mut work, mut friction) = (0.0, 0.0);
+    let mut last: Option<(f64, usize, (f64, f64, f64))> = None;
+    for s in &run.samples {
+        let now = state(s);
+        if let Some((t0, phase0, before)) = last {
+            if s.t > t0 && s.phase == phase0 {
+                let dt = s.t - t0;
+                work += 0.5 * dt * (before.1 + now.1);
+                friction += 0.5 * dt * (before.2 + now.2);
+            }
+        }
+        last = Some((s.t, s.phase, now));
+    }
+    let lost: f64 = run.switches.iter().map(|s| s.energy_lost).sum();
+    let (start, end) = (
+        state(&run.samples[0]).0,
+        state(run.samples.last().unwrap()).0,
+    );
+    let gained = end - start;
+    let budget = work + friction - lost;
+    println!(
+        "gained {gained:.9} J; push {work:.9} J, friction {friction:.9} J, grips {lost:.3e} J: \
+         off by {:.1e} J ({:.1e} of the push's work)",
+        gained - budget,
+        ((gained - budget) / work).abs()
+    );
+    assert!(friction < 0.0 && lost > 0.0);
+    assert!(((gained - budget) / work).abs() < 1e-7);
+}
