@@ -18,7 +18,11 @@
 //! A phase entered with a guard already below zero (by more than
 //! [`Hybrid::guard_tolerance`]) is left at once, through that guard: a
 //! disc whose slip dies where rolling would need more friction than there
-//! is slides the other way. Positions are put back on the target's
+//! is slides the other way. A guard marked [`Guard::after_rising`] is the
+//! exception: it waits until it has been positive (and never fires if it
+//! never rises). A phase's [`Phase::state_inputs`] set inputs from the
+//! motion at every evaluation (a sliding contact's normal force,
+//! [`crate::sliding`]). Positions are put back on the target's
 //! holonomic constraints at each switch.
 //!
 //! Limits, by design: a guard fires where it comes down through zero, so a
@@ -402,6 +406,14 @@ impl<'a> Hybrid<'a> {
                 return bad(format!(
                     "phase `{}` carries quadrature outputs in its state",
                     p.name
+                ));
+            }
+            if p.inputs.len() != info.inputs.len() {
+                return bad(format!(
+                    "phase `{}` has {} inputs, its scene {}",
+                    p.name,
+                    p.inputs.len(),
+                    info.inputs.len()
                 ));
             }
             if let Some(g) = p.guards.iter().find(|g| g.to >= self.phases.len()) {

@@ -90,6 +90,58 @@ impl<'a> SlidingContact<'a> {
         }
     }
 
+    /// The contact at `model`'s rolling contact named `point` (its
+    /// `rolls(..., contact = P)`), its normal force the input named
+    /// `input` of `scene` (the sliding scene the contact is used in): the
+    /// form that cannot mix up the model's contact numbers and the scene's
+    /// input numbers, which differ.
+    pub fn named(
+        model: &'a dyn DynModel,
+        point: &str,
+        scene: &dyn DynModel,
+        input: &str,
+        normal: [f64; 3],
+    ) -> Result<Self, SlidingError> {
+        let index = scene
+            .dyn_info()
+            .inputs
+            .iter()
+            .position(|name| *name == input)
+            .ok_or_else(|| {
+                SlidingError::BadContact(format!(
+                    "the scene has no input `{input}` (its inputs: {:?})",
+                    scene.dyn_info().inputs
+                ))
+            })?;
+        let contact = Self::contact_named(model, point)?;
+        Ok(Self::at_rolling_contact(model, contact, index, normal))
+    }
+
+    /// A support without friction at `model`'s rolling contact named
+    /// `point` (see [`SlidingContact::support_at_rolling_contact`]).
+    pub fn support_named(
+        model: &'a dyn DynModel,
+        point: &str,
+        normal: [f64; 3],
+    ) -> Result<Self, SlidingError> {
+        let contact = Self::contact_named(model, point)?;
+        Ok(Self::support_at_rolling_contact(model, contact, normal))
+    }
+
+    /// The index of `model`'s rolling contact at `point`.
+    fn contact_named(model: &dyn DynModel, point: &str) -> Result<usize, SlidingError> {
+        let contacts = model.dyn_info().contacts;
+        contacts
+            .iter()
+            .position(|c| c.point == point)
+            .ok_or_else(|| {
+                let names: Vec<&str> = contacts.iter().map(|c| c.point).collect();
+                SlidingError::BadContact(format!(
+                    "the model has no rolling contact at `{point}` (its contacts: {names:?})"
+                ))
+            })
+    }
+
     /// A support without friction at `point(t, q)`, normal `normal`: its
     /// normal force is solved for with the others.
     pub fn support(normal: [f64; 3], point: impl Fn(f64, &[f64]) -> [f64; 3] + 'a) -> Self {
@@ -180,18 +232,24 @@ pub enum SlidingError {
     /// contacts on one line, or none).
     NotDetermined,
     /// The balances do not close with any normal forces (by more than
-    /// 1e-8 relative): the contacts are not all the supports there are.
+    /// 1e-8 relative): the contacts are not all the supports there are,
+    /// or a load is not affine in the normal-force inputs (a friction
+    /// written with `max(n, 0)`).
     Unbalanced {
         /// The relative residual.
         residual: f64,
     },
-    /// A contact's friction feeds back into its own normal force by
-    /// κ ≥ 1 (Painlevé's paradox).
+    /// Friction feeds back into the normal forces so strongly that no
+    /// normal force is consistent, or several are (Painlevé's paradox): a
+    /// contact's own feedback κ ≥ 1, or a group of contacts that drive
+    /// each other's normal forces.
     Paradox {
-        /// The contact (index into the list given).
-        contact: usize,
-        /// Its feedback κ.
-        feedback: f64,
+        /// The contacts (indices into the list given), the smallest group
+        /// that fails.
+        contacts: Vec<usize>,
+        /// The principal minor of I − D over that group (≤ 0; 1 − κ for
+        /// one contact), D the feedback matrix.
+        minor: f64,
     },
 }
 
@@ -211,9 +269,9 @@ impl core::fmt::Display for SlidingError {
                 f,
                 "the momentum balances do not close with any normal forces (residual {residual:e})"
             ),
-            SlidingError::Paradox { contact, feedback } => write!(
+            SlidingError::Paradox { contacts, minor } => write!(
                 f,
-                "sliding contact {contact}: its friction feeds back into its normal force by {feedback} ≥ 1 (Painlevé's paradox)"
+                "sliding contacts {contacts:?}: their friction feeds back into their normal forces too strongly: the principal minor of I − κ over them is {minor} ≤ 0 (Painlevé's paradox)"
             ),
         }
     }
@@ -269,6 +327,11 @@ pub fn sliding_normals<K: DynModel + ?Sized>(
         .iter()
         .map(|c| (c.point)(t, q))
         .collect::<Result<_, _>>()?;
+    if points.iter().flatten().any(|v| !v.is_finite()) {
+        return Err(SlidingError::BadContact(
+            "a contact point is not finite".into(),
+        ));
+    }
     let o = points.first().copied().unwrap_or([0.0; 3]);
     let mut trial = inputs.to_vec();
     let mut residuals: Vec<[f64; 6]> = Vec::with_capacity(k + 1);
@@ -353,6 +416,10 @@ fn solve_normals(
     r0: &[f64; 6],
 ) -> Result<(DVector<f64>, Vec<f64>), SlidingError> {
     let (columns, k) = (wrenches.len(), fed.len());
+    if columns > 6 {
+        // Six balances cannot determine more than six forces.
+        return Err(SlidingError::NotDetermined);
+    }
     let w = DMatrix::from_fn(6, columns, |r, c| wrenches[c][r]);
     let kmat = DMatrix::from_fn(6, k, |r, c| fed[c][r]);
     let determined = |m: &DMatrix<f64>| {
@@ -365,16 +432,10 @@ fn solve_normals(
         .solve(&kmat, 0.0)
         .map_err(|_| SlidingError::NotDetermined)?;
     let feedback: Vec<f64> = (0..k).map(|i| demanded[(i, i)]).collect();
-    if let Some((contact, &kappa)) = feedback
-        .iter()
-        .enumerate()
-        .find(|(_, &f)| f.is_nan() || f >= 1.0)
-    {
-        return Err(SlidingError::Paradox {
-            contact,
-            feedback: kappa,
-        });
+    if demanded.iter().any(|v| !v.is_finite()) {
+        return Err(SlidingError::NotDetermined);
     }
+    paradox_check(&demanded, k)?;
     let mut a = w;
     for c in 0..k {
         for r in 0..6 {
@@ -386,6 +447,31 @@ fn solve_normals(
         .solve(&DVector::from_column_slice(r0), 0.0)
         .map_err(|_| SlidingError::NotDetermined)?;
     Ok((x, feedback))
+}
+
+/// Painlevé's condition on the sliding contacts' feedback D = (W⁺ K)₁..ₖ:
+/// every principal minor of I − D positive (for one contact, κ < 1; for
+/// several, also no group of contacts that drive each other's normal
+/// forces). The smallest group that fails is reported.
+fn paradox_check(demanded: &DMatrix<f64>, k: usize) -> Result<(), SlidingError> {
+    let mut subsets: Vec<u32> = (1..1u32 << k).collect();
+    subsets.sort_by_key(|s| s.count_ones());
+    for set in subsets {
+        let members: Vec<usize> = (0..k).filter(|i| set & (1 << i) != 0).collect();
+        let n = members.len();
+        let minor = DMatrix::from_fn(n, n, |r, c| {
+            let identity = if r == c { 1.0 } else { 0.0 };
+            identity - demanded[(members[r], members[c])]
+        })
+        .determinant();
+        if minor.is_nan() || minor <= 0.0 {
+            return Err(SlidingError::Paradox {
+                contacts: members,
+                minor,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The contacts' inputs exist and their normals are unit vectors.
@@ -482,12 +568,24 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 /// A phase's [`state_inputs`](crate::hybrid::Phase::state_inputs): at
 /// every evaluation, the normal forces of `contacts` in `model` (the
 /// phase's scene) from [`sliding_normals`], written into their inputs.
+/// A negative normal force (a contact that lifts off, here or at one of
+/// the scene's rolling contacts) is the error [`ModelError::Contact`]:
+/// give the phase a guard on the normal force that switches to a scene
+/// without the contact before it reaches zero.
 pub fn normal_inputs<'a>(
     model: &'a dyn DynModel,
     contacts: Vec<SlidingContact<'a>>,
 ) -> crate::hybrid::StateInputs<'a> {
     Box::new(move |t, q, u, inputs: &mut [f64]| {
         let found = sliding_normals(model, t, q, u, inputs, &contacts)?;
+        if found.forces.iter().chain(&found.rolling).any(|&n| n < 0.0) {
+            // A negative normal force would make friction push along the
+            // slip: the body lifts off, and no scene of these contacts
+            // holds.
+            return Err(ModelError::Contact {
+                what: "a contact lifts off (its normal force is negative)",
+            });
+        }
         for (c, n) in contacts.iter().zip(&found.forces) {
             if let Some(input) = c.input {
                 inputs[input] = *n;

@@ -172,7 +172,8 @@ pub fn friction_margin(
 /// where the slip speed comes down to [`GRIP_SPEED`].
 pub fn phases(disc: &PushedRollingDisc) -> Vec<Phase<'_>> {
     let sliding = PushedRollingDiscSliding::from_ref(disc);
-    let contact = SlidingContact::at_rolling_contact(disc, 0, 0, [0.0, 0.0, 1.0]);
+    let contact = SlidingContact::named(disc, "P", sliding, "normal", [0.0, 0.0, 1.0])
+        .expect("the disc rolls at P and its sliding scene reads `normal`");
     vec![
         Phase::new("rolling", PushedRollingDiscRolling::from_ref(disc)).guard(Guard::new(
             "slips",

@@ -212,7 +212,9 @@ pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::
             "slides" => slides = Some(expr_ident(&v)?),
             key @ ("mu" | "normal" | "smoothing" | "viscous" | "plane") => {
                 first_friction_key.get_or_insert(k.clone());
-                friction.insert(key.to_string(), convert(&v)?);
+                if friction.insert(key.to_string(), convert(&v)?).is_some() {
+                    return Err(syn::Error::new(k.span(), format!("`{key}` is given twice")));
+                }
             }
             "along" => match &v {
                 syn::Expr::Array(a) => along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?),
@@ -230,6 +232,12 @@ pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::
         )
     })?;
     let slides = match (slides, first_friction_key) {
+        (Some(slides), _) if effect.is_none() => {
+            return Err(syn::Error::new(
+                slides.span(),
+                "a contact that slides where a scene drops its rolling needs that rolling to belong to an effect: add `effect = rolling`",
+            ))
+        }
         (Some(effect), _) => Some(SlidesDef {
             effect,
             values: friction,
