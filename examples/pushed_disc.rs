@@ -11,58 +11,12 @@
 mod pushed_disc;
 
 use appell::animate::{svg, Frame, SvgOptions, View};
-use appell::constraint_forces::contact_forces;
-use appell::hybrid::{Guard, Hybrid, Phase};
+use appell::hybrid::Hybrid;
 use appell::integrate::Dop853;
-use appell::ModelError;
-use pushed_disc::{PushedDiscRolling, PushedDiscSlidingBackward, PushedDiscSlidingForward, DISC};
+use pushed_disc::DISC;
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
-    let rolling = PushedDiscRolling::from_ref(&DISC);
-    let limit = DISC.mu * DISC.m * DISC.g;
-    // The friction along N.x that rolling needs: the rolling row's reaction.
-    let needed = move |t: f64, q: &[f64], u: &[f64]| -> Result<f64, ModelError> {
-        contact_forces(rolling, t, q, u, &[])
-            .map(|f| f.contacts[0].rolling[0])
-            .map_err(|_| ModelError::NonFinite {
-                what: "the friction",
-            })
-    };
-    let slip = |u: &[f64]| u[0] + DISC.r * u[1];
-    let phases = vec![
-        Phase {
-            name: "rolling",
-            model: rolling,
-            inputs: Vec::new(),
-            state_inputs: None,
-            guards: vec![
-                Guard::new("slips forward", 1, move |t, q: &[f64], u: &[f64]| {
-                    Ok(needed(t, q, u)? + limit)
-                }),
-                Guard::new("slips backward", 2, move |t, q: &[f64], u: &[f64]| {
-                    Ok(limit - needed(t, q, u)?)
-                }),
-            ],
-        },
-        Phase {
-            name: "sliding forward",
-            model: PushedDiscSlidingForward::from_ref(&DISC),
-            inputs: Vec::new(),
-            state_inputs: None,
-            guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
-                Ok(slip(u))
-            })],
-        },
-        Phase {
-            name: "sliding backward",
-            model: PushedDiscSlidingBackward::from_ref(&DISC),
-            inputs: Vec::new(),
-            state_inputs: None,
-            guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
-                Ok(-slip(u))
-            })],
-        },
-    ];
+    let phases = pushed_disc::phases(&DISC);
     let names: Vec<&str> = phases.iter().map(|p| p.name).collect();
     let run = Hybrid::new(phases)
         .solver(Dop853::new().rtol(1e-10).atol(1e-12))

@@ -6,67 +6,12 @@
 #[path = "../examples/models/pushed_disc.rs"]
 mod pushed_disc;
 
-use appell::constraint_forces::contact_forces;
-use appell::hybrid::{Guard, Hybrid, HybridRun, Phase};
+use appell::hybrid::{Hybrid, HybridRun};
 use appell::integrate::Dop853;
-use appell::{Appell, Model, ModelError};
+use appell::{Appell, Model};
 use pushed_disc::{
-    PushedDisc, PushedDiscRolling, PushedDiscSlidingBackward, PushedDiscSlidingForward, DISC,
+    phases, slip, PushedDisc, PushedDiscSlidingBackward, PushedDiscSlidingForward, DISC,
 };
-
-/// The friction force along N.x that rolling needs on `disc` (the
-/// rolling row's reaction).
-fn needed_friction(disc: &PushedDisc, t: f64, q: &[f64], u: &[f64]) -> Result<f64, ModelError> {
-    let rolling = PushedDiscRolling::from_ref(disc);
-    contact_forces(rolling, t, q, u, &[])
-        .map(|f| f.contacts[0].rolling[0])
-        .map_err(|_| ModelError::NonFinite {
-            what: "the friction",
-        })
-}
-
-/// The slip velocity of the disc's material point at the contact.
-fn slip(disc: &PushedDisc, u: &[f64]) -> f64 {
-    u[0] + disc.r * u[1]
-}
-
-fn phases(disc: &PushedDisc) -> Vec<Phase<'_>> {
-    let limit = disc.mu * disc.m * disc.g;
-    vec![
-        Phase {
-            name: "rolling",
-            model: PushedDiscRolling::from_ref(disc),
-            inputs: Vec::new(),
-            state_inputs: None,
-            guards: vec![
-                Guard::new("slips forward", 1, move |t, q: &[f64], u: &[f64]| {
-                    Ok(needed_friction(disc, t, q, u)? + limit)
-                }),
-                Guard::new("slips backward", 2, move |t, q: &[f64], u: &[f64]| {
-                    Ok(limit - needed_friction(disc, t, q, u)?)
-                }),
-            ],
-        },
-        Phase {
-            name: "sliding forward",
-            model: PushedDiscSlidingForward::from_ref(disc),
-            inputs: Vec::new(),
-            state_inputs: None,
-            guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
-                Ok(slip(disc, u))
-            })],
-        },
-        Phase {
-            name: "sliding backward",
-            model: PushedDiscSlidingBackward::from_ref(disc),
-            inputs: Vec::new(),
-            state_inputs: None,
-            guards: vec![Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
-                Ok(-slip(disc, u))
-            })],
-        },
-    ]
-}
 
 fn run(disc: &PushedDisc, t_end: f64, rtol: f64) -> HybridRun {
     Hybrid::new(phases(disc))

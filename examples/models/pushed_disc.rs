@@ -4,9 +4,11 @@
 //! friction μ N against the slip) where it does not. The disc's height is
 //! fixed by construction, so the normal force is its weight, N = m g.
 //! `tests/rolling_sliding.rs` and `examples/pushed_disc.rs` switch between
-//! the three scenes.
+//! the three scenes with [`phases`].
 
-use appell::Appell;
+use appell::constraint_forces::contact_forces;
+use appell::hybrid::{Guard, Phase};
+use appell::{Appell, ModelError};
 
 /// The pushed disc: rolling (`rolls(..., effect = rolling)`) or sliding,
 /// with the friction of the sliding direction (a force μ m g at the
@@ -52,3 +54,50 @@ pub const DISC: PushedDisc = PushedDisc {
     push: 3.6 * 0.3 * 1.0 * 9.81,
     omega: 2.0,
 };
+
+/// The friction force along N.x that rolling needs on `disc` (the
+/// rolling row's reaction).
+pub fn needed_friction(disc: &PushedDisc, t: f64, q: &[f64], u: &[f64]) -> Result<f64, ModelError> {
+    let rolling = PushedDiscRolling::from_ref(disc);
+    contact_forces(rolling, t, q, u, &[])
+        .map(|f| f.contacts[0].rolling[0])
+        .map_err(|_| ModelError::NonFinite {
+            what: "the friction",
+        })
+}
+
+/// The slip velocity of the disc's material point at the contact.
+pub fn slip(disc: &PushedDisc, u: &[f64]) -> f64 {
+    u[0] + disc.r * u[1]
+}
+
+/// The three phases: rolling (0), left forward (1) or backward (2) where
+/// the friction rolling needs reaches μ m g, and sliding forward or
+/// backward, left where the slip dies.
+pub fn phases(disc: &PushedDisc) -> Vec<Phase<'_>> {
+    let limit = disc.mu * disc.m * disc.g;
+    let grips = |sign: f64| {
+        Guard::new("grips", 0, move |_, _: &[f64], u: &[f64]| {
+            Ok(sign * slip(disc, u))
+        })
+    };
+    vec![
+        Phase::new("rolling", PushedDiscRolling::from_ref(disc))
+            .guard(Guard::new(
+                "slips forward",
+                1,
+                move |t, q: &[f64], u: &[f64]| Ok(needed_friction(disc, t, q, u)? + limit),
+            ))
+            .guard(Guard::new(
+                "slips backward",
+                2,
+                move |t, q: &[f64], u: &[f64]| Ok(limit - needed_friction(disc, t, q, u)?),
+            )),
+        Phase::new("sliding forward", PushedDiscSlidingForward::from_ref(disc)).guard(grips(1.0)),
+        Phase::new(
+            "sliding backward",
+            PushedDiscSlidingBackward::from_ref(disc),
+        )
+        .guard(grips(-1.0)),
+    ]
+}
