@@ -6,6 +6,8 @@
 //! motor torque it reproduces the driven motion, and it is the undriven
 //! model's inverse dynamics.
 
+#[path = "../examples/models/driven_wheel_axle.rs"]
+mod driven_wheel_axle;
 #[path = "../examples/models/wheel_axle.rs"]
 mod wheel_axle;
 
@@ -13,38 +15,8 @@ mod common;
 use appell::constraint_forces::contact_forces;
 use appell::{Appell, Model, RowSource};
 use common::{close, Rng};
+use driven_wheel_axle::DrivenWheelAxle;
 use wheel_axle::WheelAxle;
-
-/// The wheel-axle with wheel 1's spin rate commanded instead of its motor
-/// torque: psi1's rate is no longer a privileged speed.
-#[derive(Appell, Clone, Debug, PartialEq)]
-#[appell(coordinates(x1, y1, psi1, x2, y2, psi2, phi))]
-#[appell(speeds(phi))]
-#[appell(positive(a))]
-#[appell(frame(A = N.rotate_z(phi)))]
-#[appell(frame(W1 = A.rotate_y(psi1)), frame(W2 = A.rotate_y(psi2)))]
-#[appell(point(C1 = O + x1 * N.x + y1 * N.y), point(C2 = O + x2 * N.x + y2 * N.y))]
-#[appell(body(wheel1, center = C1, frame = W1, mass = mass,
-              inertia = principal(rim * a * a / 2, rim * a * a, rim * a * a / 2)))]
-#[appell(body(wheel2, center = C2, frame = W2, mass = mass,
-              inertia = principal(rim * a * a / 2, rim * a * a, rim * a * a / 2)))]
-#[appell(nonholonomic(dt(x1) == a * dt(psi1) * cos(phi)),
-         nonholonomic(dt(y1) == a * dt(psi1) * sin(phi)),
-         nonholonomic(dt(x2) == a * dt(psi2) * cos(phi)),
-         nonholonomic(dt(y2) == a * dt(psi2) * sin(phi)),
-         nonholonomic(a * dt(psi2) == a * dt(psi1) - l * dt(phi)),
-         nonholonomic(dt(psi1) == w_cmd))]
-#[appell(force(C1, mass * g * sin(alpha) * N.x, effect = gravity),
-         force(C2, mass * g * sin(alpha) * N.x, effect = gravity))]
-#[appell(inputs(w_cmd))]
-struct DrivenWheelAxle {
-    a: f64,
-    l: f64,
-    mass: f64,
-    rim: f64,
-    g: f64,
-    alpha: f64,
-}
 
 /// A pendulum whose angle is position-controlled, beside a free particle
 /// (its one privileged speed).
