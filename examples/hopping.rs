@@ -10,7 +10,7 @@
 #[path = "models/hopper.rs"]
 mod hopper;
 
-use appell::animate::{svg, Frame, SvgOptions, View};
+use appell::animate::{svg, SvgOptions, View};
 use appell::hybrid::{Hybrid, HybridError};
 use appell::integrate::Dop853;
 use hopper::HOPPER;
@@ -48,15 +48,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         );
     }
     // The animation: every sample, once per instant.
-    let mut frames: Vec<Frame> = Vec::new();
-    for s in &run.samples {
-        if frames.last().is_none_or(|f| s.t > f.t) {
-            frames.push(Frame {
-                t: s.t,
-                q: s.q.clone(),
-            });
-        }
-    }
+    let frames = run.frames();
     let options = SvgOptions {
         title: "Hopping leg: stance and flight".into(),
         view: View::Along(0),

@@ -10,7 +10,7 @@
 #[path = "models/pushed_disc.rs"]
 mod pushed_disc;
 
-use appell::animate::{svg, Frame, SvgOptions, View};
+use appell::animate::{svg, SvgOptions, View};
 use appell::hybrid::Hybrid;
 use appell::integrate::Dop853;
 use pushed_disc::DISC;
@@ -36,15 +36,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
             s.t, names[s.from], names[s.to], s.reason, s.energy_lost
         );
     }
-    let mut frames: Vec<Frame> = Vec::new();
-    for s in &run.samples {
-        if frames.last().is_none_or(|f| s.t > f.t) {
-            frames.push(Frame {
-                t: s.t,
-                q: s.q.clone(),
-            });
-        }
-    }
+    let frames = run.frames();
     let options = SvgOptions {
         title: "Pushed disc: rolling and sliding".into(),
         view: View::Along(2),

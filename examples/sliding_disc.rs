@@ -13,7 +13,7 @@
 #[allow(dead_code)] // the model written with sliding alone is for the test
 mod sliding_disc;
 
-use appell::animate::{svg, Frame, SvgOptions, View};
+use appell::animate::{svg, SvgOptions, View};
 use appell::hybrid::Hybrid;
 use appell::integrate::Dop853;
 use appell::sliding::{sliding_normals, SlidingContact};
@@ -74,15 +74,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         took.as_secs_f64() * 1e3
     );
 
-    let mut frames: Vec<Frame> = Vec::new();
-    for s in &run.samples {
-        if frames.last().is_none_or(|f| s.t > f.t) {
-            frames.push(Frame {
-                t: s.t,
-                q: s.q.clone(),
-            });
-        }
-    }
+    let frames = run.frames();
     let options = SvgOptions {
         title: "Pushed rolling disc: rolling and sliding".into(),
         view: View::Oblique,

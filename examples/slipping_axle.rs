@@ -13,7 +13,7 @@
 #[path = "models/slipping_axle.rs"]
 mod slipping_axle;
 
-use appell::animate::{svg, Frame, SvgOptions, View};
+use appell::animate::{svg, SvgOptions, View};
 use appell::hybrid::Hybrid;
 use appell::integrate::Dop853;
 use appell::sliding::{sliding_normals, SlidingContact};
@@ -67,15 +67,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         took.as_secs_f64() * 1e3
     );
 
-    let mut frames: Vec<Frame> = Vec::new();
-    for s in &run.samples {
-        if frames.last().is_none_or(|f| s.t > f.t) {
-            frames.push(Frame {
-                t: s.t,
-                q: s.q.clone(),
-            });
-        }
-    }
+    let frames = run.frames();
     let options = SvgOptions {
         title: "Wheel-axle on a slope, wheel 1 on ice: gripping and slipping".into(),
         view: View::Oblique,

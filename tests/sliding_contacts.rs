@@ -5,6 +5,9 @@
 #[path = "../examples/models/sliding_disc.rs"]
 mod sliding_disc;
 
+mod common;
+use common::XorShift;
+
 use appell::hybrid::{Hybrid, HybridRun, Phase};
 use appell::integrate::Dop853;
 use appell::sliding::{sliding_normals, SlidingContact, SlidingError};
@@ -22,15 +25,10 @@ fn contact(disc: &PushedRollingDisc) -> SlidingContact<'_> {
     SlidingContact::at_rolling_contact(disc, 0, 0, [0.0, 0.0, 1.0])
 }
 
-/// A sliding state from a small generator: coordinates and five speeds.
+/// Sliding states: a time, coordinates and five speeds.
 fn sliding_states(count: usize) -> Vec<(f64, [f64; 5], [f64; 5])> {
-    let mut seed = 0x2545_f491_4f6c_dd1du64;
-    let mut next = move || {
-        seed ^= seed << 13;
-        seed ^= seed >> 7;
-        seed ^= seed << 17;
-        (seed >> 11) as f64 / (1u64 << 53) as f64 * 2.0 - 1.0
-    };
+    let mut rng = XorShift(0x2545_f491_4f6c_dd1d);
+    let mut next = move || rng.uniform(-1.0, 1.0);
     (0..count)
         .map(|_| {
             let t = 1.5 * next().abs();

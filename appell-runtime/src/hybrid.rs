@@ -211,6 +211,24 @@ pub struct HybridRun {
     pub samples: Vec<Sample>,
 }
 
+impl HybridRun {
+    /// The samples as animation frames ([`crate::animate::svg`]), one per
+    /// instant: a switch's second sample (the same time, after the map)
+    /// is left out.
+    pub fn frames(&self) -> Vec<crate::animate::Frame> {
+        let mut frames: Vec<crate::animate::Frame> = Vec::with_capacity(self.samples.len());
+        for s in &self.samples {
+            if frames.last().is_none_or(|f| s.t > f.t) {
+                frames.push(crate::animate::Frame {
+                    t: s.t,
+                    q: s.q.clone(),
+                });
+            }
+        }
+        frames
+    }
+}
+
 /// Why a hybrid run stopped early.
 #[derive(Debug)]
 pub enum HybridError {

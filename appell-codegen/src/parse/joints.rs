@@ -329,6 +329,7 @@ fn triple(e: &syn::Expr, form: &str) -> syn::Result<[Expr; 3]> {
 }
 
 /// What one joint adds to the model, in declaration order.
+#[derive(Default)]
 pub(super) struct Lowered {
     pub frames: Vec<FrameDef>,
     pub points: Vec<PointDef>,
@@ -364,18 +365,7 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
             ))
         }
     };
-    let mut out = Lowered {
-        frames: Vec::new(),
-        points: Vec::new(),
-        coordinates: Vec::new(),
-        speeds: Vec::new(),
-        inputs: Vec::new(),
-        forces: Vec::new(),
-        torques: Vec::new(),
-        speed_definitions: Vec::new(),
-        holonomic: Vec::new(),
-        nonholonomic: Vec::new(),
-    };
+    let mut out = Lowered::default();
     // The joint frame: the parent's axes turned by rpy, when it turns them.
     let rpy = j.rpy.as_ref().map(rpy_rotations).unwrap_or_default();
     let joint_frame = if rpy.is_empty() {
@@ -460,6 +450,14 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         name: origin_name.clone(),
         location: plus(joint_origin.clone(), slide),
     });
+    drives_and_lock(j, &mut out, &origin_name, &joint_origin);
+    Ok(out)
+}
+
+/// The joint's actuation (input `tau_<joint>`, saturated if asked), its
+/// springs, dampers and friction along its axis, and its lock.
+fn drives_and_lock(j: &JointDef, out: &mut Lowered, origin_name: &Ident, joint_origin: &Expr) {
+    let name = |suffix: &str| Ident::new(&format!("{}{suffix}", j.name), j.name.span());
     if j.actuated {
         let tau = Ident::new(&format!("tau_{}", j.name), j.name.span());
         out.inputs.push(tau.clone());
@@ -476,10 +474,10 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         let at = name("_at");
         along_axis(
             j,
-            &mut out,
+            out,
             magnitude,
             effect,
-            &origin_name,
+            origin_name,
             joint_origin.clone(),
             at,
         );
@@ -488,10 +486,10 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         let at = name(&format!("_{effect}_at"));
         along_axis(
             j,
-            &mut out,
+            out,
             magnitude,
             effect,
-            &origin_name,
+            origin_name,
             joint_origin.clone(),
             at,
         );
@@ -499,7 +497,6 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
     if let Some(lock) = &j.lock {
         out.nonholonomic.push(locked(&j.name, lock));
     }
-    Ok(out)
 }
 
 /// `dt(q) == 0` on a locked joint's coordinate `q`, of the lock's effect.
