@@ -27,6 +27,8 @@ pub mod model;
 pub mod parse;
 pub mod probe;
 
+pub use parse::FileRoots;
+
 use proc_macro2::TokenStream;
 
 /// Expands `#[derive(Appell)]` on `input`: the `Model` implementation, or
@@ -54,23 +56,29 @@ use proc_macro2::TokenStream;
 /// assert!(out.contains("did you mean `q`?"), "{out}");
 /// ```
 pub fn expand(input: &syn::DeriveInput) -> TokenStream {
-    let dir = std::env::var_os("CARGO_MANIFEST_DIR").map(std::path::PathBuf::from);
-    expand_in(input, dir.as_deref())
+    expand_with(
+        input,
+        &FileRoots::from_env(),
+        &derivation::Options::default(),
+    )
 }
 
 /// [`expand`], reading the files a model names (`urdf(...)`) relative to
 /// `manifest_dir` instead of the environment's `CARGO_MANIFEST_DIR` (tools
 /// that expand models of several crates, such as the snapshot test).
 pub fn expand_in(input: &syn::DeriveInput, manifest_dir: Option<&std::path::Path>) -> TokenStream {
-    expand_with(input, manifest_dir, &derivation::Options::default())
+    let roots = FileRoots::new(manifest_dir, None);
+    expand_with(input, &roots, &derivation::Options::default())
 }
 
-/// [`expand_in`] with the derivation's cost-driven choices forced by
-/// `options` (tests that compare forms: a model written with joints is the
-/// model written with frames once the structured form is left out).
+/// [`expand`] with the files a model names looked for from `roots` (the
+/// derive adds the directory of the model's source file) and the
+/// derivation's cost-driven choices forced by `options` (tests that compare
+/// forms: a model written with joints is the model written with frames once
+/// the structured form is left out).
 ///
 /// ```
-/// use appell_codegen::{derivation::Options, expand_with};
+/// use appell_codegen::{derivation::Options, expand_with, FileRoots};
 ///
 /// let input: syn::DeriveInput = syn::parse_str(r#"
 ///     #[appell(joint(j, revolute(z), parent = N, child = A))]
@@ -78,16 +86,16 @@ pub fn expand_in(input: &syn::DeriveInput, manifest_dir: Option<&std::path::Path
 ///     struct Arm;
 /// "#).unwrap();
 /// let closed = Options { closed_form_only: true, ..Options::default() };
-/// let out = expand_with(&input, None, &closed).to_string();
+/// let out = expand_with(&input, &FileRoots::default(), &closed).to_string();
 /// assert!(out.contains("form : \"closed form\""), "{out}");
 /// ```
 pub fn expand_with(
     input: &syn::DeriveInput,
-    manifest_dir: Option<&std::path::Path>,
+    roots: &FileRoots,
     options: &derivation::Options,
 ) -> TokenStream {
     let cx = ctxt::Ctxt::new();
-    let ast = parse::parse_in(&cx, input, manifest_dir);
+    let ast = parse::parse_in(&cx, input, roots);
     let model = if cx.has_errors() {
         None
     } else {

@@ -2,7 +2,7 @@
 //! they stand for: a mechanism written with joints expands exactly as the
 //! same mechanism written with frames and points.
 
-use appell_codegen::{derivation::Options, expand_with};
+use appell_codegen::{derivation::Options, expand_with, FileRoots};
 
 /// The expansion without the structured form, which only a model written
 /// with joints has.
@@ -12,7 +12,7 @@ fn expand_str(src: &str) -> String {
         closed_form_only: true,
         ..Options::default()
     };
-    expand_with(&input, None, &closed).to_string()
+    expand_with(&input, &FileRoots::default(), &closed).to_string()
 }
 
 fn same_expansion(with_joints: &str, written_out: &str) {

@@ -12,7 +12,8 @@
 //! The expansion is compared as formatted Rust (see [`expansion_text`]),
 //! with the workspace's directory written `$WORKSPACE` (a URDF model
 //! includes its file by absolute path). Each model reads its files (URDF)
-//! from the directory its crate is compiled in ([`manifest_dir`]). Models
+//! from the directory its crate is compiled in ([`manifest_dir`]), then
+//! beside its source file ([`file_roots`]). Models
 //! behind a cargo feature (`#[cfg(feature = ...)]`: the 32-link spatial
 //! chain) are expanded only with `APPELL_LARGE_MODELS=1`.
 //!
@@ -21,6 +22,7 @@
 
 use std::path::{Path, PathBuf};
 
+use appell_codegen::{derivation::Options, FileRoots};
 use quote::ToTokens;
 use syn::visit::Visit;
 
@@ -82,9 +84,9 @@ impl<'ast> Visit<'ast> for Models {
 /// statement a line so a change reads as a diff. Formatting the syntax tree
 /// leaves out what only the token stream carries (spans, and whether two
 /// punctuation marks were written together), which is no change of code.
-fn expansion_text(item: &syn::ItemStruct, manifest_dir: &Path) -> String {
+fn expansion_text(item: &syn::ItemStruct, roots: &FileRoots) -> String {
     let input = syn::DeriveInput::from(item.clone());
-    let tokens = appell_codegen::expand_in(&input, Some(manifest_dir));
+    let tokens = appell_codegen::expand_with(&input, roots, &Options::default());
     // The workspace's path is replaced before formatting: its length would
     // otherwise decide where a long line breaks.
     let root = workspace_root().to_string_lossy().into_owned();
@@ -107,6 +109,13 @@ fn manifest_dir(rel: &Path) -> PathBuf {
     } else {
         root
     }
+}
+
+/// Where `file`'s models look for the files they name: its crate's
+/// directory, then beside the file itself, as the derive looks.
+fn file_roots(rel: &Path) -> FileRoots {
+    let source = workspace_root().join(rel);
+    FileRoots::new(Some(&manifest_dir(rel)), source.parent())
 }
 
 /// Whether a model is compiled only with a cargo feature.
@@ -141,7 +150,7 @@ fn expansions() -> Vec<(String, String)> {
             if behind_a_feature(item) && !large {
                 continue;
             }
-            let text = expansion_text(item, &manifest_dir(rel));
+            let text = expansion_text(item, &file_roots(rel));
             out.push((format!("{stem}__{}.txt", item.ident), text));
         }
     }

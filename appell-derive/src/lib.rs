@@ -15,7 +15,12 @@ pub fn derive_appell(input: TokenStream) -> TokenStream {
     // panic: report it as a compile error on the struct.
     let span = input.ident.span();
     let start = std::time::Instant::now();
-    match std::panic::catch_unwind(|| appell_codegen::expand(&input)) {
+    // Files the model names are looked for from the crate's directory, then
+    // beside the source file that holds the model (as `include_str!`).
+    let source_file = proc_macro::Span::call_site().local_file();
+    let roots = appell_codegen::FileRoots::from_env().beside(source_file.as_deref());
+    let options = appell_codegen::derivation::Options::default();
+    match std::panic::catch_unwind(|| appell_codegen::expand_with(&input, &roots, &options)) {
         Ok(mut tokens) => {
             let build = DeriveBuild {
                 opt_level: env!("APPELL_DERIVE_OPT_LEVEL"),

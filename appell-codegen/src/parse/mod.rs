@@ -11,29 +11,26 @@ use crate::ctxt::Ctxt;
 
 mod elements;
 mod expr;
+mod files;
 mod items;
 pub mod joints;
 mod repeat;
 pub mod urdf;
 
 pub use expr::convert;
+pub use files::FileRoots;
 use items::*;
 
 /// Parses the derive input; errors go to `cx`. Files a model reads
 /// (`urdf(...)`) are found relative to the directory in the environment's
 /// `CARGO_MANIFEST_DIR`, the crate being compiled.
 pub fn parse(cx: &Ctxt, input: &syn::DeriveInput) -> ModelAst {
-    let dir = std::env::var_os("CARGO_MANIFEST_DIR").map(std::path::PathBuf::from);
-    parse_in(cx, input, dir.as_deref())
+    parse_in(cx, input, &FileRoots::from_env())
 }
 
-/// [`parse`], with files read relative to `manifest_dir` (None: a model
-/// that reads a file is an error).
-pub fn parse_in(
-    cx: &Ctxt,
-    input: &syn::DeriveInput,
-    manifest_dir: Option<&std::path::Path>,
-) -> ModelAst {
+/// [`parse`], with files looked for from `roots` (none: a model that reads
+/// a file is an error).
+pub fn parse_in(cx: &Ctxt, input: &syn::DeriveInput, roots: &FileRoots) -> ModelAst {
     let mut ast = ModelAst {
         name: input.ident.clone(),
         fields: Vec::new(),
@@ -114,7 +111,7 @@ pub fn parse_in(
         match expanded.and_then(|tokens| Parser::parse2(parser, tokens)) {
             Ok(items) => {
                 for item in items {
-                    add_item(cx, &mut ast, item, manifest_dir);
+                    add_item(cx, &mut ast, item, roots);
                 }
             }
             Err(e) => cx.syn_error(e),
@@ -313,7 +310,7 @@ const ITEMS: &[&str] = &[
     "urdf",
 ];
 
-fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, manifest_dir: Option<&std::path::Path>) {
+fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
     let name = item.name.to_string();
     let tokens = item.content.clone();
     let result: syn::Result<()> = (|| {
@@ -362,7 +359,7 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, manifest_dir: Option<&std
                     Parser::parse2(move |s: ParseStream| joints::parse_joint(s, span), tokens)?;
                 add_joint(ast, &joint)?
             }
-            "urdf" => urdf::add(cx, ast, &item, manifest_dir)?,
+            "urdf" => urdf::add(cx, ast, &item, roots)?,
             "holonomic" | "nonholonomic" => {
                 let at = item.content.clone();
                 let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, at), tokens)?;

@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../tests/ui/urdf/bad_element.urdf"))]
+#[appell(urdf("bad_element.urdf"))]
 struct Robot;
 
 fn main() {}

@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../tests/ui/urdf/bad_inertia.urdf"))]
+#[appell(urdf("bad_inertia.urdf"))]
 struct Robot;
 
 fn main() {}

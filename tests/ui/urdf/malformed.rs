@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../tests/ui/urdf/malformed.urdf"))]
+#[appell(urdf("malformed.urdf"))]
 struct Robot;
 
 fn main() {}

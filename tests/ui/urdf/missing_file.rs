@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../tests/ui/urdf/no_such_robot.urdf"))]
+#[appell(urdf("no_such_robot.urdf"))]
 struct Robot;
 
 fn main() {}

@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../examples/robots/ur5/ur5_robot.urdf"), gravity(-9.81 * N.z))]
+#[appell(urdf("../../../examples/robots/ur5/ur5_robot.urdf"), gravity(-9.81 * N.z))]
 #[appell(coordinates(q), frame(forearm_link = N.rotate_z(q)), inputs(tau_elbow_joint))]
 struct Ur5;
 

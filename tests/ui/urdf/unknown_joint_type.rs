@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../tests/ui/urdf/unknown_joint_type.urdf"))]
+#[appell(urdf("unknown_joint_type.urdf"))]
 struct Robot;
 
 fn main() {}

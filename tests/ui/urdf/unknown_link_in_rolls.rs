@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../examples/robots/ur5/ur5_robot.urdf"), gravity(-9.81 * N.z))]
+#[appell(urdf("../../../examples/robots/ur5/ur5_robot.urdf"), gravity(-9.81 * N.z))]
 #[appell(point(P = O), rolls(forearm, contact = P), rolls(tool0, contact = P))]
 struct Ur5;
 

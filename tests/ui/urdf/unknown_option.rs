@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../examples/robots/ur5/ur5_robot.urdf", welds(shoulder_pan_joint)))]
+#[appell(urdf("../../../examples/robots/ur5/ur5_robot.urdf", welds(shoulder_pan_joint)))]
 struct Ur5;
 
 fn main() {}

@@ -5,7 +5,7 @@
 use appell::Appell;
 
 #[derive(Appell)]
-#[appell(urdf("../../../../tests/ui/urdf/unknown_parent.urdf"))]
+#[appell(urdf("unknown_parent.urdf"))]
 struct Robot;
 
 fn main() {}

@@ -46,11 +46,9 @@ mod options;
 mod read;
 mod tree;
 
-use std::path::Path;
-
 use syn::parse::Parser;
 
-use super::Item;
+use super::{FileRoots, Item};
 use crate::ast::ModelAst;
 use crate::ctxt::Ctxt;
 
@@ -61,17 +59,13 @@ pub(super) fn add(
     cx: &Ctxt,
     ast: &mut ModelAst,
     item: &Item,
-    manifest_dir: Option<&Path>,
+    roots: &FileRoots,
 ) -> syn::Result<()> {
     let spec = Parser::parse2(options::parse_spec, item.content.clone())?;
     let span = spec.path.span();
-    let Some(dir) = manifest_dir else {
-        return Err(syn::Error::new(
-            span,
-            "cannot find the URDF: CARGO_MANIFEST_DIR, the directory a relative path starts from, is not set",
-        ));
-    };
-    let path = read::resolve(dir, &spec.path.value());
+    let path = roots
+        .find(&spec.path.value())
+        .map_err(|e| syn::Error::new(span, e))?;
     let Some(absolute) = path.to_str() else {
         return Err(syn::Error::new(
             span,

@@ -8,7 +8,7 @@
 //! each top-level element alone, so every bad element is reported, each by
 //! its tag, name and line.
 
-use std::path::{Component, Path, PathBuf};
+use std::path::Path;
 
 /// The URDF joint types, as the file spells them.
 pub(super) const JOINT_TYPES: &[&str] = &[
@@ -42,31 +42,12 @@ pub(super) struct Read {
     pub lines: Lines,
 }
 
-/// `manifest_dir` joined with the path as written, with `.` and `..` taken
-/// out by the names alone (so the path need not pass through directories
-/// that exist). An absolute path is kept as it is.
-pub(super) fn resolve(manifest_dir: &Path, written: &str) -> PathBuf {
-    let mut out = PathBuf::new();
-    for part in manifest_dir.join(written).components() {
-        match part {
-            Component::CurDir => {}
-            Component::ParentDir => {
-                if !out.pop() {
-                    out.push("..");
-                }
-            }
-            other => out.push(other),
-        }
-    }
-    out
-}
-
 /// The robot in the file at `path`, or the messages of everything wrong
 /// with the file.
 pub(super) fn read(path: &Path) -> Result<Read, Vec<String>> {
     let text = std::fs::read_to_string(path).map_err(|e| {
         vec![format!(
-            "cannot read the URDF file `{}`: {e} (a relative path is taken from the directory of the crate's Cargo.toml)",
+            "cannot read the URDF file `{}`: {e}",
             path.display()
         )]
     })?;
@@ -202,16 +183,6 @@ fn plain(message: &str) -> &str {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn dot_dot_is_taken_out_by_name() {
-        let p = resolve(Path::new("/a/b/target/x"), "../../c/./d.urdf");
-        assert_eq!(p, Path::new("/a/b/c/d.urdf"));
-        assert_eq!(
-            resolve(Path::new("/a"), "/e/f.urdf"),
-            Path::new("/e/f.urdf")
-        );
-    }
 
     #[test]
     fn a_syntax_error_has_its_line() {
