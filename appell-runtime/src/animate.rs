@@ -3,7 +3,7 @@
 //! geometry.
 //!
 //! [`simulate`] integrates every coordinate (cyclic ones included, with
-//! q̇ from [`Model::driven_coordinate_rates`], so a driven coordinate moves
+//! q̇ from [`Model::driven_coordinate_rates`](crate::Model::driven_coordinate_rates), so a driven coordinate moves
 //! at its commanded rate) and returns evenly spaced
 //! [`Frame`]s; [`svg`] draws them. Each rigid body is its equivalent
 //! inertia ellipsoid (the uniform solid ellipsoid with the body's mass and
@@ -86,7 +86,7 @@ pub const MAX_STEP: f64 = 1e-3;
 /// `frames + 1` frames evenly spaced in time (the first at `t0`).
 ///
 /// Fourth-order Runge–Kutta on the full coordinates (q̇ from
-/// [`Model::coordinate_rates`], u̇ from [`Model::rhs`]), at most
+/// [`Model::coordinate_rates`](crate::Model::coordinate_rates), u̇ from [`Model::rhs`](crate::Model::rhs)), at most
 /// [`MAX_STEP`] per step: accurate enough for a picture, not a reference
 /// (use the adaptive integrators for that).
 ///

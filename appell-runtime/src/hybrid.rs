@@ -94,7 +94,7 @@ impl<'a> Guard<'a> {
 
     /// Makes the switch an impact against `contact`'s constraints with
     /// Newton's coefficient of `restitution` (see
-    /// [`impact_state`](crate::switch::impact_state)) before the motion is
+    /// [`impact_state`]) before the motion is
     /// mapped into phase `to`: a ball that bounces stays in flight (`to`
     /// its own phase) with its normal velocity reversed and scaled by e.
     /// `contact` is evaluated without inputs.
