@@ -25,6 +25,7 @@ pub mod derivation;
 pub mod emit;
 pub mod model;
 pub mod parse;
+pub(crate) mod physical;
 pub mod probe;
 
 pub use parse::FileRoots;

@@ -45,10 +45,7 @@ impl Builder<'_> {
         };
         let mass = self.scalar(&d.mass);
         if let Some(m) = mass {
-            if self.g.is_zero(m) {
-                self.cx
-                    .error_at(d.mass.span(), format!("`{}` has zero mass", d.name));
-            }
+            self.check_mass(d, m);
         }
         let zero = self.g.int(0).ok()?;
         let mut inertia = [[zero; 3]; 3];
@@ -64,6 +61,9 @@ impl Builder<'_> {
             }
             None => {}
         }
+        if let Some(i) = &d.inertia {
+            self.check_inertia(d, i, &inertia);
+        }
         Some(Body {
             name: d.name.to_string(),
             center: center?,
@@ -71,6 +71,60 @@ impl Builder<'_> {
             mass: mass?,
             inertia,
         })
+    }
+
+    /// A mass that is a number must be positive.
+    fn check_mass(&mut self, d: &BodyDef, m: Id) {
+        let Some(value) = self.g.as_number(m).map(|n| n.to_f64()) else {
+            return;
+        };
+        let rule = if value == 0.0 {
+            "zero mass"
+        } else if value < 0.0 {
+            "a negative mass"
+        } else {
+            return;
+        };
+        self.cx.error_at(
+            d.mass.span(),
+            format!(
+                "`{}` has {rule} ({value}): a body's mass must be positive",
+                d.name
+            ),
+        );
+    }
+
+    /// An inertia whose entries are all numbers must be one a rigid body can
+    /// have: positive definite and within the triangle inequality. The
+    /// error points at the largest principal moment of a `principal(...)`,
+    /// else at the first entry.
+    fn check_inertia(&mut self, d: &BodyDef, written: &Inertia, inertia: &[[Id; 3]; 3]) {
+        let mut m = [[0.0; 3]; 3];
+        for (r, row) in inertia.iter().enumerate() {
+            for (c, e) in row.iter().enumerate() {
+                let Some(n) = self.g.as_number(*e) else {
+                    return;
+                };
+                m[r][c] = n.to_f64();
+            }
+        }
+        let Err(rule) = crate::physical::check_matrix(&m) else {
+            return;
+        };
+        let span = match written {
+            Inertia::Principal(e) => {
+                let largest = (0..3).fold(0, |b, k| if m[k][k] > m[b][b] { k } else { b });
+                e[largest].span()
+            }
+            Inertia::Matrix(e) => e[0].span(),
+        };
+        let hint = match written {
+            Inertia::Principal(_) => "a rigid body's principal moments are positive, each at most the sum of the other two",
+            Inertia::Matrix(_) => "`matrix(...)` takes ixx, iyy, izz, ixy, iyz, izx, and a rigid body's is positive definite with each principal moment at most the sum of the other two",
+        };
+        let rule = rule.trim_start_matches("its ");
+        self.cx
+            .error_at(span, format!("`{}`'s {rule}\n  hint: {hint}", d.name));
     }
 
     /// A constraint's residuals, lhs − rhs: one for an equation between

@@ -15,7 +15,7 @@ const MIXED: &str = r#"
     #[appell(joint(w_4, weld, parent = l_3, child = l_4, xyz = [0.3, 0, 0], rpy = [0, 0.5, 0]))]
     #[appell(joint(j_5, revolute([1, 2, 2]), parent = l_4, child = l_5, xyz = [0, 0, 0.2]))]
     #[appell(body(b_1, frame = l_1, mass = m, center = origin(l_1) + 0.05 * l_1.x + 0.2 * l_1.z,
-                  inertia = matrix(0.02, 0.03, 0.01, 0.001, 0.0015, -0.002)))]
+                  inertia = matrix(0.02, 0.025, 0.01, 0.001, 0.0015, -0.002)))]
     #[appell(frame(i_2 = l_2.rotate_x(0.4).rotate_z(-0.3)))]
     #[appell(body(b_2, frame = i_2, mass = 1.3, center = origin(l_2) + 0.1 * i_2.y - 0.25 * l_2.z,
                   inertia = principal(0.04, 0.05, 0.02)))]
@@ -169,7 +169,7 @@ const ON_WHEELS: &str = r#"
              body(left_wheel, center = lw_origin, frame = lw, mass = 2, inertia = principal(0.005, 0.01, 0.005)),
              body(right_wheel, center = rw_origin, frame = rw, mass = 2, inertia = principal(0.005, 0.01, 0.005)),
              body(b_1, frame = a_1, mass = 1.3, center = origin(a_1) + 0.02 * a_1.x + 0.1 * a_1.z,
-                  inertia = matrix(0.02, 0.03, 0.01, 0.001, 0.0015, -0.002)),
+                  inertia = matrix(0.02, 0.025, 0.01, 0.001, 0.0015, -0.002)),
              body(b_2, frame = a_2, mass = 0.8, center = origin(a_2) + 0.2 * a_2.x + 0.03 * a_2.y,
                   inertia = principal(0.01, 0.02, 0.015)),
              rolls(left_wheel, contact = lp, along = [c.x, c.y]),
