@@ -290,3 +290,45 @@ fn a_one_sided_contact_keeps_the_closed_form_contact_time_and_rebound() {
     );
     assert!((rebound.x[1] - v0).abs() < 1e-7, "{} vs {v0}", rebound.x[1]);
 }
+
+/// A particle tied to the origin by a spring of zero rest length, and the
+/// same with `length = 0.0` written out.
+#[derive(Appell)]
+#[appell(coordinates(x, y), speeds(x, y), positive(m, k))]
+#[appell(point(P = O + x * N.x + y * N.y), particle(P, mass = m))]
+#[appell(spring(O, P, stiffness = k))]
+struct Tether {
+    m: f64,
+    k: f64,
+}
+
+#[derive(Appell)]
+#[appell(coordinates(x, y), speeds(x, y), positive(m, k))]
+#[appell(point(P = O + x * N.x + y * N.y), particle(P, mass = m))]
+#[appell(spring(O, P, stiffness = k, length = 0.0))]
+struct TetherWritten {
+    m: f64,
+    k: f64,
+}
+
+#[test]
+fn a_spring_of_zero_rest_length_pulls_k_d_and_is_regular_where_its_points_meet() {
+    let (m, k) = (2.0, 5.0);
+    let tether = Tether { m, k };
+    let written = TetherWritten { m, k };
+    for (x, y) in [(0.3, -0.4), (1e-300, 0.0), (0.0, 0.0)] {
+        let state = [x, y, 0.1, -0.2];
+        let (mut d, mut e) = ([0.0; 4], [0.0; 4]);
+        tether
+            .rhs(&tether.prepare::<f64>(), 0.0, &state, &[], &mut d)
+            .unwrap();
+        written
+            .rhs(&written.prepare::<f64>(), 0.0, &state, &[], &mut e)
+            .unwrap();
+        assert_eq!(d, e);
+        let expected = [0.1, -0.2, -k / m * x, -k / m * y];
+        for (a, b) in d.iter().zip(expected) {
+            assert!((a - b).abs() < 1e-15 * (1.0 + b.abs()), "{x} {y}: {d:?}");
+        }
+    }
+}

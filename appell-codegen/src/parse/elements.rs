@@ -143,6 +143,14 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
             ));
         }
     }
+    if p == q {
+        return Err(syn::Error::new(
+            span,
+            format!(
+                "a {kind} between `{p}` and itself has no direction: name the two points it joins"
+            ),
+        ));
+    }
     let d = sub(Expr::Name(q.clone()), Expr::Name(p.clone()));
     let direction = call("unit", vec![d.clone()], span);
     let tension = match kind {
