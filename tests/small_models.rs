@@ -200,3 +200,124 @@ fn cartesian_pendulum_matches_the_angle_form() {
         assert!(hol[0].abs() < 1e-14);
     }
 }
+
+/// A disc on a gimbal with a particle on its rim: the disc's inertia and
+/// the particle's mass are parameters, so only `validate` can check them.
+#[derive(Appell, Clone)]
+#[appell(coordinates(theta, phi), speeds(theta, phi), positive(m))]
+#[appell(frame(A = N.rotate_z(theta)), frame(B = A.rotate_x(phi)))]
+#[appell(point(P = O + r * B.y))]
+#[appell(body(disc, center = O, frame = B, mass = m, inertia = principal(i1, i1, i3)))]
+#[appell(particle(P, mass = mp))]
+pub struct Gimbal {
+    pub m: f64,
+    pub i1: f64,
+    pub i3: f64,
+    pub mp: f64,
+    pub r: f64,
+}
+
+#[test]
+fn bodies_made_of_parameters_are_checked_before_a_simulation_starts() {
+    use appell::integrate::{Dop853, IntegrateError, TrBdf2};
+    let good = Gimbal {
+        m: 2.0,
+        i1: 0.25,
+        i3: 0.5,
+        mp: 0.1,
+        r: 0.5,
+    };
+    assert_eq!(good.validate(), Ok(()));
+    let impossible = |body, rule, parameters| {
+        Err(ModelError::ImpossibleBody {
+            body,
+            rule,
+            parameters,
+        })
+    };
+    use appell::physical::BodyRule::*;
+    let lopsided = Gimbal {
+        i3: 0.6,
+        ..good.clone()
+    };
+    assert_eq!(
+        lopsided.validate(),
+        impossible("disc", Triangle, &["i1", "i3"])
+    );
+    let negative = Gimbal {
+        i1: -0.25,
+        ..good.clone()
+    };
+    assert_eq!(
+        negative.validate(),
+        impossible("disc", NotSemidefinite, &["i1", "i3"])
+    );
+    let light = Gimbal {
+        mp: -0.1,
+        ..good.clone()
+    };
+    assert_eq!(light.validate(), impossible("P", NonPositiveMass, &["mp"]));
+    assert_eq!(
+        light.validate().unwrap_err().to_string(),
+        "body `P` cannot be physical: its mass is not positive; check parameter `mp`"
+    );
+    assert_eq!(
+        lopsided.validate().unwrap_err().to_string(),
+        "body `disc` cannot be physical: its inertia violates the triangle inequality: a principal moment exceeds the sum of the other two; check parameters `i1`, `i3`"
+    );
+    // Declared positivity is checked first, as `rhs` does.
+    let massless = Gimbal {
+        m: 0.0,
+        ..good.clone()
+    };
+    assert!(matches!(
+        massless.validate(),
+        Err(ModelError::NonPositiveParameter { name: "m", .. })
+    ));
+    // The entry points refuse before their first step: an explicit and an
+    // implicit integrator, and the linearization.
+    let x0 = [0.2, 0.3, 0.4];
+    assert_eq!(
+        Dop853::new()
+            .solve_model(&lopsided, &[], 0.0, &x0, 1.0)
+            .unwrap_err(),
+        IntegrateError::Model(lopsided.validate().unwrap_err())
+    );
+    assert!(matches!(
+        TrBdf2::new().solve_model(&light, &[], 0.0, &x0, 1.0),
+        Err(IntegrateError::Model(ModelError::ImpossibleBody {
+            body: "P",
+            ..
+        }))
+    ));
+    assert_eq!(
+        appell::linearize::linearize(&negative, 0.0, &x0, &[]).unwrap_err(),
+        negative.validate().unwrap_err()
+    );
+    assert!(Dop853::new().solve_model(&good, &[], 0.0, &x0, 0.1).is_ok());
+}
+
+#[test]
+fn the_command_line_refuses_parameters_that_make_a_body_impossible() {
+    let args: Vec<String> = ["gimbal", "eval"].iter().map(|s| s.to_string()).collect();
+    let good = Gimbal {
+        m: 2.0,
+        i1: 0.25,
+        i3: 0.5,
+        mp: 0.1,
+        r: 0.5,
+    };
+    let lines = b"{\"q\": {\"phi\": 0.2}, \"u\": {\"theta\": 0.3, \"phi\": 0.4}}\n\
+                  {\"q\": {\"phi\": 0.2}, \"u\": {\"theta\": 0.3, \"phi\": 0.4}, \"params\": {\"i3\": 0.6}}\n";
+    let mut out = Vec::new();
+    appell::cli::run_with(good, &args, &mut &lines[..], &mut out, |_| Ok(())).unwrap();
+    let text = String::from_utf8(out).unwrap();
+    let lines: Vec<&str> = text.lines().collect();
+    assert!(lines[0].starts_with(r#"{"qdot":"#), "{}", lines[0]);
+    assert!(
+        lines[1].contains("body `disc` cannot be physical")
+            && lines[1].contains("check parameters `i1`, `i3`"),
+        "{}",
+        lines[1]
+    );
+}

@@ -271,6 +271,9 @@ pub trait DynModel: sealed::Sealed {
     /// [`Model::set_parameter`].
     fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool;
 
+    /// [`Model::validate`].
+    fn dyn_validate(&self) -> Result<(), ModelError>;
+
     /// The reduced rhs with [`Model::prepare`] done once, in `f64` and
     /// [`Dual64`].
     fn dyn_prepare(&self) -> Box<dyn DynRhs + '_>;
@@ -572,6 +575,10 @@ impl<M: Model> DynModel for M {
 
     fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool {
         self.set_parameter(name, value)
+    }
+
+    fn dyn_validate(&self) -> Result<(), ModelError> {
+        self.validate()
     }
 
     fn dyn_prepare(&self) -> Box<dyn DynRhs + '_> {

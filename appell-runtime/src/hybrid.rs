@@ -434,6 +434,9 @@ impl<'a> Hybrid<'a> {
                     info.inputs.len()
                 ));
             }
+            p.model
+                .dyn_validate()
+                .map_err(|e| HybridError::Integrate(IntegrateError::Model(e)))?;
             if let Some(g) = p.guards.iter().find(|g| g.to >= self.phases.len()) {
                 return bad(format!(
                     "guard `{}` of phase `{}` leads to no phase",

@@ -26,7 +26,7 @@
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
 //! otherwise, so a blow-up never goes unnoticed as NaN.
 
-use crate::model::{check_state_len, Model, ModelError};
+use crate::model::{check_model, check_state_len, Model, ModelError};
 use crate::scalar::Scalar;
 
 mod dop853;
@@ -348,7 +348,7 @@ pub fn rk4<M: Model, T: Scalar, const S: usize>(
     steps: usize,
     inputs: &[T],
 ) -> Result<[T; S], ModelError> {
-    check_state_len::<M>(S)?;
+    check_model(model, S)?;
     if !state0.iter().all(|x| x.re().is_finite()) {
         return Err(ModelError::NonFinite { what: "state" });
     }

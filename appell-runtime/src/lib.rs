@@ -39,6 +39,7 @@ mod model;
 pub mod motion;
 #[cfg(feature = "std")]
 pub mod oracle;
+pub mod physical;
 pub mod precision;
 mod scalar;
 #[cfg(feature = "std")]
@@ -88,6 +89,7 @@ pub mod __private {
         pivot_margin,
     };
     pub use crate::model::check_len;
+    pub use crate::physical::check_body;
     pub use crate::{
         BodyInfo, ContactInfo, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar,
         SceneVisitor,

@@ -409,8 +409,10 @@ impl Emitter<'_> {
             }
         };
         let margin_fn = self.dependent_block_margin(c);
+        let validate_fn = self.validate(c);
         quote! {
             #margin_fn
+            #validate_fn
             fn mass_properties(&self, __masses: &mut [f64], __inertias: &mut [[f64; 9]]) -> #p::Result<(), #p::ModelError> {
                 #(#checks_mp)* #params_f #mp_body #(#mp_out)*
                 #p::Ok(())
@@ -420,6 +422,58 @@ impl Emitter<'_> {
                 #p::Ok(())
             }
             #rows_fn
+        }
+    }
+
+    /// `validate`: positivity, then every body whose mass or inertia
+    /// depends on parameters (the others were checked at compile time)
+    /// against the rules of `physical`, through `mass_properties`. Nothing
+    /// (the trait's default) for a model with neither.
+    fn validate(&self, c: &Common) -> TokenStream {
+        let p = p();
+        let g = &self.model.g;
+        let params = &self.model.params;
+        let checks: Vec<TokenStream> = self
+            .model
+            .bodies
+            .iter()
+            .enumerate()
+            .filter_map(|(k, b)| {
+                let names = |roots: &[Id]| -> Vec<String> {
+                    params
+                        .iter()
+                        .filter(|prm| roots.iter().any(|&e| g.depends_on(e, prm.symbol)))
+                        .map(|prm| prm.display())
+                        .collect()
+                };
+                let of_mass = names(&[b.mass]);
+                let of_inertia = names(&b.inertia.concat());
+                if of_mass.is_empty() && of_inertia.is_empty() {
+                    return None;
+                }
+                let (name, k) = (&b.name, int(k));
+                Some(quote!(#p::check_body(#name, &[#(#of_mass),*], &[#(#of_inertia),*], __masses[#k], &__inertias[#k])?;))
+            })
+            .collect();
+        let positivity = &c.positivity;
+        if checks.is_empty() && positivity.is_empty() {
+            return TokenStream::new();
+        }
+        let nb = int(self.model.bodies.len());
+        let bodies = (!checks.is_empty()).then(|| {
+            quote! {
+                let mut __masses = [0.0f64; #nb];
+                let mut __inertias = [[0.0f64; 9]; #nb];
+                <Self as #p::Model>::mass_properties(self, &mut __masses, &mut __inertias)?;
+                #(#checks)*
+            }
+        });
+        quote! {
+            fn validate(&self) -> #p::Result<(), #p::ModelError> {
+                #positivity
+                #bodies
+                #p::Ok(())
+            }
         }
     }
 

@@ -95,7 +95,7 @@ impl Builder<'_> {
     }
 
     /// An inertia whose entries are all numbers must be one a rigid body can
-    /// have: positive definite and within the triangle inequality. The
+    /// have: positive semidefinite and within the triangle inequality. The
     /// error points at the largest principal moment of a `principal(...)`,
     /// else at the first entry.
     fn check_inertia(&mut self, d: &BodyDef, written: &Inertia, inertia: &[[Id; 3]; 3]) {
@@ -119,8 +119,9 @@ impl Builder<'_> {
             Inertia::Matrix(e) => e[0].span(),
         };
         let hint = match written {
-            Inertia::Principal(_) => "a rigid body's principal moments are positive, each at most the sum of the other two",
-            Inertia::Matrix(_) => "`matrix(...)` takes ixx, iyy, izz, ixy, iyz, izx, and a rigid body's is positive definite with each principal moment at most the sum of the other two",
+            Inertia::Principal(_) if m[0][0] == 0.0 && m[1][1] == 0.0 => "a rigid body's principal moments are non-negative, each at most the sum of the other two; in a planar model only the moment about the normal enters, so write the body as a plate: `principal(i / 2, i / 2, i)`",
+            Inertia::Principal(_) => "a rigid body's principal moments are non-negative, each at most the sum of the other two",
+            Inertia::Matrix(_) => "`matrix(...)` takes ixx, iyy, izz, ixy, iyz, izx, and a rigid body's is positive semidefinite with each principal moment at most the sum of the other two",
         };
         let rule = rule.trim_start_matches("its ");
         self.cx

@@ -261,6 +261,7 @@ impl EvalState {
                 return Err(format!("the model does not accept parameter `{name}`"));
             }
         }
+        model.dyn_validate().map_err(|e| e.to_string())?;
         for r in info.retained {
             if info
                 .coordinate_index(r)

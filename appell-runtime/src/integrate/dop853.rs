@@ -8,7 +8,7 @@ use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
 };
 use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
-use crate::model::{check_state_len, Model, ModelError};
+use crate::model::{check_model, Model, ModelError};
 use crate::scalar::Scalar;
 
 /// Adaptive Dormand–Prince 8(5,3) integrator (Hairer, Nørsett & Wanner,

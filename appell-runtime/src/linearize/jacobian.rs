@@ -67,6 +67,7 @@ pub fn linearize<M: Model>(
     finite(&[t], "t")?;
     finite(state, "state")?;
     finite(inputs, "inputs")?;
+    model.validate()?;
 
     let prepared = model.prepare::<Dual64>();
     let td = Dual64::from_re(t);

@@ -78,6 +78,7 @@ pub fn minimal_linearization<M: Model>(
     check_configuration(info, t, q_full)?;
     check_len("u", u, nl)?;
     finite(u, "u")?;
+    model.validate()?;
     let retained = indices(info, info.retained, "retained")?;
     let dependent = indices(info, info.dependent, "dependent")?;
     indices(info, info.speeds, "speeds")?;

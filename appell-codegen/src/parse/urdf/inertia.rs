@@ -96,7 +96,7 @@ mod tests {
         let e = check(0.0, &inertia(1.0, 1.0, 1.0, 0.0, 0.0, 0.0)).unwrap_err();
         assert!(e.contains("zero"), "{e}");
         let e = check(1.0, &inertia(1.0, 1.0, 1.0, 2.0, 0.0, 0.0)).unwrap_err();
-        assert!(e.contains("not positive definite"), "{e}");
+        assert!(e.contains("not positive semidefinite"), "{e}");
         let e = check(1.0, &inertia(1.0, 1.0, 3.0, 0.0, 0.0, 0.0)).unwrap_err();
         assert!(e.contains("triangle"), "{e}");
         // Positive definite, but off-diagonal terms make a principal moment

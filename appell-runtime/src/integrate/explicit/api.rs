@@ -261,7 +261,7 @@ macro_rules! explicit_api {
             x0: &[T; S],
             t_end: f64,
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_state_len::<M>(S)?;
+            check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
             self.solve_projected(f, project, t0, x0, t_end)
@@ -278,7 +278,7 @@ macro_rules! explicit_api {
             x0: &[T; S],
             t_end: f64,
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_state_len::<M>(S)?;
+            check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
             self.solve(f, t0, x0, t_end)
@@ -294,7 +294,7 @@ macro_rules! explicit_api {
             x0: &[T; S],
             out: &mut [(f64, [T; S])],
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_state_len::<M>(S)?;
+            check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
             self.solve_at(f, t0, x0, out)
@@ -314,7 +314,7 @@ macro_rules! explicit_api {
         where
             G: FnMut(f64, &[T; S]) -> f64,
         {
-            check_state_len::<M>(S)?;
+            check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
             self.solve_until(f, g, t0, x0, t_end)

@@ -441,6 +441,7 @@ impl TrBdf2 {
         project: Option<&mut ProjectG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError> {
         check_len("state", x0, M::info().state_len())?;
+        model.validate()?;
         self.run_prepared(
             &Prepared::new(model),
             t0,

@@ -526,6 +526,7 @@ impl Radau5 {
         project: Option<&mut ProjectG<'_>>,
     ) -> Result<Radau5Solution, IntegrateError> {
         check_len("state", x0, M::info().state_len())?;
+        model.validate()?;
         let rhs = Prepared::new(model);
         self.run_prepared(&rhs, inputs, t0, x0, t_end, out, event, project)
     }
