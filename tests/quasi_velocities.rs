@@ -110,8 +110,9 @@ fn sleigh_agrees_with_the_oracle() {
 fn body_frame_speeds_give_eulers_equations() {
     // (I1) ω̇1 = (I2 − I3) ω2 ω3 and cyclic.
     // The Euler-angle kinematics W(a2, a3) are singular at a2 = 0 (gimbal
-    // lock), so the rates are solved numerically and the two angles they
-    // involve stay in the state, although M and f do not depend on them.
+    // lock), so the rates are solved numerically and S reads a2 and a3;
+    // M and f do not depend on them through the solve, so the reduced
+    // state is ω alone, and no orientation is singular for it.
     let p = FreeRotor {
         m: 1.0,
         i1: 0.2,
@@ -119,8 +120,8 @@ fn body_frame_speeds_give_eulers_equations() {
         i3: 0.45,
     };
     let info = FreeRotor::info();
-    assert_eq!(info.retained, &["a2", "a3"]);
-    assert_eq!(info.ignorable, &["a1"]);
+    assert!(info.retained.is_empty());
+    assert_eq!(info.ignorable, &["a1", "a2", "a3"]);
     let prepared = p.prepare::<f64>();
     let mut rng = Rng(53);
     for _ in 0..500 {
@@ -129,17 +130,8 @@ fn body_frame_speeds_give_eulers_equations() {
             rng.uniform(-3.0, 3.0),
             rng.uniform(-3.0, 3.0),
         ];
-        let angles = [rng.uniform(0.3, 2.8), rng.uniform(-3.0, 3.0)];
-        let mut d = [0.0; 5];
-        p.rhs(
-            &prepared,
-            0.0,
-            &[angles[0], angles[1], w[0], w[1], w[2]],
-            &[],
-            &mut d,
-        )
-        .unwrap();
-        let d = [d[2], d[3], d[4]];
+        let mut d = [0.0; 3];
+        p.rhs(&prepared, 0.0, &w, &[], &mut d).unwrap();
         let e = [
             (p.i2 - p.i3) * w[1] * w[2] / p.i1,
             (p.i3 - p.i1) * w[2] * w[0] / p.i2,
@@ -147,6 +139,97 @@ fn body_frame_speeds_give_eulers_equations() {
         ];
         for k in 0..3 {
             assert!(close(d[k], e[k], 1e-12), "{k}: {} vs {}", d[k], e[k]);
+        }
+    }
+}
+
+/// The snakeboard: a board with a rotor at its centre P and two steered
+/// wheel axles a distance `r` ahead and behind, neither of which may slide
+/// sideways; the rider turns the rotor against the board and steers both
+/// axles. The constraints are written in the ground frame, so the heading
+/// enters the numeric elimination; nothing the board does depends on it.
+#[derive(Appell, Clone)]
+#[appell(coordinates(x, y, theta, psi, phi_b, phi_f))]
+#[appell(speeds(v = dot(velocity(P), B.x), psi, phi_b, phi_f))]
+#[appell(frame(B = N.rotate_z(theta)), frame(R = B.rotate_z(psi)))]
+#[appell(frame(Wb = B.rotate_z(phi_b)), frame(Wf = B.rotate_z(phi_f)))]
+#[appell(point(P = O + x * N.x + y * N.y))]
+#[appell(point(Pb = P - r * B.x), point(Pf = P + r * B.x))]
+#[appell(body(board, center = P, frame = B, mass = m, inertia = principal(j, j, j)))]
+#[appell(body(rotor, center = P, frame = R, mass = mr, inertia = principal(jr, jr, jr)))]
+#[appell(body(back, center = Pb, frame = Wb, mass = mw, inertia = principal(jw, jw, jw)))]
+#[appell(body(front, center = Pf, frame = Wf, mass = mw, inertia = principal(jw, jw, jw)))]
+#[appell(nonholonomic(dot(velocity(Pb), Wb.y) == 0))]
+#[appell(nonholonomic(dot(velocity(Pf), Wf.y) == 0))]
+#[appell(inputs(spin, steer))]
+#[appell(torque(R, spin * B.z), torque(B, -spin * B.z))]
+#[appell(torque(Wb, -steer * B.z), torque(Wf, steer * B.z))]
+struct Snakeboard {
+    m: f64,
+    j: f64,
+    mr: f64,
+    jr: f64,
+    mw: f64,
+    jw: f64,
+    r: f64,
+}
+
+fn snakeboard() -> Snakeboard {
+    Snakeboard {
+        m: 3.0,
+        j: 0.2,
+        mr: 1.0,
+        jr: 0.05,
+        mw: 0.3,
+        jw: 0.01,
+        r: 0.4,
+    }
+}
+
+#[test]
+fn snakeboard_state_leaves_out_position_heading_and_rotor_angle() {
+    // Six where seven were kept before: the heading enters S and R of the
+    // numeric elimination but not M, f through it.
+    let info = Snakeboard::info();
+    assert_eq!(info.retained, ["phi_b", "phi_f"]);
+    assert_eq!(info.ignorable, ["x", "y", "theta", "psi"]);
+    assert_eq!(info.state_len(), 6);
+}
+
+#[test]
+fn snakeboard_agrees_with_the_oracle_at_every_heading() {
+    // The oracle integrates all six coordinates at random headings.
+    let mut rng = Rng(0x5a4e);
+    let worst = common::agree_with_inputs(&snakeboard(), &mut rng, 300, 1.2, 1.0);
+    assert!(worst < 1e-9, "largest relative difference {worst:.2e}");
+}
+
+#[test]
+fn snakeboard_coordinate_rates_turn_with_the_heading() {
+    // q̇ still comes from the model's own elimination: at any heading the
+    // wheels do not slide sideways, and (ẋ, ẏ) is the board-frame velocity
+    // turned by θ.
+    let model = snakeboard();
+    let u = [0.8, 1.5, -0.4, 0.6];
+    let rates_at = |theta: f64| {
+        let q = [0.3, -0.2, theta, 0.5, 0.35, -0.25];
+        let mut qdot = [0.0; 6];
+        model.coordinate_rates(0.0, &q, &u, &mut qdot).unwrap();
+        let (mut holonomic, mut velocity) = ([0.0; 0], [0.0; 2]);
+        model
+            .constraint_residuals(0.0, &q, &qdot, &mut holonomic, &mut velocity)
+            .unwrap();
+        assert!(velocity.iter().all(|v| v.abs() < 1e-12), "{velocity:?}");
+        qdot
+    };
+    let level = rates_at(0.0);
+    for theta in [0.7, -2.1, 3.0] {
+        let turned = rates_at(theta);
+        let (c, s) = (theta.cos(), theta.sin());
+        assert!(close(turned[0], c * level[0] - s * level[1], 1e-12));
+        assert!(close(turned[1], s * level[0] + c * level[1], 1e-12));
+        for k in 2..6 {
+            assert!(close(turned[k], level[k], 1e-12));
         }
     }
 }

@@ -185,6 +185,26 @@ fn command_line_lists_scenes_and_evaluates_one() {
         |_| Ok(()),
     );
     assert!(matches!(err, Err(appell::cli::CliError::Usage(_))));
+    // `--scene` with no name says what it needs and which scenes exist.
+    for command in ["eval", "contacts"] {
+        let err = appell::cli::run_with(
+            WheelAxle::default(),
+            &args(&["wheel_axle", command, "--scene"]),
+            &mut &line[..],
+            &mut Vec::new(),
+            |_| Ok(()),
+        );
+        let Err(appell::cli::CliError::Usage(message)) = err else {
+            panic!("a usage error, got {err:?}");
+        };
+        assert!(
+            message.starts_with(&format!(
+                "`{command} --scene` needs the name of a scene after it"
+            )),
+            "{message}"
+        );
+        assert!(message.contains("WheelAxle::driven"), "{message}");
+    }
 }
 
 #[test]

@@ -297,6 +297,57 @@ fn bodies_made_of_parameters_are_checked_before_a_simulation_starts() {
     assert!(Dop853::new().solve_model(&good, &[], 0.0, &x0, 0.1).is_ok());
 }
 
+/// A pendulum whose bob hangs at a length the model computes by dividing
+/// by a parameter: `stretch = 0` makes the divisor zero.
+#[derive(Appell, Clone)]
+#[appell(coordinates(theta), speeds(theta))]
+#[appell(point(P = O + (l / stretch) * (sin(theta) * N.x - cos(theta) * N.y)))]
+#[appell(particle(P, mass = m), gravity(-g * N.y))]
+pub struct StretchedPendulum {
+    pub m: f64,
+    pub l: f64,
+    pub stretch: f64,
+    pub g: f64,
+}
+
+#[test]
+fn a_zero_divisor_names_its_parameter() {
+    use appell::integrate::{Dop853, IntegrateError};
+    let good = StretchedPendulum {
+        m: 1.0,
+        l: 1.0,
+        stretch: 2.0,
+        g: 9.81,
+    };
+    assert_eq!(good.validate(), Ok(()));
+    let broken = StretchedPendulum {
+        stretch: 0.0,
+        ..good.clone()
+    };
+    let zero = ModelError::ZeroDivisor {
+        place: "point `P`",
+        parameters: &["stretch"],
+    };
+    assert_eq!(broken.validate(), Err(zero.clone()));
+    assert_eq!(
+        zero.to_string(),
+        "division by zero in point `P`; check parameter `stretch`"
+    );
+    // The rhs, called directly, names it too instead of a non-finite result.
+    let prepared = broken.prepare::<f64>();
+    let mut d = [0.0; 2];
+    assert_eq!(
+        broken.rhs(&prepared, 0.0, &[0.3, 0.0], &[], &mut d),
+        Err(zero.clone())
+    );
+    assert_eq!(
+        Dop853::new()
+            .solve_model(&broken, &[], 0.0, &[0.3, 0.0], 1.0)
+            .unwrap_err(),
+        IntegrateError::Model(zero)
+    );
+}
+
 #[test]
 fn the_command_line_refuses_parameters_that_make_a_body_impossible() {
     let args: Vec<String> = ["gimbal", "eval"].iter().map(|s| s.to_string()).collect();

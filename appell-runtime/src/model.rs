@@ -249,6 +249,14 @@ pub enum ModelError {
         /// The parameters its mass and inertia depend on.
         parameters: &'static [&'static str],
     },
+    /// A divisor made of parameters (`1 / k`) is zero (see
+    /// [`Model::validate`]).
+    ZeroDivisor {
+        /// Where the division is written (`point `P``, `body `rod``).
+        place: &'static str,
+        /// The parameters the divisor depends on.
+        parameters: &'static [&'static str],
+    },
     /// A function without an `inputs` argument, called on a model whose
     /// constraints read inputs (driven coordinates): its result depends on
     /// them, so use the `driven_` form that takes them.
@@ -294,6 +302,15 @@ impl core::fmt::Display for ModelError {
                 parameters,
             } => {
                 write!(f, "body `{body}` cannot be physical: {}", rule.describe())?;
+                for (k, name) in parameters.iter().enumerate() {
+                    let lead = if k == 0 { "; check parameter" } else { "," };
+                    let plural = if k == 0 && parameters.len() > 1 { "s" } else { "" };
+                    write!(f, "{lead}{plural} `{name}`")?;
+                }
+                Ok(())
+            }
+            ModelError::ZeroDivisor { place, parameters } => {
+                write!(f, "division by zero in {place}")?;
                 for (k, name) in parameters.iter().enumerate() {
                     let lead = if k == 0 { "; check parameter" } else { "," };
                     let plural = if k == 0 && parameters.len() > 1 { "s" } else { "" };
@@ -393,8 +410,9 @@ pub trait Model {
     /// parameter declared `positive` is, and every body whose mass or
     /// inertia is made of parameters can be physical (a positive mass, an
     /// inertia that is positive semidefinite and obeys the triangle
-    /// inequality; see [`physical`](crate::physical)). Bodies written in
-    /// numbers were checked when the model compiled.
+    /// inequality; see [`physical`](crate::physical)), and no divisor made
+    /// of parameters is zero. Bodies written in numbers were checked when
+    /// the model compiled.
     ///
     /// The integrators' `solve_model*`, [`linearize`](crate::linearize),
     /// the hybrid driver and the command line call it; the generated
@@ -402,7 +420,9 @@ pub trait Model {
     /// [`rk4_step`](crate::integrate::rk4_step) in a loop should call it
     /// once when its parameters change. Errors:
     /// [`ModelError::NonPositiveParameter`] and
-    /// [`ModelError::ImpossibleBody`], naming the body's parameters. The
+    /// [`ModelError::ImpossibleBody`], naming the body's parameters, and
+    /// [`ModelError::ZeroDivisor`] for a divisor made of parameters that is
+    /// zero (`1 / k` with k = 0), naming them. The
     /// default (a model written by hand) accepts everything.
     fn validate(&self) -> Result<(), ModelError> {
         Ok(())

@@ -85,6 +85,25 @@ pub fn speed_definitions(
         cx.error_spanned_by(&rows.at[row], dependent_row_message(model, rows, row));
         return Ok(None);
     }
+    if m >= n {
+        cx.error_spanned_by(
+            &model.speeds_at,
+            format!(
+                "the model has no degree of freedom: its {m} velocity constraint(s) fix all {n} coordinate(s), so no speed is independent and nothing moves; drop a constraint or add a coordinate"
+            ),
+        );
+        return Ok(None);
+    }
+    if !model.speeds_declared {
+        cx.error_spanned_by(
+            &model.speeds_at,
+            format!(
+                "the model declares no `speeds(...)`: its {m} velocity constraint(s) on {n} coordinates leave {} independent speed(s); name the coordinates whose rates they are",
+                n - m
+            ),
+        );
+        return Ok(None);
+    }
     if l + m != n {
         let joints = if model.joint_speeds.is_empty() {
             String::new()

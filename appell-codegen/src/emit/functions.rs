@@ -456,7 +456,8 @@ impl Emitter<'_> {
             })
             .collect();
         let positivity = &c.positivity;
-        if checks.is_empty() && positivity.is_empty() {
+        let divisors = self.divisor_checks();
+        if checks.is_empty() && positivity.is_empty() && divisors.is_empty() {
             return TokenStream::new();
         }
         let nb = int(self.model.bodies.len());
@@ -471,6 +472,7 @@ impl Emitter<'_> {
         quote! {
             fn validate(&self) -> #p::Result<(), #p::ModelError> {
                 #positivity
+                #divisors
                 #bodies
                 #p::Ok(())
             }
@@ -645,8 +647,41 @@ impl Emitter<'_> {
             let (f, what) = (prm.place(), format!("parameter `{}`", prm.display()));
             out.extend(quote!(if !#this.#f.is_finite() { return #p::Err(#p::ModelError::NonFinite { what: #what }); }));
         }
+        out.extend(self.divisor_checks());
         out.extend(self.zero_length_checks());
         out
+    }
+
+    /// A `ZeroDivisor` for each divisor made of parameters alone that is
+    /// zero, naming the parameters (nothing when there is none).
+    fn divisor_checks(&self) -> TokenStream {
+        let p = p();
+        let model = self.model;
+        let g = &model.g;
+        let mut list: Vec<&(Id, String)> = Vec::new();
+        for entry in &model.divisors {
+            if !list.iter().any(|(d, _)| *d == entry.0) {
+                list.push(entry);
+            }
+        }
+        if list.is_empty() {
+            return TokenStream::new();
+        }
+        let roots: Vec<Id> = list.iter().map(|(d, _)| *d).collect();
+        let mut c = code(g, &roots, Target::F64);
+        let statements = c.take_statements();
+        let params_f = self.params_as(false);
+        let tests = list.iter().enumerate().map(|(k, (d, place))| {
+            let names: Vec<String> = model
+                .params
+                .iter()
+                .filter(|prm| g.depends_on(*d, prm.symbol))
+                .map(|prm| prm.display())
+                .collect();
+            let value = &c.outputs[k];
+            quote!(if #value == 0.0 { return #p::Err(#p::ModelError::ZeroDivisor { place: #place, parameters: &[#(#names),*] }); })
+        });
+        quote!({ #params_f #statements #(#tests)* })
     }
 
     /// A zero-length `norm`/`unit` argument, where it depends on the

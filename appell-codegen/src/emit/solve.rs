@@ -35,8 +35,17 @@ pub(super) fn matrix(outputs: &[TokenStream], offset: usize, m: usize, w: usize)
 impl Emitter<'_> {
     /// S X = R (and S w = (Ṙ − Ṡ X)[ẏ; 1] when `rates`) solved with
     /// `lu_solve`, binding the auxiliary symbols `__x_i_j` (and `__w_i`).
+    /// Without `rates` the values are the dependent rates themselves, so
+    /// where the reduction fixed coordinates only M and f do not depend on
+    /// through the solve, the model's own elimination is solved.
     pub(super) fn elimination(&self, rates: bool) -> TokenStream {
-        let Elimination::Numeric(ne) = &self.d.elimination else {
+        let own = !rates && !self.d.reduction.through_solve.is_empty();
+        let elimination = if own {
+            &self.d.unreduced.elimination
+        } else {
+            &self.d.elimination
+        };
+        let Elimination::Numeric(ne) = elimination else {
             return TokenStream::new();
         };
         let (m, l) = (ne.k, self.d.l);

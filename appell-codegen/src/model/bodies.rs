@@ -43,6 +43,7 @@ impl Builder<'_> {
             Some(f) => Some(self.frame_named(f)?),
             None => None,
         };
+        self.context = format!("body `{}`", d.name);
         let mass = self.scalar(&d.mass);
         if let Some(m) = mass {
             self.check_mass(d, m);
@@ -238,6 +239,7 @@ impl Builder<'_> {
         let mut torques = Vec::new();
         let mut gravity = None;
         if let Some(gvec) = &ast.gravity {
+            self.context = "`gravity(...)`".to_string();
             if let Some(v) = self.vector(gvec) {
                 gravity = Some(v);
                 for (index, body) in bodies.iter().enumerate() {
@@ -296,6 +298,7 @@ impl Builder<'_> {
     /// A force's or torque's vector and effect; a new effect is added to
     /// `effects` in order of first use.
     fn load_value(&mut self, l: &LoadDef, effects: &mut Vec<String>) -> Option<(Vec3, String)> {
+        self.context = format!("a load on `{}`", l.target);
         let v = self.vector(&l.vector)?;
         let effect = l.effect.to_string();
         if !effects.contains(&effect) {

@@ -26,6 +26,8 @@ pub(super) struct Builder<'a> {
     /// The definition being evaluated (for `norms`).
     pub(super) context: String,
     pub(super) norms: Vec<(Id, String)>,
+    /// Divisors made of parameters alone, with where they occur.
+    pub(super) divisors: Vec<(Id, String)>,
     /// Quaternion frames' coordinates (see `Model::quaternions`).
     pub(super) quaternions: Vec<[usize; 4]>,
     /// When building the twin: the model's frame matrices, whose entries
@@ -67,6 +69,7 @@ pub(super) fn build_in(
         poisoned: Vec::new(),
         context: String::new(),
         norms: Vec::new(),
+        divisors: Vec::new(),
         quaternions: Vec::new(),
         cut_from,
         cuts: Vec::new(),
@@ -130,6 +133,7 @@ pub(super) fn build_in(
         speeds,
         speed_specs,
         speeds_at,
+        speeds_declared: ast.speeds.is_some(),
         inputs: b.inputs,
         input_rates,
         time: b.time,
@@ -145,6 +149,7 @@ pub(super) fn build_in(
         scenes,
         gravity: loads.gravity,
         norms: b.norms,
+        divisors: b.divisors,
         quaternions: b.quaternions,
         joint_speeds: ast.joint_speeds.iter().map(|q| q.to_string()).collect(),
         files: ast.files.clone(),
@@ -256,7 +261,7 @@ impl Builder<'_> {
         }
         if ast.coordinates.is_empty() {
             self.cx
-                .error_at(ast.name.span(), "the model declares no `coordinates(...)`");
+                .error_at(ast.name.span(), "the model declares no coordinates, so nothing in it moves: declare `coordinates(...)` (or a joint that is not welded), then name their independent rates in `speeds(...)`");
         }
         for c in &ast.coordinates {
             if check(self.cx, c, "coordinate") {
@@ -280,7 +285,8 @@ impl Builder<'_> {
 
     pub(super) fn speeds(&mut self, ast: &ModelAst) -> (Vec<SpeedSpec>, proc_macro2::TokenStream) {
         let Some((list, at)) = &ast.speeds else {
-            self.cx.error_at(ast.name.span(), "the model declares no `speeds(...)`: name the coordinates whose rates are independent");
+            // The speeds stage says how many to name once the constraints
+            // are counted (no coordinates at all is reported above).
             let name = &ast.name;
             return (Vec::new(), quote::quote!(#name));
         };

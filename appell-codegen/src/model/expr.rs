@@ -32,6 +32,26 @@ impl Val {
 }
 
 impl Builder<'_> {
+    /// Checks a divisor: one that is identically zero is an error at
+    /// `span` (returns false); one of parameters alone is recorded for
+    /// `validate`, which names them when it is zero at run time.
+    fn divisor(&mut self, d: Id, span: Span) -> bool {
+        if self.g.is_zero(d) {
+            self.cx.error_at(
+                span,
+                format!(
+                    "division by zero in {}: this divisor is identically zero",
+                    self.context
+                ),
+            );
+            return false;
+        }
+        if self.g.is_parameter_only(d) && self.g.as_number(d).is_none() {
+            self.divisors.push((d, self.context.clone()));
+        }
+        true
+    }
+
     pub(super) fn scalar(&mut self, e: &Expr) -> Option<Id> {
         match self.eval(e)? {
             Val::Scalar(s) => Some(s),
@@ -113,6 +133,11 @@ impl Builder<'_> {
                     let (Some(x), Some(y)) = (self.eval(a), self.eval(b)) else {
                         return Ok(None);
                     };
+                    if let (BinOp::Div, Val::Scalar(d)) = (op, y) {
+                        if !self.divisor(d, b.span()) {
+                            return Ok(None);
+                        }
+                    }
                     return self.binary(*op, x, y, span);
                 }
                 Expr::Call(f, args, _) => return self.call(f, args, span),

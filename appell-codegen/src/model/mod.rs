@@ -285,6 +285,9 @@ pub struct Model {
     pub speed_specs: Vec<SpeedSpec>,
     /// The tokens of `speeds(...)`, for errors.
     pub speeds_at: proc_macro2::TokenStream,
+    /// Whether the model names its speeds (`speeds(...)` or joints); the
+    /// speeds stage says what to name when it does not.
+    pub speeds_declared: bool,
     /// Inputs: the declared ones, then the companions of the inputs that
     /// drive constraints (`{input}_rate`, and `{input}_accel` for a
     /// holonomic one).
@@ -320,6 +323,9 @@ pub struct Model {
     /// where it occurs, so that the generated code can name a zero-length
     /// one at run time.
     pub norms: Vec<(Id, String)>,
+    /// Every divisor made of parameters alone (`1 / k`), with where it
+    /// occurs, so that `validate` can name a zero one.
+    pub divisors: Vec<(Id, String)>,
     /// Frames oriented by a quaternion of coordinates: the indices (into
     /// `coords`) of its components, scalar first. The elimination solves
     /// their rates in closed form.

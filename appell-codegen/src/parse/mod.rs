@@ -191,6 +191,27 @@ fn add_joint_speeds(ast: &mut ModelAst) {
     }
 }
 
+/// An error at `parent` when it names no frame declared so far (N or a
+/// frame above), with the nearest names; `None` when it is one.
+pub(super) fn unknown_parent(ast: &ModelAst, parent: &Ident) -> Option<syn::Error> {
+    if *parent == "N" || ast.frames.iter().any(|f| f.name == *parent) {
+        return None;
+    }
+    let names: Vec<String> = ast
+        .frames
+        .iter()
+        .map(|f| f.name.to_string())
+        .chain(std::iter::once("N".to_string()))
+        .collect();
+    let hint = crate::ctxt::suggest(&parent.to_string(), names.iter().map(String::as_str))
+        .map(|s| format!("; did you mean `{s}`?"))
+        .unwrap_or_default();
+    Some(syn::Error::new(
+        parent.span(),
+        format!("unknown frame `{parent}`: a parent is N or a frame declared above{hint}"),
+    ))
+}
+
 /// Adds a joint's frames, points, coordinates, speeds, inputs, loads and
 /// constraints.
 pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
@@ -202,6 +223,11 @@ pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Re
             .find(|(f, _)| *f == joint.parent)
             .map(|(_, p)| Ident::new(&p.to_string(), joint.parent.span()))
     };
+    if parent_origin.is_none() && joint.at.is_none() {
+        if let Some(e) = unknown_parent(ast, &joint.parent) {
+            return Err(e);
+        }
+    }
     let lowered = joints::lower(joint, parent_origin)?;
     ast.joints.push(joint.clone());
     ast.origins

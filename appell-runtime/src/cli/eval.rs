@@ -100,6 +100,14 @@ impl EvalState {
         })
     }
 
+    /// The error for `eval --scene` (or `contacts --scene`) without a name.
+    pub(super) fn scene_name_missing(model: &dyn DynModel, command: &str) -> CliError {
+        CliError::Usage(format!(
+            "`{command} --scene` needs the name of a scene after it (`{command} --scene NAME`); the model's scenes: {}\n",
+            scene_names(model)
+        ))
+    }
+
     /// The state of an evaluator of the scene named `name`.
     pub(super) fn with_scene(model: &dyn DynModel, name: &str) -> Result<Self, CliError> {
         let scenes = model.dyn_scene_infos();
@@ -107,14 +115,9 @@ impl EvalState {
             .iter()
             .position(|s| s.name == name || s.name.rsplit("::").next() == Some(name))
             .ok_or_else(|| {
-                let names: Vec<&str> = scenes.iter().map(|s| s.name).collect();
                 CliError::Usage(format!(
                     "unknown scene `{name}`; the model's scenes: {}\n",
-                    if names.is_empty() {
-                        "none".to_string()
-                    } else {
-                        names.join(", ")
-                    }
+                    scene_names(model)
                 ))
             })?;
         let mut e = EvalState::new(model)?;
@@ -371,4 +374,14 @@ fn holonomic_warning(
         }
         _ => None,
     })
+}
+
+/// The model's scenes' names, comma-separated ("none" when it has none).
+fn scene_names(model: &dyn DynModel) -> String {
+    let names: Vec<&str> = model.dyn_scene_infos().iter().map(|s| s.name).collect();
+    if names.is_empty() {
+        "none".to_string()
+    } else {
+        names.join(", ")
+    }
 }

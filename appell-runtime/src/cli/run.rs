@@ -194,6 +194,11 @@ fn dispatch(
             return Ok(Dispatched::Done);
         }
     }
+    if let [command, flag] = rest {
+        if (command == "eval" || command == "contacts") && flag == "--scene" {
+            return Err(EvalState::scene_name_missing(model, command));
+        }
+    }
     let command = match rest {
         [] => return Ok(Dispatched::Default),
         [command] => command.as_str(),

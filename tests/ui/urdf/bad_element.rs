@@ -1,6 +1,6 @@
-//! trybuild compiles this case in `target/tests/trybuild/appell`, the
-//! directory a relative path starts from: the path climbs back to the
-//! workspace.
+//! A relative path is looked for from the crate's manifest directory,
+//! then from this file's directory, so the case passes wherever cargo
+//! puts its output.
 
 use appell::Appell;
 

@@ -259,6 +259,25 @@ fn masses(cx: &Ctxt, read: &Read, links: &[LinkNumbers], span: Span) -> Vec<bool
     out
 }
 
+/// The links' inertials checked when the joints do not make a tree, so
+/// that one build reports what is wrong with both; a number `parameters`
+/// names is promoted as [`lower`] would promote it.
+pub(super) fn check_links(cx: &Ctxt, read: &Read, spec: &Spec, span: Span) {
+    for l in &read.robot.links {
+        let name = super::tree::model_name(&l.name);
+        let promoted: Vec<String> = spec
+            .parameters
+            .iter()
+            .filter(|p| p.element == name)
+            .map(Promotion::field_text)
+            .collect();
+        if let Err(e) = is_body(&l.inertial, &promoted) {
+            let at = read.lines.describe("link", &l.name);
+            cx.error_at(span, format!("URDF {at}: {e}"));
+        }
+    }
+}
+
 /// Whether an inertial is a body's, its numbers checked where they are the
 /// file's (a parameter is checked by nobody at compile time).
 fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, String> {
@@ -355,10 +374,13 @@ fn root(ast: &mut ModelAst, tree: &Tree, spec: &Spec) -> syn::Result<()> {
         None => match ast.origins.iter().find(|(f, _)| *f == parent) {
             Some((_, p)) => p.clone(),
             None => {
+                if let Some(e) = crate::parse::unknown_parent(ast, &parent) {
+                    return Err(e);
+                }
                 return Err(syn::Error::new(
                     parent.span(),
                     format!("frame `{parent}` was not made by a joint, so it has no origin: give `at = P`, a point fixed in it, for the URDF's root link"),
-                ))
+                ));
             }
         },
     };

@@ -88,6 +88,7 @@ pub(super) fn add(
             for e in errors {
                 cx.error_at(span, e);
             }
+            lower::check_links(cx, &read, &spec, span);
             return Ok(());
         }
     };

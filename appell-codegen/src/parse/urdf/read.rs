@@ -61,11 +61,15 @@ pub(super) fn read(path: &Path) -> Result<Read, Vec<String>> {
             root.name
         )]);
     }
+    // Joints of unknown type and elements `urdf-rs` rejects are reported
+    // together, so one build shows every mistake of the file.
     let mut errors = joint_types(&root, &lines);
-    if errors.is_empty() {
-        match urdf_rs::read_from_string(&text) {
-            Ok(robot) => return Ok(Read { robot, lines }),
-            Err(whole) => errors = element_errors(&root, &lines, &whole.to_string()),
+    match urdf_rs::read_from_string(&text) {
+        Ok(robot) if errors.is_empty() => return Ok(Read { robot, lines }),
+        Ok(_) => {}
+        Err(whole) => {
+            let known = errors.is_empty();
+            errors.extend(element_errors(&root, &lines, &whole.to_string(), known));
         }
     }
     Err(errors)
@@ -148,15 +152,25 @@ fn joint_types(root: &xml::Element, lines: &Lines) -> Vec<String> {
 }
 
 /// When `urdf-rs` rejects the file: each top-level element read alone, and
-/// an error for each one it rejects; the whole file's error when none is
-/// rejected alone.
-fn element_errors(root: &xml::Element, lines: &Lines, whole: &str) -> Vec<String> {
+/// an error for each one it rejects (joints of unknown type left to
+/// [`joint_types`]); the whole file's error when none is rejected alone
+/// and `nothing_else` was found.
+fn element_errors(
+    root: &xml::Element,
+    lines: &Lines,
+    whole: &str,
+    nothing_else: bool,
+) -> Vec<String> {
     let mut errors = Vec::new();
     for node in &root.children {
         let xml::Xml::ElementNode(e) = node else {
             continue;
         };
         if !matches!(e.name.as_str(), "link" | "joint" | "material") {
+            continue;
+        }
+        let typed = e.get_attribute("type", None);
+        if e.name == "joint" && !typed.is_some_and(|t| JOINT_TYPES.contains(&t)) {
             continue;
         }
         let alone = format!("<robot name=\"alone\">{e}</robot>");
@@ -169,7 +183,7 @@ fn element_errors(root: &xml::Element, lines: &Lines, whole: &str) -> Vec<String
             ));
         }
     }
-    if errors.is_empty() {
+    if errors.is_empty() && nothing_else {
         errors.push(format!("the URDF cannot be read: {}", plain(whole)));
     }
     errors
