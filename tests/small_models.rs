@@ -328,7 +328,7 @@ fn a_zero_divisor_names_its_parameter() {
         place: "point `P`",
         parameters: &["stretch"],
     };
-    assert_eq!(broken.validate(), Err(zero.clone()));
+    assert_eq!(broken.validate(), Err(zero));
     assert_eq!(
         zero.to_string(),
         "division by zero in point `P`; check parameter `stretch`"
@@ -338,7 +338,7 @@ fn a_zero_divisor_names_its_parameter() {
     let mut d = [0.0; 2];
     assert_eq!(
         broken.rhs(&prepared, 0.0, &[0.3, 0.0], &[], &mut d),
-        Err(zero.clone())
+        Err(zero)
     );
     assert_eq!(
         Dop853::new()

@@ -31,6 +31,9 @@ pub struct Remainders {
     pub dependent: Vec<(Symbol, Id)>,
     /// The coordinates of `dependent`, in order.
     pub coordinates: Vec<usize>,
+    /// Which of `coordinates` are a quaternion's components: their terms
+    /// take ∂v/∂q̇_d from the velocity as given (see [`Self::of_velocity`]).
+    pub quaternion: Vec<bool>,
     /// Per body: α with ÿ = 0 in its frame (None for a particle).
     pub alphas: Vec<Option<Vec3>>,
 }
@@ -39,8 +42,14 @@ impl Remainders {
     /// The remainder of a velocity `v` (the twin's, when there is one).
     /// `parts`, when given, are the partial velocities ∂v/∂q̇_r already
     /// built for β̄ (the same values): the dependent rates' terms reuse
-    /// them. Left factored: a remainder enters f only through dot products
-    /// with the partial velocities.
+    /// them, except a quaternion's. The twin writes a quaternion frame's
+    /// direction cosines turning at ω = 2 G(e) ė, which equals the rate of
+    /// R(e) only where e · ė = 0; its ∂v/∂ė is that of the twin's own v
+    /// (G(e) e = 0), while R(e)'s is not, and the dependent rates' own
+    /// remainders r_d have a part along e (e · ë = −|ė|²). Mixing the two
+    /// would add a term along the body's offset times |ω|². Left factored:
+    /// a remainder enters f only through dot products with the partial
+    /// velocities.
     pub fn of_velocity(
         &self,
         g: &mut appell_symbolic::Graph,
@@ -55,10 +64,11 @@ impl Remainders {
             let along = g.time_derivative(v[i], &rates.along)?;
             let along = uncut.apply(g, along)?;
             let mut terms = vec![rates.fixed.apply(g, along)?];
-            for (&(rate, r), &d) in self.dependent.iter().zip(&self.coordinates) {
+            let dependent = self.dependent.iter().zip(&self.coordinates);
+            for ((&(rate, r), &d), &quaternion) in dependent.zip(&self.quaternion) {
                 let c = match parts {
-                    Some(p) => p[d][i],
-                    None => {
+                    Some(p) if !quaternion => p[d][i],
+                    _ => {
                         let c = g.diff(v[i], rate)?;
                         let c = uncut.apply(g, c)?;
                         rates.fixed.apply(g, c)?
@@ -84,6 +94,10 @@ pub fn remainders(
     rates: &mut Rates,
     calculus: &mut Calculus,
 ) -> Result<Remainders, SymbolicError> {
+    let quaternion = dependent
+        .iter()
+        .map(|d| model.quaternions.iter().any(|block| block.contains(d)))
+        .collect();
     let g = &mut model.g;
     let zero = g.int(0)?;
     let mut zero_accels = Substitution::new();
@@ -100,6 +114,7 @@ pub fn remainders(
         zero_accels,
         dependent: dependent_remainders,
         coordinates: dependent.to_vec(),
+        quaternion,
         alphas: Vec::new(),
     };
     for (bi, b) in model.bodies.iter().enumerate() {

@@ -144,6 +144,14 @@ impl Builder<'_> {
     /// at three pseudo-random configurations and rates (any failure to
     /// evaluate counts as not fixed).
     pub(super) fn fixed_in(&mut self, u: Vec3, rot: &Mat3) -> Result<bool, SymbolicError> {
+        // A quaternion frame's matrix is a rotation only for a unit
+        // quaternion turning tangentially (e · ė = 0): those values are
+        // drawn so, or an axis fixed in such a frame would look turning.
+        let blocks: Vec<[(Symbol, Symbol); 4]> = self
+            .quaternions
+            .iter()
+            .map(|b| b.map(|i| (self.coords[i].1.q, self.coords[i].1.rate)))
+            .collect();
         let g = &mut self.g;
         let local = mat_t_vec(g, rot, u)?;
         let rules = RateRules::coordinates();
@@ -159,7 +167,22 @@ impl Builder<'_> {
         roots.extend(local);
         let tape = appell_symbolic::Tape::new(g, &roots);
         for trial in 0..3u64 {
-            let env = |s: Symbol| Some(crate::probe::pseudo_value(g, s, trial));
+            let mut unit: Vec<(Symbol, f64)> = Vec::new();
+            for block in &blocks {
+                let e = block.map(|(q, _)| crate::probe::pseudo_value(g, q, trial));
+                let norm = e.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-3);
+                let e = e.map(|x| x / norm);
+                let de = block.map(|(_, r)| crate::probe::pseudo_value(g, r, trial));
+                let along: f64 = e.iter().zip(&de).map(|(a, b)| a * b).sum();
+                for k in 0..4 {
+                    unit.push((block[k].0, e[k]));
+                    unit.push((block[k].1, de[k] - along * e[k]));
+                }
+            }
+            let env = |s: Symbol| match unit.iter().find(|(u, _)| *u == s) {
+                Some((_, v)) => Some(*v),
+                None => Some(crate::probe::pseudo_value(g, s, trial)),
+            };
             let Ok(v) = tape.eval(&env) else {
                 return Ok(false);
             };
