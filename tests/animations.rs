@@ -270,3 +270,14 @@ fn every_animation_plays_in_chromium() {
         dir.display()
     );
 }
+
+#[test]
+fn a_repeated_key_in_an_animation_is_an_error() {
+    let problem = r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1, "t_end": 2}"#;
+    match animate(problem) {
+        Err(appell::cli::CliError::Animate(why)) => {
+            assert!(why.contains("duplicate key `t_end`"), "{why}")
+        }
+        other => panic!("{other:?}"),
+    }
+}

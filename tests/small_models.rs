@@ -372,3 +372,34 @@ fn the_command_line_refuses_parameters_that_make_a_body_impossible() {
         lines[1]
     );
 }
+
+/// The command line's answer to `lines` (one JSON object per line) under
+/// `command`, for the Cartesian pendulum (l = 0.8).
+fn pendulum_cli(command: &str, lines: &str) -> Vec<serde_json::Value> {
+    let p = CartesianPendulum {
+        m: 1.3,
+        l: 0.8,
+        g: 9.81,
+    };
+    let args: Vec<String> = ["pendulum", command]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut out = Vec::new();
+    appell::cli::run_with(p, &args, &mut lines.as_bytes(), &mut out, |_| Ok(())).unwrap();
+    String::from_utf8(out)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+#[test]
+fn a_repeated_key_is_an_error_not_the_last_value() {
+    let answers = pendulum_cli(
+        "eval",
+        "{\"q\": {\"x\": 0.48, \"x\": 0.2}, \"u\": {\"x\": 0.1}}\n",
+    );
+    let error = answers[0]["error"].as_str().unwrap();
+    assert!(error.contains("duplicate key `x`"), "{error}");
+}

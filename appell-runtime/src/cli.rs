@@ -50,8 +50,9 @@
 //! * `inputs`: inputs by name; omitted ones are 0.
 //! * `t`: the time; 0 when omitted.
 //!
-//! Unknown fields or names, missing values, values that are not finite
-//! numbers, malformed JSON and any [`ModelError`] (for example a singular
+//! Unknown fields or names, a key given twice in one object (serde_json
+//! would keep the last silently), missing values, values that are not
+//! finite numbers, malformed JSON and any [`ModelError`] (for example a singular
 //! configuration) answer that line with `{"error": "..."}`; evaluation goes on
 //! with the next line. A good line is answered with
 //!
@@ -156,6 +157,7 @@ mod error;
 mod eval;
 mod info;
 mod input;
+mod json;
 mod output;
 mod run;
 mod sweep;

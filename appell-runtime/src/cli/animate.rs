@@ -3,6 +3,7 @@
 
 use super::eval::EvalState;
 use super::input::number;
+use super::json::parse_object;
 use crate::animate::{simulate, svg, SvgOptions, View};
 use crate::dynamic::DynModel;
 use serde_json::{Map, Value};
@@ -27,10 +28,7 @@ const FIELDS: [&str; 12] = [
 /// options, see the module documentation), simulates it and returns the
 /// SVG, or why it could not.
 pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<String, String> {
-    let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
-    let Value::Object(obj) = value else {
-        return Err("expected a JSON object".to_string());
-    };
+    let obj = parse_object(text)?;
     let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let point = evaluator.parse_point(model, &obj, &FIELDS)?;
     let t_end = match obj.get("t_end") {

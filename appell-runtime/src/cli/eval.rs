@@ -3,6 +3,7 @@
 
 use super::error::CliError;
 use super::input::{named, number, Point};
+use super::json::parse_object;
 use super::output::{contact_forces_json, finite_or_null, result_number};
 use crate::dynamic::DynModel;
 use crate::model::{Model, ModelError, ModelInfo};
@@ -146,11 +147,7 @@ impl EvalState {
 
     fn try_eval(&self, model: &mut dyn DynModel, line: &str) -> Result<Value, String> {
         let info = self.info(model);
-        let value: Value =
-            serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
-        let Value::Object(obj) = value else {
-            return Err("expected a JSON object".to_string());
-        };
+        let obj = parse_object(line)?;
         let point = self.parse_point(model, &obj, &[])?;
         let model: &dyn DynModel = model;
         let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);

@@ -2,6 +2,7 @@
 
 use super::eval::EvalState;
 use super::input::{number, Point};
+use super::json::parse_object;
 use super::output::finite_or_null;
 use crate::accuracy::{standard_methods, Run};
 use crate::dynamic::{DynModel, DynRhs};
@@ -28,10 +29,7 @@ pub fn accuracy<M: Model>(mut model: M, text: &str) -> Result<Value, String> {
 
 /// [`accuracy()`] of any [`DynModel`], compiled once.
 pub(super) fn accuracy_dyn(model: &mut dyn DynModel, text: &str) -> Result<Value, String> {
-    let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
-    let Value::Object(obj) = value else {
-        return Err("expected a JSON object".to_string());
-    };
+    let obj = parse_object(text)?;
     let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let extra = ["t_end", "checkpoints", "levels", "repeats"];
     let point = evaluator.parse_point(model, &obj, &extra)?;
