@@ -155,6 +155,7 @@ mod animate;
 mod bench;
 mod error;
 mod eval;
+mod holonomic;
 mod info;
 mod input;
 mod json;

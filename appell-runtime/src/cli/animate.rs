@@ -24,10 +24,17 @@ const FIELDS: [&str; 12] = [
     "dots",
 ];
 
+/// A picture, and what `animate` did to the state it was given (the
+/// coordinates it solved, a warning), as lines for stderr.
+pub(super) struct Animated {
+    pub(super) svg: String,
+    pub(super) notes: Vec<String>,
+}
+
 /// Parses one problem (an `eval` state plus `t_end` and the picture's
 /// options, see the module documentation), simulates it and returns the
 /// SVG, or why it could not.
-pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<String, String> {
+pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<Animated, String> {
     let obj = parse_object(text)?;
     let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let point = evaluator.parse_point(model, &obj, &FIELDS)?;
@@ -50,7 +57,18 @@ pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<String
         frames,
     )
     .map_err(|e| format!("the simulation stopped: {e}"))?;
-    svg(&*model, &motion, &options).map_err(|e| e.to_string())
+    let notes = point.filled.lines();
+    let mut picture = svg(&*model, &motion, &options).map_err(|e| e.to_string())?;
+    // The notes go into the picture too, so that a saved SVG records the
+    // state it started from; `--` may not appear in an XML comment.
+    if let Some(end) = picture.find('>').filter(|_| !notes.is_empty()) {
+        let comment = format!("\n<!-- {} -->", notes.join("; ").replace("--", "- -"));
+        picture.insert_str(end + 1, &comment);
+    }
+    Ok(Animated {
+        svg: picture,
+        notes,
+    })
 }
 
 /// An integer field from 1 to `max`, `default` when absent.

@@ -262,8 +262,11 @@ fn dispatch(
             let mut text = String::new();
             stdin.read_to_string(&mut text)?;
             match animate_dyn(model, &text) {
-                Ok(picture) => {
-                    write!(stdout, "{picture}")?;
+                Ok(animated) => {
+                    for note in &animated.notes {
+                        eprintln!("animate: {note}");
+                    }
+                    write!(stdout, "{}", animated.svg)?;
                     stdout.flush()?;
                 }
                 Err(why) => return Err(CliError::Animate(why)),

@@ -68,7 +68,12 @@ pub(super) fn accuracy_dyn(model: &mut dyn DynModel, text: &str) -> Result<Value
             }
         };
     }
-    sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+    let mut report = sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)?;
+    // What was solved, and whether the start is off the constraints.
+    if let Value::Object(fields) = &mut report {
+        fields.extend(point.filled.notes());
+    }
+    Ok(report)
 }
 
 fn sweep_report<const S: usize>(
