@@ -160,6 +160,7 @@ mod info;
 mod input;
 mod json;
 mod output;
+mod progress;
 mod run;
 mod sweep;
 

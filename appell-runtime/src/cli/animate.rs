@@ -4,13 +4,24 @@
 use super::eval::EvalState;
 use super::input::number;
 use super::json::parse_object;
-use crate::animate::{simulate, svg, SvgOptions, View};
+use super::progress::Bar;
+use crate::animate::{simulate_with_progress, steps_needed, svg, SvgOptions, View, MAX_STEP};
 use crate::dynamic::DynModel;
 use serde_json::{Map, Value};
+use std::io::Write;
+
+/// The RK4 steps an `animate` problem may take unless its `max_steps`
+/// says otherwise: 2000 s of motion at the 1 ms step, seconds to a few
+/// minutes of computing for the models of the examples.
+pub(super) const DEFAULT_MAX_STEPS: u64 = 2_000_000;
+
+/// Runs of at least this many steps show a progress bar (on a terminal).
+const PROGRESS_STEPS: f64 = 100_000.0;
 
 /// The fields an `animate` problem may add to an `eval` state.
-const FIELDS: [&str; 12] = [
+const FIELDS: [&str; 13] = [
     "t_end",
+    "max_steps",
     "frames",
     "playback",
     "width",
@@ -33,8 +44,13 @@ pub(super) struct Animated {
 
 /// Parses one problem (an `eval` state plus `t_end` and the picture's
 /// options, see the module documentation), simulates it and returns the
-/// SVG, or why it could not.
-pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<Animated, String> {
+/// SVG, or why it could not. A run of many steps draws a progress bar on
+/// `terminal` when there is one.
+pub(super) fn animate_dyn(
+    model: &mut dyn DynModel,
+    text: &str,
+    terminal: Option<&mut dyn Write>,
+) -> Result<Animated, String> {
     let obj = parse_object(text)?;
     let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let point = evaluator.parse_point(model, &obj, &FIELDS)?;
@@ -46,8 +62,13 @@ pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<Animat
         return Err(format!("`t_end` ({t_end}) must be after `t` ({})", point.t));
     }
     let frames = count(&obj, "frames", 200, 10_000)?;
+    let steps = steps_needed(point.t, t_end, frames);
+    check_budget(&obj, point.t, t_end, steps)?;
     let options = options(model, &obj)?;
-    let motion = simulate(
+    let mut bar = terminal
+        .filter(|_| steps >= PROGRESS_STEPS)
+        .map(|out| Bar::new(out, "animate", frames));
+    let motion = simulate_with_progress(
         &*model,
         point.t,
         &point.q,
@@ -55,6 +76,11 @@ pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<Animat
         &point.inputs,
         t_end,
         frames,
+        &mut |done, _| {
+            if let Some(bar) = bar.as_mut() {
+                bar.set(done);
+            }
+        },
     )
     .map_err(|e| format!("the simulation stopped: {e}"))?;
     let notes = point.filled.lines();
@@ -69,6 +95,26 @@ pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<Animat
         svg: picture,
         notes,
     })
+}
+
+/// The step budget: `max_steps` (an integer of at least 1) or
+/// [`DEFAULT_MAX_STEPS`]; a run that needs more is an error saying how
+/// many steps it needs and what to change.
+fn check_budget(obj: &Map<String, Value>, t: f64, t_end: f64, steps: f64) -> Result<(), String> {
+    let (budget, whose) = match obj.get("max_steps") {
+        None => (DEFAULT_MAX_STEPS, "the default"),
+        Some(v) => match v.as_u64() {
+            Some(n) if n >= 1 => (n, "`max_steps`"),
+            _ => return Err(format!("`max_steps` must be a positive integer, found {v}")),
+        },
+    };
+    if steps <= budget as f64 {
+        return Ok(());
+    }
+    Err(format!(
+        "the motion from t = {t} to t_end = {t_end} needs {steps:.0} RK4 steps (at most {MAX_STEP} s each), more than the budget of {budget} ({whose}): shorten `t_end` (about {:.0} s of motion fit) or raise `max_steps` to at least {steps:.0} if the wait is worth it",
+        budget as f64 * MAX_STEP
+    ))
 }
 
 /// An integer field from 1 to `max`, `default` when absent.
