@@ -22,7 +22,9 @@ pub const ACCURACY_MAX_STATE: usize = 16;
 /// The report: `{"t_end", "checkpoints", "reference_error", "points": [{"method",
 /// "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}, ..]}`
 /// with the fields of [`crate::accuracy::Point`]; methods that fail (a
-/// step-size underflow, say) are left out.
+/// step-size underflow, say) are left out. Coordinates solved from the
+/// holonomic constraints add `"solved"` and `"residual"`, a start off them
+/// `"warning"`, as `eval` answers (see [the module](super)).
 pub fn accuracy<M: Model>(mut model: M, text: &str) -> Result<Value, String> {
     accuracy_dyn(&mut model, text)
 }
