@@ -270,3 +270,61 @@ fn every_animation_plays_in_chromium() {
         dir.display()
     );
 }
+
+#[test]
+fn a_long_animation_is_refused_before_it_starts_unless_its_budget_is_raised() {
+    // A billion seconds would be 10¹² steps: refused at once, saying how
+    // many steps it needs and what to change.
+    let huge = r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1e9}"#;
+    match animate(huge) {
+        Err(appell::cli::CliError::Animate(why)) => {
+            assert!(
+                why.contains("needs 1000000000000 RK4 steps")
+                    && why.contains("the budget of 2000000 (the default)")
+                    && why.contains("shorten `t_end`")
+                    && why.contains("raise `max_steps`"),
+                "{why}"
+            );
+        }
+        other => panic!("{other:?}"),
+    }
+    // 2 s in 20 frames is 2000 steps: over a budget of 1999, within 2000.
+    let problem = |max_steps: &str| {
+        format!(
+            r#"{{"q": {{"a": -1, "b": 0}}, "u": {{"a": 0, "b": 0}}, "t_end": 2, "frames": 20, "max_steps": {max_steps}}}"#
+        )
+    };
+    match animate(&problem("1999")) {
+        Err(appell::cli::CliError::Animate(why)) => {
+            assert!(
+                why.contains("needs 2000 RK4 steps") && why.contains("(`max_steps`)"),
+                "{why}"
+            )
+        }
+        other => panic!("{other:?}"),
+    }
+    assert!(animate(&problem("2000")).unwrap().starts_with("<svg"));
+    for bad in ["0", "-3", "1.5", "\"many\""] {
+        match animate(&problem(bad)) {
+            Err(appell::cli::CliError::Animate(why)) => {
+                assert!(
+                    why.contains("`max_steps` must be a positive integer"),
+                    "{why}"
+                )
+            }
+            other => panic!("{bad}: {other:?}"),
+        }
+    }
+    assert_eq!(appell::animate::steps_needed(0.0, 2.0, 20), 2000.0);
+}
+
+#[test]
+fn a_repeated_key_in_an_animation_is_an_error() {
+    let problem = r#"{"q": {"a": 0, "b": 0}, "u": {"a": 0, "b": 0}, "t_end": 1, "t_end": 2}"#;
+    match animate(problem) {
+        Err(appell::cli::CliError::Animate(why)) => {
+            assert!(why.contains("duplicate key `t_end`"), "{why}")
+        }
+        other => panic!("{other:?}"),
+    }
+}

@@ -372,3 +372,169 @@ fn the_command_line_refuses_parameters_that_make_a_body_impossible() {
         lines[1]
     );
 }
+
+/// The command line's answer to `lines` (one JSON object per line) under
+/// `command`, for the Cartesian pendulum (l = 0.8).
+fn pendulum_cli(command: &str, lines: &str) -> Vec<serde_json::Value> {
+    let p = CartesianPendulum {
+        m: 1.3,
+        l: 0.8,
+        g: 9.81,
+    };
+    let args: Vec<String> = ["pendulum", command]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut out = Vec::new();
+    appell::cli::run_with(p, &args, &mut lines.as_bytes(), &mut out, |_| Ok(())).unwrap();
+    String::from_utf8(out)
+        .unwrap()
+        .lines()
+        .map(|l| serde_json::from_str(l).unwrap())
+        .collect()
+}
+
+#[test]
+fn the_command_line_solves_a_coordinate_the_constraint_fixes() {
+    // y is left out: x² + y² = l² fixes it (flat at y = 0, so Newton starts
+    // from the second guess and finds the upper branch, which is reported).
+    let answers = pendulum_cli(
+        "eval",
+        "{\"q\": {\"x\": 0.48}, \"u\": {\"x\": 0.1}}\n{\"u\": {\"x\": 0.1}}\n",
+    );
+    let solved = &answers[0];
+    let y = solved["solved"]["y"].as_f64().expect("y solved");
+    assert!((y.abs() - 0.64).abs() < 1e-12, "{solved}");
+    let residual = solved["residual"].as_f64().unwrap();
+    assert!(residual.abs() < 1e-12, "{solved}");
+    assert!(solved.get("warning").is_none(), "{solved}");
+    // On the circle, ẏ = −x ẋ / y.
+    let ydot = solved["qdot"]["y"].as_f64().unwrap();
+    assert!((ydot + 0.48 * 0.1 / y).abs() < 1e-12, "{solved}");
+    // x is not fixed by the constraint (it is the independent coordinate).
+    let missing = answers[1]["error"].as_str().unwrap();
+    assert!(
+        missing.contains("missing coordinate `x` in `q` (the holonomic constraints do not fix it)"),
+        "{missing}"
+    );
+}
+
+#[test]
+fn contacts_warns_of_a_state_off_the_constraint_as_eval_does() {
+    let off = "{\"q\": {\"x\": 0.48, \"y\": -0.7}, \"u\": {\"x\": 0.1}}\n";
+    let on = "{\"q\": {\"x\": 0.48, \"y\": -0.64}, \"u\": {\"x\": 0.1}}\n";
+    for command in ["eval", "contacts"] {
+        let answers = pendulum_cli(command, &format!("{off}{on}"));
+        let message = answers[0]["warning"]["message"].as_str().unwrap_or("");
+        assert!(
+            message.contains("violate holonomic constraint 0"),
+            "{command}: {}",
+            answers[0]
+        );
+        let residual = answers[0]["warning"]["holonomic_residuals"][0]
+            .as_f64()
+            .unwrap();
+        assert!(
+            (residual - (0.48f64.powi(2) + 0.49 - 0.64)).abs() < 1e-12,
+            "{residual}"
+        );
+        assert!(
+            answers[1].get("warning").is_none(),
+            "{command}: {}",
+            answers[1]
+        );
+        assert!(
+            answers[1].get("error").is_none(),
+            "{command}: {}",
+            answers[1]
+        );
+    }
+    // The contacts answer still carries the forces.
+    let answers = pendulum_cli("contacts", off);
+    assert!(answers[0]["multipliers"].is_array(), "{}", answers[0]);
+}
+
+#[test]
+fn a_repeated_key_is_an_error_not_the_last_value() {
+    let answers = pendulum_cli(
+        "eval",
+        "{\"q\": {\"x\": 0.48, \"x\": 0.2}, \"u\": {\"x\": 0.1}}\n",
+    );
+    let error = answers[0]["error"].as_str().unwrap();
+    assert!(error.contains("duplicate key `x`"), "{error}");
+}
+
+/// `accuracy` or `animate` of one problem: stdout, or the error.
+fn pendulum_problem(command: &str, problem: &str) -> Result<String, appell::cli::CliError> {
+    let p = CartesianPendulum {
+        m: 1.3,
+        l: 0.8,
+        g: 9.81,
+    };
+    let args: Vec<String> = ["pendulum", command]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut out = Vec::new();
+    appell::cli::run_with(p, &args, &mut problem.as_bytes(), &mut out, |_| Ok(()))?;
+    Ok(String::from_utf8(out).unwrap())
+}
+
+#[test]
+fn accuracy_reports_what_it_solved_and_warns_off_the_constraint() {
+    let settings = "\"t_end\": 0.2, \"checkpoints\": 2, \"levels\": 1, \"repeats\": 1";
+    let solved: serde_json::Value = serde_json::from_str(
+        &pendulum_problem(
+            "accuracy",
+            &format!("{{\"q\": {{\"x\": 0.48}}, \"u\": {{\"x\": 0.1}}, {settings}}}"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let y = solved["solved"]["y"].as_f64().expect("y solved");
+    assert!((y.abs() - 0.64).abs() < 1e-12, "{solved}");
+    assert!(solved.get("warning").is_none(), "{solved}");
+    assert!(!solved["points"].as_array().unwrap().is_empty(), "{solved}");
+    let off: serde_json::Value = serde_json::from_str(
+        &pendulum_problem(
+            "accuracy",
+            &format!("{{\"q\": {{\"x\": 0.48, \"y\": -0.7}}, \"u\": {{\"x\": 0.1}}, {settings}}}"),
+        )
+        .unwrap(),
+    )
+    .unwrap();
+    let message = off["warning"]["message"].as_str().unwrap_or("");
+    assert!(message.contains("violate holonomic constraint 0"), "{off}");
+}
+
+#[test]
+fn animate_records_what_it_solved_and_warns_off_the_constraint() {
+    let picture = pendulum_problem(
+        "animate",
+        "{\"q\": {\"x\": 0.48}, \"u\": {\"x\": 0.1}, \"t_end\": 0.1, \"frames\": 4}",
+    )
+    .unwrap();
+    assert!(picture.starts_with("<svg"), "{}", &picture[..200]);
+    assert!(
+        picture.contains("<!-- solved from the holonomic constraints: y = "),
+        "{}",
+        &picture[..400]
+    );
+    let off = pendulum_problem(
+        "animate",
+        "{\"q\": {\"x\": 0.48, \"y\": -0.7}, \"u\": {\"x\": 0.1}, \"t_end\": 0.1, \"frames\": 4}",
+    )
+    .unwrap();
+    assert!(
+        off.contains("warning: the coordinates violate holonomic constraint 0"),
+        "{}",
+        &off[..400]
+    );
+    // Given on the constraint, there is nothing to say.
+    let on = pendulum_problem(
+        "animate",
+        "{\"q\": {\"x\": 0.48, \"y\": -0.64}, \"u\": {\"x\": 0.1}, \"t_end\": 0.1, \"frames\": 4}",
+    )
+    .unwrap();
+    assert!(!on.contains("<!--"), "{}", &on[..400]);
+}

@@ -246,3 +246,66 @@ fn eval_warns_of_a_state_off_the_holonomic_constraint() {
     let message = off["warning"]["message"].as_str().unwrap();
     assert!(message.contains("holonomic constraint 0"), "{message}");
 }
+
+#[test]
+fn eval_and_contacts_solve_the_pitch_when_it_is_left_out() {
+    // q5 (the pitch) is retained but fixed by the holonomic constraint:
+    // left out, it is solved (and reported), and the answer is the one for
+    // the pitch given on the constraint.
+    let p = WhippleBicycle::default();
+    let q = whipple_bicycle::operating_point(&p).unwrap();
+    let run = |command: &str, pitch: Option<f64>| -> serde_json::Value {
+        let pitch = pitch.map_or(String::new(), |x| format!(", \"q5\": {x}"));
+        let line = format!(
+            r#"{{"q": {{"q2": 0.1, "q3": 0.2, "q4": 0.0, "q7": 0.0{pitch}}}, "u": {{"q4": 0.1, "q6": -10.0, "q7": 0.2}}}}"#
+        );
+        let mut out = Vec::new();
+        appell::cli::run_with(
+            p.clone(),
+            &["whipple".to_string(), command.to_string()],
+            &mut line.as_bytes(),
+            &mut out,
+            |_| Ok(()),
+        )
+        .unwrap();
+        serde_json::from_slice(&out).unwrap()
+    };
+    for command in ["eval", "contacts"] {
+        let solved = run(command, None);
+        let pitch = solved["solved"]["q5"].as_f64().expect("the pitch solved");
+        assert!((pitch - q[4]).abs() < 1e-12, "{command}: {solved}");
+        assert!(
+            solved["residual"].as_f64().unwrap().abs() < 1e-12,
+            "{solved}"
+        );
+        assert!(solved.get("warning").is_none(), "{solved}");
+        let mut given = run(command, Some(pitch));
+        assert!(given.get("solved").is_none(), "{given}");
+        let mut solved = solved;
+        for key in ["solved", "residual"] {
+            solved.as_object_mut().unwrap().remove(key);
+            given.as_object_mut().unwrap().remove(key);
+        }
+        assert_eq!(solved, given, "{command}");
+    }
+}
+
+#[test]
+fn a_retained_coordinate_the_constraints_do_not_fix_is_still_required() {
+    let line = r#"{"q": {"q5": 0.3, "q7": 0.0}, "u": {"q4": 0.1, "q6": -10.0, "q7": 0.2}}"#;
+    let mut out = Vec::new();
+    appell::cli::run_with(
+        WhippleBicycle::default(),
+        &["whipple".to_string(), "eval".to_string()],
+        &mut line.as_bytes(),
+        &mut out,
+        |_| Ok(()),
+    )
+    .unwrap();
+    let answer: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    let error = answer["error"].as_str().unwrap();
+    assert_eq!(
+        error,
+        "missing coordinate `q4` in `q` (the holonomic constraints do not fix it)"
+    );
+}

@@ -81,14 +81,23 @@ pub struct Frame {
 /// The largest step [`simulate`] takes.
 pub const MAX_STEP: f64 = 1e-3;
 
+/// How many RK4 steps [`simulate`] takes from `t0` to `t_end` in `frames`
+/// frames: whole steps of at most [`MAX_STEP`] per frame, at least one.
+/// A float, so that a huge span is counted without overflow (to check it
+/// against a budget before starting).
+pub fn steps_needed(t0: f64, t_end: f64, frames: usize) -> f64 {
+    let per_frame = (t_end - t0) / frames as f64;
+    frames as f64 * (per_frame / MAX_STEP).ceil().max(1.0)
+}
+
 /// Simulates the model from every coordinate `q0` and the privileged
 /// speeds `u0`, with `inputs` held, from `t0` to `t_end`, and returns
 /// `frames + 1` frames evenly spaced in time (the first at `t0`).
 ///
 /// Fourth-order Runge–Kutta on the full coordinates (q̇ from
 /// [`Model::coordinate_rates`](crate::Model::coordinate_rates), u̇ from [`Model::rhs`](crate::Model::rhs)), at most
-/// [`MAX_STEP`] per step: accurate enough for a picture, not a reference
-/// (use the adaptive integrators for that).
+/// [`MAX_STEP`] per step ([`steps_needed`] steps in all): accurate enough
+/// for a picture, not a reference (use the adaptive integrators for that).
 ///
 /// Errors: wrong lengths, `frames == 0`, a non-finite argument or
 /// `t_end <= t0` (as [`ModelError::NonFinite`] naming it), and any error of
@@ -101,6 +110,22 @@ pub fn simulate<K: DynModel + ?Sized>(
     inputs: &[f64],
     t_end: f64,
     frames: usize,
+) -> Result<Vec<Frame>, ModelError> {
+    simulate_with_progress(model, t0, q0, u0, inputs, t_end, frames, &mut |_, _| {})
+}
+
+/// [`simulate`], calling `progress(done, frames)` after each frame (for a
+/// progress bar on a long run).
+#[allow(clippy::too_many_arguments)]
+pub fn simulate_with_progress<K: DynModel + ?Sized>(
+    model: &K,
+    t0: f64,
+    q0: &[f64],
+    u0: &[f64],
+    inputs: &[f64],
+    t_end: f64,
+    frames: usize,
+    progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Frame>, ModelError> {
     let info = model.dyn_info();
     let (n, l) = (info.coordinates.len(), info.speeds.len());
@@ -137,6 +162,7 @@ pub fn simulate<K: DynModel + ?Sized>(
             t: t0 + (k + 1) as f64 * per_frame,
             q: x[..n].to_vec(),
         });
+        progress(k + 1, frames);
     }
     Ok(out)
 }

@@ -39,10 +39,16 @@
 //! {"t": 0.0, "params": {"a": 0.3}, "q": {"phi": 0.2, "x": 1.0}, "u": {"phi": 0.1}, "inputs": {"tau": 0.5}}
 //! ```
 //!
-//! * `q`: coordinates by name. Every [retained](ModelInfo::retained)
-//!   coordinate is required; the others default to 0 (their values do not
-//!   enter the reduced equations but are passed to
-//!   [`Model::coordinate_rates`]).
+//! * `q`: coordinates by name. A [dependent](ModelInfo::dependent)
+//!   coordinate left out that a holonomic constraint involves (a bicycle's
+//!   pitch) is solved from the constraints, the others held: Newton's
+//!   method from 0 (from 0.3 when that fails), to a residual of at most
+//!   1e-12 × (1 + max |q|); the answer then carries `"solved": {name:
+//!   value}` and `"residual"` (the largest |residual| of the constraints
+//!   solved), so that a wrong branch shows. Every other
+//!   [retained](ModelInfo::retained) coordinate is required; the rest
+//!   default to 0 (their values do not enter the reduced equations but are
+//!   passed to [`Model::coordinate_rates`]).
 //! * `u`: the privileged speeds, keyed by their coordinate's name
 //!   ([`ModelInfo::speeds`]); all are required.
 //! * `params`: parameters by name; omitted ones keep the model's values (the
@@ -50,8 +56,10 @@
 //! * `inputs`: inputs by name; omitted ones are 0.
 //! * `t`: the time; 0 when omitted.
 //!
-//! Unknown fields or names, missing values, values that are not finite
-//! numbers, malformed JSON and any [`ModelError`] (for example a singular
+//! Unknown fields or names, a key given twice in one object (serde_json
+//! would keep the last silently), missing values, values that are not
+//! finite numbers, malformed JSON, constraints that cannot be solved for
+//! the coordinates left out, and any [`ModelError`] (for example a singular
 //! configuration) answer that line with `{"error": "..."}`; evaluation goes on
 //! with the next line. A good line is answered with
 //!
@@ -60,10 +68,13 @@
 //! ```
 //!
 //! where `qdot` comes from [`Model::coordinate_rates`] and `udot` from
-//! [`Model::rhs`] (after [`Model::prepare`]). When `q` is off a holonomic
+//! [`Model::rhs`] (after [`Model::prepare`]), plus `"solved"` and
+//! `"residual"` when coordinates were solved. When `q` is off a holonomic
 //! constraint by more than 1e-9 × (1 + max |q|), the answer also carries
 //! `"warning": {"message": "...", "holonomic_residuals": [..]}`: the rates
-//! are still computed, but for a state the mechanism cannot take.
+//! are still computed, but for a state the mechanism cannot take. Every
+//! action that reads a state (`eval`, `contacts`, `accuracy`, `animate`)
+//! reads `q` this way and gives these notes.
 //!
 //! With `--scene NAME` the scene's reduced equations answer, and the
 //! outputs its `outputs(...)` asked for are added: `"energies"`
@@ -73,7 +84,8 @@
 //!
 //! # `contacts`
 //!
-//! The same input lines, answered by [`crate::constraint_forces`]:
+//! The same input lines (coordinates solved and the warning as for
+//! `eval`), answered by [`crate::constraint_forces`]:
 //!
 //! ```text
 //! {"multipliers": [λ..], "rows": [{"source": "rolls at P, N.x", "multiplier": λ}, ..],
@@ -83,7 +95,8 @@
 //!                "friction": {"mu": μ} or {"lift_off": N} or {"unavailable": ".."}}]}
 //! ```
 //!
-//! Forces are on the body, from the ground, in N components.
+//! Forces are on the body, from the ground, in N components. `"solved"`,
+//! `"residual"` and `"warning"` are added as in `eval`.
 //!
 //! # `info`
 //!
@@ -111,7 +124,8 @@
 //!
 //! Reads one JSON object from stdin: an `eval` state (`t` must be 0 or
 //! omitted) plus `t_end` (the horizon, required), `checkpoints` (default
-//! 10), `levels` (default 4) and `repeats` (default 3), for example
+//! 10, at most 1000), `levels` (default 4, at most 10) and `repeats`
+//! (default 3, at most 100), for example
 //!
 //! ```text
 //! {"q": {"phi": 0.3}, "u": {"phi": 0.2, "psi1": 1.0}, "inputs": {"tau": 0.4}, "t_end": 10}
@@ -120,31 +134,45 @@
 //! and prints what accuracy costs on that problem: every integrator of
 //! [`crate::accuracy::standard_methods`] against a DOP853 reference, as
 //! `{"t_end", "checkpoints", "reference_error", "points": [{"method",
-//! "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}]}`.
-//! A problem it cannot run is answered with `{"error": ".."}` and exit
-//! status 1. States up to [`ACCURACY_MAX_STATE`] entries. See [`accuracy()`].
-
+//! "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}]}`,
+//! plus `"solved"`, `"residual"` and `"warning"` as in `eval`. A problem it
+//! cannot run is answered with `{"error": ".."}` on stdout and exit status
+//! 1 (there is only the one problem to go on with). States up to
+//! [`ACCURACY_MAX_STATE`] entries. See [`accuracy()`].
+//!
 //! # `animate`
 //!
 //! Reads one JSON object from stdin: an `eval` state plus `t_end` (when the
-//! motion ends, required) and, optionally, `frames` (default 200),
-//! `playback` (seconds of motion per second, default 1), `width` and
-//! `height` (default 640 × 480), `title` (default the model's name), `view`
-//! (`"auto"`, `"oblique"`, `"x"`, `"y"` or `"z"`: looking along N's axis),
-//! `up` (three numbers, for the oblique view), `follow` (keep the bodies
-//! in the middle), `connectors` (pairs of body names, `"O"` for the
+//! motion ends, required) and, optionally, `frames` (default 200, at most
+//! 10000: the picture has `frames + 1` of them, the first at `t`),
+//! `max_steps` (the step budget, default 2000000, see below), `playback`
+//! (seconds of motion per second, default 1), `width` and `height`
+//! (default 640 × 480, each at most 4096), `title` (default the model's
+//! name), `view` (`"auto"`, the default, `"oblique"`, `"x"`, `"y"` or
+//! `"z"`: looking along N's axis), `up` (three numbers, for the oblique
+//! view, default `[0, 0, 1]`), `follow` (keep the bodies in the middle,
+//! default `false`), `connectors` (pairs of body names, `"O"` for the
 //! origin: lines drawn between them), `traces` and `dots` (body names: a
-//! centre's path drawn; a body drawn as a dot), for example
+//! centre's path drawn; a body drawn as a dot; default none), for example
 //!
 //! ```text
 //! {"q": {"phi": 0.3}, "u": {"phi": 0.2, "psi1": 1.0}, "inputs": {"tau": 0.4}, "t_end": 5, "view": "z"}
 //! ```
 //!
 //! simulates it ([`crate::animate::simulate`]: RK4 on every coordinate) and
-//! prints the SVG ([`crate::animate::svg`]). Every coordinate is taken from
-//! `q` as given (0 when omitted): give dependent coordinates on their
-//! constraints. A problem it cannot run is reported on stderr with exit
-//! status 1 and nothing on stdout.
+//! prints the SVG ([`crate::animate::svg`]). `q` is read as for `eval`:
+//! the coordinates the holonomic constraints fix may be left out and are
+//! solved; what was solved and the warning for a state off the constraints
+//! go to stderr and into an XML comment at the top of the SVG.
+//!
+//! The simulation takes [`crate::animate::steps_needed`] steps (about
+//! (t_end − t) / 1 ms); a problem that needs more than `max_steps` is
+//! refused before it starts, with the number of steps it needs, so that a
+//! huge `t_end` is not hours of silent computing. Runs of 100000 steps or
+//! more draw a progress bar on stderr when stderr is a terminal.
+//!
+//! A problem it cannot run is reported on stderr with exit status 1 and
+//! nothing on stdout (which is the picture).
 
 // Items the documentation links to.
 #[cfg(doc)]
@@ -154,9 +182,12 @@ mod animate;
 mod bench;
 mod error;
 mod eval;
+mod holonomic;
 mod info;
 mod input;
+mod json;
 mod output;
+mod progress;
 mod run;
 mod sweep;
 

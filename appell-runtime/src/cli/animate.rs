@@ -3,13 +3,25 @@
 
 use super::eval::EvalState;
 use super::input::number;
-use crate::animate::{simulate, svg, SvgOptions, View};
+use super::json::parse_object;
+use super::progress::Bar;
+use crate::animate::{simulate_with_progress, steps_needed, svg, SvgOptions, View, MAX_STEP};
 use crate::dynamic::DynModel;
 use serde_json::{Map, Value};
+use std::io::Write;
+
+/// The RK4 steps an `animate` problem may take unless its `max_steps`
+/// says otherwise: 2000 s of motion at the 1 ms step, seconds to a few
+/// minutes of computing for the models of the examples.
+pub(super) const DEFAULT_MAX_STEPS: u64 = 2_000_000;
+
+/// Runs of at least this many steps show a progress bar (on a terminal).
+const PROGRESS_STEPS: f64 = 100_000.0;
 
 /// The fields an `animate` problem may add to an `eval` state.
-const FIELDS: [&str; 12] = [
+const FIELDS: [&str; 13] = [
     "t_end",
+    "max_steps",
     "frames",
     "playback",
     "width",
@@ -23,14 +35,23 @@ const FIELDS: [&str; 12] = [
     "dots",
 ];
 
+/// A picture, and what `animate` did to the state it was given (the
+/// coordinates it solved, a warning), as lines for stderr.
+pub(super) struct Animated {
+    pub(super) svg: String,
+    pub(super) notes: Vec<String>,
+}
+
 /// Parses one problem (an `eval` state plus `t_end` and the picture's
 /// options, see the module documentation), simulates it and returns the
-/// SVG, or why it could not.
-pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<String, String> {
-    let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
-    let Value::Object(obj) = value else {
-        return Err("expected a JSON object".to_string());
-    };
+/// SVG, or why it could not. A run of many steps draws a progress bar on
+/// `terminal` when there is one.
+pub(super) fn animate_dyn(
+    model: &mut dyn DynModel,
+    text: &str,
+    terminal: Option<&mut dyn Write>,
+) -> Result<Animated, String> {
+    let obj = parse_object(text)?;
     let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let point = evaluator.parse_point(model, &obj, &FIELDS)?;
     let t_end = match obj.get("t_end") {
@@ -41,8 +62,13 @@ pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<String
         return Err(format!("`t_end` ({t_end}) must be after `t` ({})", point.t));
     }
     let frames = count(&obj, "frames", 200, 10_000)?;
+    let steps = steps_needed(point.t, t_end, frames);
+    check_budget(&obj, point.t, t_end, steps)?;
     let options = options(model, &obj)?;
-    let motion = simulate(
+    let mut bar = terminal
+        .filter(|_| steps >= PROGRESS_STEPS)
+        .map(|out| Bar::new(out, "animate", frames));
+    let motion = simulate_with_progress(
         &*model,
         point.t,
         &point.q,
@@ -50,9 +76,45 @@ pub(super) fn animate_dyn(model: &mut dyn DynModel, text: &str) -> Result<String
         &point.inputs,
         t_end,
         frames,
+        &mut |done, _| {
+            if let Some(bar) = bar.as_mut() {
+                bar.set(done);
+            }
+        },
     )
     .map_err(|e| format!("the simulation stopped: {e}"))?;
-    svg(&*model, &motion, &options).map_err(|e| e.to_string())
+    let notes = point.filled.lines();
+    let mut picture = svg(&*model, &motion, &options).map_err(|e| e.to_string())?;
+    // The notes go into the picture too, so that a saved SVG records the
+    // state it started from; `--` may not appear in an XML comment.
+    if let Some(end) = picture.find('>').filter(|_| !notes.is_empty()) {
+        let comment = format!("\n<!-- {} -->", notes.join("; ").replace("--", "- -"));
+        picture.insert_str(end + 1, &comment);
+    }
+    Ok(Animated {
+        svg: picture,
+        notes,
+    })
+}
+
+/// The step budget: `max_steps` (an integer of at least 1) or
+/// [`DEFAULT_MAX_STEPS`]; a run that needs more is an error saying how
+/// many steps it needs and what to change.
+fn check_budget(obj: &Map<String, Value>, t: f64, t_end: f64, steps: f64) -> Result<(), String> {
+    let (budget, whose) = match obj.get("max_steps") {
+        None => (DEFAULT_MAX_STEPS, "the default"),
+        Some(v) => match v.as_u64() {
+            Some(n) if n >= 1 => (n, "`max_steps`"),
+            _ => return Err(format!("`max_steps` must be a positive integer, found {v}")),
+        },
+    };
+    if steps <= budget as f64 {
+        return Ok(());
+    }
+    Err(format!(
+        "the motion from t = {t} to t_end = {t_end} needs {steps:.0} RK4 steps (at most {MAX_STEP} s each), more than the budget of {budget} ({whose}): shorten `t_end` (about {:.0} s of motion fit) or raise `max_steps` to at least {steps:.0} if the wait is worth it",
+        budget as f64 * MAX_STEP
+    ))
 }
 
 /// An integer field from 1 to `max`, `default` when absent.

@@ -2,17 +2,14 @@
 //! line with rates, a scene's outputs or the constraint forces.
 
 use super::error::CliError;
+use super::holonomic::fill_in;
 use super::input::{named, number, Point};
+use super::json::parse_object;
 use super::output::{contact_forces_json, finite_or_null, result_number};
 use crate::dynamic::DynModel;
 use crate::model::{Model, ModelError, ModelInfo};
 use serde_json::{json, Map, Value};
 use std::io::{BufRead, Write};
-
-/// How far, relative to 1 + max |q|, a holonomic residual may be from zero
-/// before `eval` warns: a thousand times what solving the constraints to
-/// round-off leaves.
-const HOLONOMIC_TOLERANCE: f64 = 1e-9;
 
 // Items the documentation links to.
 #[cfg(doc)]
@@ -146,13 +143,10 @@ impl EvalState {
 
     fn try_eval(&self, model: &mut dyn DynModel, line: &str) -> Result<Value, String> {
         let info = self.info(model);
-        let value: Value =
-            serde_json::from_str(line).map_err(|e| format!("malformed JSON: {e}"))?;
-        let Value::Object(obj) = value else {
-            return Err("expected a JSON object".to_string());
-        };
+        let obj = parse_object(line)?;
         let point = self.parse_point(model, &obj, &[])?;
         let model: &dyn DynModel = model;
+        let notes = point.filled.notes();
         let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);
         let outputs = |energies: bool, contacts: bool| {
             let outputs = Outputs {
@@ -163,20 +157,15 @@ impl EvalState {
                 energies,
                 contacts,
             };
-            match self.scene {
-                Some(i) => {
-                    let mut result = None;
-                    model
-                        .dyn_visit_scene(i, &mut |scene| result = Some(outputs.of(scene)))
-                        .map_err(|e| e.to_string())?;
-                    result.unwrap_or_else(|| Err(ModelError::UnknownScene { index: i }.to_string()))
-                }
-                None => outputs.of(model),
-            }
+            self.on_target(model, |target| outputs.of(target))
         };
         if self.contacts {
             let mut out = outputs(false, true)?;
-            return Ok(out.remove("contact_forces").unwrap_or(Value::Null));
+            let mut forces = out.remove("contact_forces").unwrap_or(Value::Null);
+            if let Value::Object(forces) = &mut forces {
+                forces.extend(notes);
+            }
+            return Ok(forces);
         }
         let mut dstate = vec![0.0; info.state_len()];
         match self.scene {
@@ -184,23 +173,13 @@ impl EvalState {
             None => model.dyn_rhs(t, &state, &inputs, &mut dstate),
         }
         .map_err(|e| e.to_string())?;
-        // q̇ and the holonomic check are the scene's own: a scene may have
-        // other speeds and fewer constraints than the model.
+        // q̇ is the scene's own: a scene may have other speeds than the model.
         let mut qdot = vec![0.0; info.coordinates.len()];
-        let mut warning = Ok(None);
-        let mut rates_and_warning = |target: &dyn DynModel| {
-            warning = target
+        self.on_target(model, |target| {
+            target
                 .dyn_driven_coordinate_rates(t, &q, &u, &inputs, &mut qdot)
                 .map_err(|e| e.to_string())
-                .and_then(|()| holonomic_warning(target, info, t, &q, &qdot, &inputs));
-        };
-        match self.scene {
-            Some(i) => model
-                .dyn_visit_scene(i, &mut rates_and_warning)
-                .map_err(|e| e.to_string())?,
-            None => rates_and_warning(model),
-        }
-        let warning = warning?;
+        })?;
 
         let mut qdot_out = Map::new();
         for (name, v) in info.coordinates.iter().zip(&qdot) {
@@ -214,9 +193,7 @@ impl EvalState {
         let mut answer = Map::new();
         answer.insert("qdot".into(), Value::Object(qdot_out));
         answer.insert("udot".into(), Value::Object(udot_out));
-        if let Some(warning) = warning {
-            answer.insert("warning".into(), warning);
-        }
+        answer.extend(notes);
         let (energies, contacts) = (
             info.has_output("energies"),
             info.has_output("contact_forces"),
@@ -265,31 +242,30 @@ impl EvalState {
             }
         }
         model.dyn_validate().map_err(|e| e.to_string())?;
-        for r in info.retained {
-            if info
-                .coordinate_index(r)
-                .is_some_and(|i| q_given[i].is_none())
-            {
-                return Err(format!("missing coordinate `{r}` in `q`"));
-            }
-        }
         if let Some(k) = u_given.iter().position(Option::is_none) {
             return Err(format!(
                 "missing privileged speed `{}` in `u`",
                 info.speeds[k]
             ));
         }
-        let q: Vec<f64> = q_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+        let mut q: Vec<f64> = q_given.iter().map(|v| v.unwrap_or(0.0)).collect();
         let u: Vec<f64> = u_given.iter().map(|v| v.unwrap_or(0.0)).collect();
         let inputs: Vec<f64> = inputs_given.iter().map(|v| v.unwrap_or(0.0)).collect();
+        let missing: Vec<usize> = (0..q.len()).filter(|&i| q_given[i].is_none()).collect();
+        let retained: Vec<usize> = info
+            .retained
+            .iter()
+            .map(|r| {
+                info.coordinate_index(r)
+                    .ok_or_else(|| format!("retained `{r}` is not a coordinate"))
+            })
+            .collect::<Result<_, _>>()?;
+        let filled = self.on_target(model, |target| {
+            fill_in(target, t, &mut q, &inputs, &missing, &retained)
+        })?;
 
         let mut state = Vec::with_capacity(info.state_len());
-        for r in info.retained {
-            let i = info
-                .coordinate_index(r)
-                .ok_or_else(|| format!("retained `{r}` is not a coordinate"))?;
-            state.push(q[i]);
-        }
+        state.extend(retained.iter().map(|&i| q[i]));
         state.extend_from_slice(&u);
         Ok(Point {
             t,
@@ -297,7 +273,26 @@ impl EvalState {
             u,
             inputs,
             state,
+            filled,
         })
+    }
+
+    /// Calls `f` with the model whose equations answer: the selected
+    /// scene (whose constraints and speeds may differ from the model's), or
+    /// the model itself.
+    fn on_target<R>(
+        &self,
+        model: &dyn DynModel,
+        f: impl FnOnce(&dyn DynModel) -> Result<R, String>,
+    ) -> Result<R, String> {
+        let Some(i) = self.scene else {
+            return f(model);
+        };
+        let (mut f, mut result) = (Some(f), None);
+        model
+            .dyn_visit_scene(i, &mut |scene| result = f.take().map(|f| f(scene)))
+            .map_err(|e| e.to_string())?;
+        result.unwrap_or_else(|| Err(ModelError::UnknownScene { index: i }.to_string()))
     }
 }
 
@@ -336,44 +331,6 @@ impl Outputs<'_> {
         }
         Ok(out)
     }
-}
-
-/// A warning when `q` is off a holonomic constraint by more than
-/// [`HOLONOMIC_TOLERANCE`] × (1 + max |q|): the rates are still those
-/// of the equations at `q`, but of a state the mechanism cannot take.
-fn holonomic_warning(
-    model: &dyn DynModel,
-    info: &ModelInfo,
-    t: f64,
-    q: &[f64],
-    qdot: &[f64],
-    inputs: &[f64],
-) -> Result<Option<Value>, String> {
-    if info.holonomic == 0 {
-        return Ok(None);
-    }
-    let (mut h, mut v) = (vec![0.0; info.holonomic], vec![0.0; info.constraints]);
-    model
-        .dyn_driven_constraint_residuals(t, q, qdot, inputs, &mut h, &mut v)
-        .map_err(|e| e.to_string())?;
-    let scale = 1.0 + q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
-    let tolerance = HOLONOMIC_TOLERANCE * scale;
-    let worst = h
-        .iter()
-        .enumerate()
-        .max_by(|a, b| a.1.abs().total_cmp(&b.1.abs()));
-    Ok(match worst {
-        // A NaN residual warns too.
-        Some((index, &residual)) if residual.is_nan() || residual.abs() > tolerance => {
-            Some(json!({
-                "message": format!(
-                    "the coordinates violate holonomic constraint {index} by {residual:e} (tolerance {tolerance:e}): the rates are those of a state the mechanism cannot take; solve for a dependent coordinate first (appell::linearize::solve_holonomic)"
-                ),
-                "holonomic_residuals": h,
-            }))
-        }
-        _ => None,
-    })
 }
 
 /// The model's scenes' names, comma-separated ("none" when it has none).

@@ -1,5 +1,6 @@
 //! Reading the JSON input: an evaluation point and its named numbers.
 
+use super::holonomic::Filled;
 use serde_json::Value;
 
 /// A parsed `eval` object.
@@ -9,6 +10,9 @@ pub(super) struct Point {
     pub(super) u: Vec<f64>,
     pub(super) inputs: Vec<f64>,
     pub(super) state: Vec<f64>,
+    /// The coordinates solved from the holonomic constraints, and the
+    /// warning when `q` is off them.
+    pub(super) filled: Filled,
 }
 
 /// A finite JSON number from a value.

@@ -11,7 +11,7 @@ use crate::dynamic::DynModel;
 use crate::model::{Model, ModelInfo};
 use serde_json::json;
 use std::error::Error;
-use std::io::{BufRead, Write};
+use std::io::{BufRead, IsTerminal, Write};
 use std::process::ExitCode;
 
 /// The usage text for `program` running model `info`.
@@ -261,9 +261,17 @@ fn dispatch(
         "animate" => {
             let mut text = String::new();
             stdin.read_to_string(&mut text)?;
-            match animate_dyn(model, &text) {
-                Ok(picture) => {
-                    write!(stdout, "{picture}")?;
+            // The progress bar only on a terminal: a log file gets no `\r`s.
+            let mut stderr = std::io::stderr();
+            let terminal = stderr
+                .is_terminal()
+                .then_some(&mut stderr as &mut dyn Write);
+            match animate_dyn(model, &text, terminal) {
+                Ok(animated) => {
+                    for note in &animated.notes {
+                        eprintln!("animate: {note}");
+                    }
+                    write!(stdout, "{}", animated.svg)?;
                     stdout.flush()?;
                 }
                 Err(why) => return Err(CliError::Animate(why)),

@@ -2,6 +2,7 @@
 
 use super::eval::EvalState;
 use super::input::{number, Point};
+use super::json::parse_object;
 use super::output::finite_or_null;
 use crate::accuracy::{standard_methods, Run};
 use crate::dynamic::{DynModel, DynRhs};
@@ -21,17 +22,16 @@ pub const ACCURACY_MAX_STATE: usize = 16;
 /// The report: `{"t_end", "checkpoints", "reference_error", "points": [{"method",
 /// "setting", "error_final", "error_max", "seconds", "rhs_calls", "steps"}, ..]}`
 /// with the fields of [`crate::accuracy::Point`]; methods that fail (a
-/// step-size underflow, say) are left out.
+/// step-size underflow, say) are left out. Coordinates solved from the
+/// holonomic constraints add `"solved"` and `"residual"`, a start off them
+/// `"warning"`, as `eval` answers (see [the module](super)).
 pub fn accuracy<M: Model>(mut model: M, text: &str) -> Result<Value, String> {
     accuracy_dyn(&mut model, text)
 }
 
 /// [`accuracy()`] of any [`DynModel`], compiled once.
 pub(super) fn accuracy_dyn(model: &mut dyn DynModel, text: &str) -> Result<Value, String> {
-    let value: Value = serde_json::from_str(text).map_err(|e| format!("malformed JSON: {e}"))?;
-    let Value::Object(obj) = value else {
-        return Err("expected a JSON object".to_string());
-    };
+    let obj = parse_object(text)?;
     let evaluator = EvalState::new(model).map_err(|e| e.to_string())?;
     let extra = ["t_end", "checkpoints", "levels", "repeats"];
     let point = evaluator.parse_point(model, &obj, &extra)?;
@@ -70,7 +70,12 @@ pub(super) fn accuracy_dyn(model: &mut dyn DynModel, text: &str) -> Result<Value
             }
         };
     }
-    sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)
+    let mut report = sizes!(1 2 3 4 5 6 7 8 9 10 11 12 13 14 15 16)?;
+    // What was solved, and whether the start is off the constraints.
+    if let Value::Object(fields) = &mut report {
+        fields.extend(point.filled.notes());
+    }
+    Ok(report)
 }
 
 fn sweep_report<const S: usize>(
