@@ -61,7 +61,10 @@ fn random_mechanisms_agree_with_the_oracle() {
         Some(_) => 1,
         None => 300,
     };
-    assert!(GENERATED >= floor, "{GENERATED} mechanisms, fewer than {floor}");
+    assert!(
+        GENERATED >= floor,
+        "{GENERATED} mechanisms, fewer than {floor}"
+    );
     assert_eq!(CASES.len() + REFUSED.len() + PANICKED.len(), GENERATED);
     assert!(
         PANICKED.is_empty(),

@@ -38,8 +38,6 @@ mod model;
 #[cfg(feature = "std")]
 pub mod motion;
 #[cfg(feature = "std")]
-mod onto;
-#[cfg(feature = "std")]
 pub mod oracle;
 pub mod physical;
 pub mod precision;

@@ -133,6 +133,8 @@ mod error;
 mod holonomic;
 mod jacobian;
 mod minimal;
+#[cfg(feature = "std")]
+pub(crate) mod newton_dyn;
 
 pub use eigen::eigenvalues;
 pub use error::LinearizeError;

@@ -5,7 +5,7 @@
 //! here.
 
 use crate::dynamic::DynModel;
-use crate::onto;
+use crate::linearize::newton_dyn;
 use serde_json::{json, Map, Value};
 
 /// How far, relative to 1 + max |q|, a holonomic residual may be from zero
@@ -96,8 +96,10 @@ pub(super) fn fill_in(
     for &i in &candidates {
         second[i] = SECOND_GUESS;
     }
-    let at_zero = onto::involved(model, t, q, inputs, &candidates).map_err(|e| e.to_string())?;
-    let at_second = onto::involved(model, t, &second, inputs, &candidates).unwrap_or_default();
+    let at_zero =
+        newton_dyn::involved(model, t, q, inputs, &candidates).map_err(|e| e.to_string())?;
+    let at_second =
+        newton_dyn::involved(model, t, &second, inputs, &candidates).unwrap_or_default();
     let union = |a: Vec<usize>, b: Vec<usize>| {
         let mut u: Vec<usize> = a.into_iter().chain(b).collect();
         u.sort_unstable();
@@ -122,12 +124,12 @@ pub(super) fn fill_in(
     }
     let mut filled = Filled::default();
     if !unknowns.is_empty() {
-        let first = onto::solve(model, t, q, inputs, &unknowns, &rows);
+        let first = newton_dyn::solve(model, t, q, inputs, &unknowns, &rows);
         let residual = match first {
             Ok(r) => r,
             Err(first) => {
                 q.copy_from_slice(&second);
-                onto::solve(model, t, q, inputs, &unknowns, &rows).map_err(|_| {
+                newton_dyn::solve(model, t, q, inputs, &unknowns, &rows).map_err(|_| {
                     let names: Vec<String> = unknowns
                         .iter()
                         .map(|&i| format!("`{}`", info.coordinates[i]))
@@ -162,7 +164,7 @@ pub(super) fn warning(
     if model.dyn_info().holonomic == 0 {
         return Ok(None);
     }
-    let h = onto::residuals(model, t, q, inputs).map_err(|e| e.to_string())?;
+    let h = newton_dyn::residuals(model, t, q, inputs).map_err(|e| e.to_string())?;
     let scale = 1.0 + q.iter().fold(0.0f64, |m, x| m.max(x.abs()));
     let tolerance = HOLONOMIC_TOLERANCE * scale;
     let worst = h
