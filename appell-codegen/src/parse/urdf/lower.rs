@@ -6,7 +6,7 @@ use proc_macro2::Span;
 use syn::Ident;
 
 use super::inertia::{self, Mass};
-use super::options::{Promotion, Spec};
+use super::options::{Base, Promotion, Spec};
 use super::read::Read;
 use super::tree::Tree;
 use crate::ast::*;
@@ -384,6 +384,9 @@ fn root(ast: &mut ModelAst, tree: &Tree, spec: &Spec) -> syn::Result<()> {
             }
         },
     };
+    if spec.base != Base::Fixed {
+        return floating_root(ast, spec, name, parent);
+    }
     let origin = Ident::new(&format!("{name}_origin"), span);
     ast.frames.push(FrameDef {
         name: name.clone(),
@@ -397,6 +400,33 @@ fn root(ast: &mut ModelAst, tree: &Tree, spec: &Spec) -> syn::Result<()> {
     });
     ast.origins.push((name, origin));
     Ok(())
+}
+
+/// The root link on a joint of its own, `root_joint` (Pinocchio's name for
+/// the joint `buildModel(urdf, JointModelFreeFlyer())` adds): free (unit
+/// quaternion `root_joint_qw, _qx, _qy, _qz` and translation
+/// `root_joint_x, _y, _z` along the parent's axes) or planar about the
+/// parent's z axis (`root_joint_x, _y, _angle`).
+fn floating_root(ast: &mut ModelAst, spec: &Spec, link: Ident, parent: Ident) -> syn::Result<()> {
+    let span = spec.path.span();
+    let joint = JointDef {
+        name: Ident::new("root_joint", span),
+        kind: match spec.base {
+            Base::Planar => JointKind::Planar(2),
+            _ => JointKind::Free,
+        },
+        parent,
+        child: link,
+        at: spec.at.clone(),
+        xyz: None,
+        rpy: None,
+        actuated: false,
+        dependent: false,
+        lock: None,
+        elements: Default::default(),
+        span,
+    };
+    crate::parse::add_joint(ast, &joint)
 }
 
 /// A link's body: its centre `{link}_center` at the inertial origin

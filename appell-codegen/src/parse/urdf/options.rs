@@ -1,5 +1,5 @@
 //! What `urdf(...)` says beside the path: `weld(...)`, `parameters(...)`,
-//! `parent = A` and `at = P`.
+//! `parent = A`, `at = P` and `base = free | planar | fixed`.
 
 use syn::parse::ParseStream;
 use syn::punctuated::Punctuated;
@@ -11,7 +11,21 @@ use crate::ctxt::did_you_mean;
 use crate::parse::convert;
 
 /// The options of `urdf(...)`.
-const OPTIONS: &[&str] = &["weld", "parameters", "parent", "at"];
+const OPTIONS: &[&str] = &["weld", "parameters", "parent", "at", "base"];
+
+/// The kinds of `base = ...`.
+const BASES: &[&str] = &["free", "floating", "planar", "fixed"];
+
+/// How the root link is held: `base = ...`.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Base {
+    /// Fixed in the parent frame (the default).
+    Fixed,
+    /// A free joint `root_joint` (unit quaternion and translation).
+    Free,
+    /// A planar joint `root_joint` about the parent's z axis.
+    Planar,
+}
 
 /// `urdf("path", options...)` as written.
 pub(super) struct Spec {
@@ -26,6 +40,8 @@ pub(super) struct Spec {
     /// The point the root link's origin is at (the parent's origin when
     /// absent).
     pub at: Option<Ident>,
+    /// How the root link is held.
+    pub base: Base,
 }
 
 /// `element.field = expression` or `element.field.component = expression`
@@ -61,6 +77,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
         parameters: Vec::new(),
         parent: None,
         at: None,
+        base: Base::Fixed,
     };
     while !s.is_empty() {
         s.parse::<Token![,]>()?;
@@ -92,13 +109,31 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     spec.at = Some(value);
                 }
             }
+            "base" => {
+                s.parse::<Token![=]>()?;
+                let value: Ident = s.parse()?;
+                spec.base = match value.to_string().as_str() {
+                    "free" | "floating" => Base::Free,
+                    "planar" => Base::Planar,
+                    "fixed" => Base::Fixed,
+                    other => {
+                        let hint = did_you_mean(other, BASES.iter().copied())
+                            .map(|s| format!(" (did you mean `{s}`?)"))
+                            .unwrap_or_default();
+                        return Err(syn::Error::new(
+                            value.span(),
+                            format!("unknown base `{other}`{hint}; a URDF's root link is `base = free` (a floating base), `base = planar` or `base = fixed` (the default)"),
+                        ));
+                    }
+                };
+            }
             other => {
                 let hint = did_you_mean(other, OPTIONS.iter().copied())
                     .map(|s| format!(" (did you mean `{s}`?)"))
                     .unwrap_or_default();
                 return Err(syn::Error::new(
                     key.span(),
-                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A` and `at = P`"),
+                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A`, `at = P` and `base = free | planar | fixed`"),
                 ));
             }
         }
