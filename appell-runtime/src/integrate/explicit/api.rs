@@ -56,6 +56,19 @@ macro_rules! explicit_api {
             self
         }
 
+        /// Whether the `solve_model*` methods watch a model's one-sided
+        /// contacts (default `true`; with `std`): for a model with `rolls`
+        /// contacts they check the initial state and every accepted step with
+        /// a stopping [`ContactWatch`](crate::contact_watch::ContactWatch) and
+        /// end with [`IntegrateError::Contact`] where a normal force turns
+        /// negative or the body leaves the region where the model holds. With
+        /// `false` nothing is checked (give a warning watch as the projection
+        /// of `solve_model_projected` to warn instead).
+        pub const fn contact_watch(mut self, on: bool) -> Self {
+            self.set.contact_watch = on;
+            self
+        }
+
         /// Integrates `dx/dt = f(t, x)` from `(t0, x0)` to `t_end` (which may
         /// be before `t0`). `f(t, x, dx)` writes the derivative into `dx`.
         ///
@@ -261,10 +274,11 @@ macro_rules! explicit_api {
             x0: &[T; S],
             t_end: f64,
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_model(model, S)?;
-            let p = model.prepare::<T>();
-            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve_projected(f, project, t0, x0, t_end)
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            self.run_model(model, inputs, t0, x0, t_end, &mut sink, None, Some(project))
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve`] of a model's reduced equations ([`Model::rhs`],")]
@@ -278,10 +292,11 @@ macro_rules! explicit_api {
             x0: &[T; S],
             t_end: f64,
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_model(model, S)?;
-            let p = model.prepare::<T>();
-            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve(f, t0, x0, t_end)
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            self.run_model(model, inputs, t0, x0, t_end, &mut sink, None, None)
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve_at`] of a model's reduced equations, as")]
@@ -294,10 +309,8 @@ macro_rules! explicit_api {
             x0: &[T; S],
             out: &mut [(f64, [T; S])],
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_model(model, S)?;
-            let p = model.prepare::<T>();
-            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve_at(f, t0, x0, out)
+            let t_end = out.last().map_or(t0, |o| o.0);
+            self.run_model(model, inputs, t0, x0, t_end, &mut SliceSink(out), None, None)
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve_until`] of a model's reduced equations, as")]
@@ -306,7 +319,7 @@ macro_rules! explicit_api {
             &self,
             model: &M,
             inputs: &[T],
-            g: G,
+            mut g: G,
             t0: f64,
             x0: &[T; S],
             t_end: f64,
@@ -314,10 +327,50 @@ macro_rules! explicit_api {
         where
             G: FnMut(f64, &[T; S]) -> f64,
         {
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            self.run_model(model, inputs, t0, x0, t_end, &mut sink, Some(&mut g), None)
+        }
+
+        /// The model methods' common run: the model's reduced equations after
+        /// one [`Model::prepare`], the caller's projection (if any) and then
+        /// the contact watch (see [`watched`](crate::integrate::watch)).
+        #[allow(clippy::too_many_arguments)] // the problem, the outputs and two optional hooks
+        fn run_model<M: Model, T: Scalar, K: Sink<T, S>, const S: usize>(
+            &self,
+            model: &M,
+            inputs: &[T],
+            t0: f64,
+            x0: &[T; S],
+            t_end: f64,
+            sink: &mut K,
+            event: Option<&mut EventFn<'_, T, S>>,
+            project: Option<&mut ProjectFn<'_, T, S>>,
+        ) -> Result<Solution<T, S>, IntegrateError> {
             check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve_until(f, g, t0, x0, t_end)
+            let on = self.set.contact_watch;
+            crate::integrate::watch::watched(model, inputs, on, t0, x0, |watch| {
+                if project.is_none() && watch.is_none() {
+                    return explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, None);
+                }
+                let (mut project, mut watch) = (project, watch);
+                let mut both = |t: f64, x: &mut [T; S]| -> Result<(), crate::integrate::ProjectionFailed> {
+                    if let Some(p) = project.as_mut() {
+                        p(t, x)?;
+                    }
+                    if let Some(w) = watch.as_mut() {
+                        // The watch sees the real parts (of dual numbers).
+                        let real: [f64; S] = core::array::from_fn(|i| x[i].re());
+                        w(t, &real)?;
+                    }
+                    Ok(())
+                };
+                explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, Some(&mut both))
+            })
         }
     };
 }
