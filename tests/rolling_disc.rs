@@ -158,7 +158,7 @@ fn falling_flat_stops_at_the_floor_naming_the_contact() {
         .h_max(Some(h))
         .solve_model(&p, &[], 0.0, &FALLING, 2.0)
         .unwrap_err();
-    println!("{err}");
+    println!("{err}; lean π/2 at t = {t_flat}");
     let IntegrateError::Contact(event) = err else {
         panic!("expected a contact error, got {err:?}");
     };

@@ -348,6 +348,10 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
     contact_forces_parts(model, t, q, u, inputs, true).map(|(forces, _)| forces)
 }
 
+/// What [`rolling_contact`] finds: the contact's force (its normal force
+/// still unknown), its oriented unit normal and its side.
+type RollingContact = (ContactForce, Option<[f64; 3]>, Option<f64>);
+
 /// Contact `c`'s reaction from its rolling rows, its unit normal (from
 /// the ground into the body) where the declaration gives one and can be
 /// oriented, and the side of the body's mass centre (see
@@ -362,7 +366,7 @@ fn rolling_contact(
     directions: &[[f64; 3]],
     multipliers: &[f64],
     motion: &BodyMotion,
-) -> Result<(ContactForce, Option<[f64; 3]>, Option<f64>), OracleError> {
+) -> Result<RollingContact, OracleError> {
     if ci.body >= info.bodies.len() {
         return Err(OracleError::InvalidInfo(format!(
             "contact {c} names body {} of {}",
