@@ -30,22 +30,28 @@
 //! Every `solve_model*` of [`Dopri5`](crate::integrate::Dopri5),
 //! [`Dop853`](crate::integrate::Dop853), [`TrBdf2`](crate::integrate::TrBdf2)
 //! and [`Radau5`](crate::integrate::Radau5) of a model with contacts runs a
-//! stopping watch on the initial state and after every accepted step and
-//! returns [`IntegrateError::Contact`](crate::integrate::IntegrateError)
-//! naming the contact; `.contact_watch(false)` on the integrator turns it
-//! off. To warn instead, turn it off and give a warning watch's
+//! stopping watch and returns
+//! [`IntegrateError::Contact`](crate::integrate::IntegrateError) naming the
+//! contact; `.contact_watch(false)` on the integrator turns it off. It
+//! checks the initial state, and then, when the run has no event function
+//! of its own, its [`ContactWatch::margin`] is the event function: the
+//! integrator locates where the first contact is lost on its dense output
+//! and stops there, before the body goes through (the falling disc stops
+//! a few µrad short of lean π/2). A run with its own event function
+//! (`solve_model_until`) checks the end of every accepted step instead. To warn instead, turn it off and give a warning watch's
 //! [`ContactWatch::check`] as the projection of `solve_model_projected`,
 //! then read [`ContactWatch::events`]. [`animate::simulate`](crate::animate::simulate)
 //! checks every frame and stops with
 //! [`ModelError::ContactLost`](crate::ModelError).
 //!
 //! Cost: one [`contact_forces`](crate::constraint_forces::contact_forces)
-//! per check (a KKT solve, the bodies' motion by dual numbers and the
-//! momentum balances), several times a step of a small model's generated
-//! rhs. A check sees accepted steps only: a normal force that dips below
-//! zero and back within one step goes unseen (bound the step with `h_max`
-//! when that matters), and a region's edge is seen once crossed, one step
-//! late at most.
+//! per accepted step (a KKT solve, the bodies' motion by dual numbers and
+//! the momentum balances), several times a step of a small model's
+//! generated rhs, and a few more where a contact is lost (the event
+//! location). Both ways see the ends of accepted steps only: a normal force
+//! that dips below zero and back within one step goes unseen (bound the
+//! step with `h_max` when that matters), and a check after each step sees
+//! a region's edge once crossed, one step late at most.
 //!
 //! A model without contacts has nothing to watch:
 //!
@@ -202,14 +208,7 @@ impl<'m, K: DynModel + ?Sized> ContactWatch<'m, K> {
     /// [`ContactWatch::stopped`]), and so is a failure to evaluate the
     /// forces ([`ContactWatch::failure`]).
     pub fn check(&mut self, t: f64, state: &[f64]) -> Result<(), ProjectionFailed> {
-        let info = self.model.dyn_info();
-        let mut q = vec![0.0; info.coordinates.len()];
-        for (k, name) in info.retained.iter().enumerate() {
-            if let (Some(i), Some(&v)) = (info.coordinate_index(name), state.get(k)) {
-                q[i] = v;
-            }
-        }
-        let u = state.get(info.retained.len()..).unwrap_or(&[]);
+        let (q, u) = self.full(state);
         match self.check_motion(t, &q, u) {
             Ok(()) => Ok(()),
             Err(ModelError::ContactLost(_)) => Err(ProjectionFailed {
@@ -266,6 +265,105 @@ impl<'m, K: DynModel + ?Sized> ContactWatch<'m, K> {
         }
     }
 
+    /// How far the reduced state `state` at `t` is from losing a contact,
+    /// as one continuous number for an integrator's event location: the
+    /// least over the contacts of the side (relative to its sign at the
+    /// first check, less the plane's tolerance) and of the normal force
+    /// over the largest contact force (plus the tolerance). Positive while
+    /// every contact holds; it comes down through zero where the first is
+    /// lost, and [`ContactWatch::lost_at`] says which and how. A singular
+    /// configuration is −1; forces that cannot be evaluated give NaN (the
+    /// error is in [`ContactWatch::failure`]). Records nothing: call
+    /// [`ContactWatch::check`] once first, on a state where every contact
+    /// holds, so that the sides have their reference signs.
+    pub fn margin(&mut self, t: f64, state: &[f64]) -> f64 {
+        match self.nearest_loss(t, state) {
+            Ok((margin, _)) => margin,
+            Err(e) => {
+                self.failure = Some(e);
+                f64::NAN
+            }
+        }
+    }
+
+    /// The contact nearest to being lost at the reduced state `state` at
+    /// `t` and how (the [`ContactWatch::margin`] there), as the event a
+    /// stopping watch gives; recorded in [`ContactWatch::events`] and
+    /// [`ContactWatch::stopped`]. For the state an integrator's event
+    /// location stopped at.
+    pub fn lost_at(&mut self, t: f64, state: &[f64]) -> Result<ContactEvent, ModelError> {
+        let (_, event) = self.nearest_loss(t, state)?;
+        self.events.push(event);
+        self.stopped = Some(event);
+        Ok(event)
+    }
+
+    /// [`ContactWatch::margin`] and the event of the contact it comes from.
+    fn nearest_loss(&mut self, t: f64, state: &[f64]) -> Result<(f64, ContactEvent), ModelError> {
+        let (q, u) = self.full(state);
+        let info = self.model.dyn_info();
+        let event = |c: usize, kind| {
+            let ci = &info.contacts[c];
+            ContactEvent {
+                t,
+                contact: c,
+                body: info.bodies.get(ci.body).map_or("?", |b| b.name),
+                point: ci.point,
+                kind,
+            }
+        };
+        let (forces, parts) = match contact_forces_parts(self.model, t, &q, u, &self.inputs, true) {
+            Ok(found) => found,
+            Err(e) if is_singular(&e) => {
+                return Ok((-1.0, event(self.nearest, ContactViolation::Singular)))
+            }
+            Err(OracleError::Model(e)) => return Err(e),
+            Err(_) => {
+                return Err(ModelError::Contact {
+                    what: "the contact forces could not be evaluated",
+                })
+            }
+        };
+        let scale = largest_force(&forces);
+        let mut least = (f64::INFINITY, None);
+        for (c, contact) in forces.contacts.iter().enumerate() {
+            if let (Some(side), true) = (parts.sides[c], self.signs[c] != 0.0) {
+                let relative = side * self.signs[c];
+                let m = relative - SIDE_TOLERANCE;
+                if m < least.0 {
+                    least = (
+                        m,
+                        Some((c, ContactViolation::LeftRegion { side: relative })),
+                    );
+                }
+            }
+            if let (Normal::Available { force, .. }, true) = (contact.normal, scale > 0.0) {
+                let m = force / scale + self.tolerance;
+                if m < least.0 {
+                    least = (m, Some((c, ContactViolation::LiftOff { normal: force })));
+                }
+            }
+        }
+        match least {
+            (m, Some((c, kind))) => Ok((m, event(c, kind))),
+            // Nothing to measure (no side, no normal force): never lost.
+            _ => Ok((f64::MAX, event(0, ContactViolation::Singular))),
+        }
+    }
+
+    /// Every coordinate and the speeds of a reduced state (see
+    /// [`ContactWatch::check`]).
+    fn full<'s>(&self, state: &'s [f64]) -> (Vec<f64>, &'s [f64]) {
+        let info = self.model.dyn_info();
+        let mut q = vec![0.0; info.coordinates.len()];
+        for (k, name) in info.retained.iter().enumerate() {
+            if let (Some(i), Some(&v)) = (info.coordinate_index(name), state.get(k)) {
+                q[i] = v;
+            }
+        }
+        (q, state.get(info.retained.len()..).unwrap_or(&[]))
+    }
+
     /// The contacts lost at `t`, from the forces and each contact's side;
     /// updates the passage flags and the reference sides.
     fn inspect(
@@ -275,11 +373,7 @@ impl<'m, K: DynModel + ?Sized> ContactWatch<'m, K> {
         sides: &[Option<f64>],
     ) -> Vec<ContactEvent> {
         let info = self.model.dyn_info();
-        let scale = forces
-            .contacts
-            .iter()
-            .map(|c| c.force.iter().map(|x| x * x).sum::<f64>().sqrt())
-            .fold(0.0, f64::max);
+        let scale = largest_force(forces);
         let mut found = Vec::new();
         let mut nearest = (f64::INFINITY, self.nearest);
         for (c, contact) in forces.contacts.iter().enumerate() {
@@ -342,6 +436,16 @@ impl<'m, K: DynModel + ?Sized> ContactWatch<'m, K> {
             kind: ContactViolation::Singular,
         }]
     }
+}
+
+/// The largest magnitude of a contact's whole force: the scale of the
+/// normal forces' tolerance.
+fn largest_force(forces: &ConstraintForces) -> f64 {
+    forces
+        .contacts
+        .iter()
+        .map(|c| c.force.iter().map(|x| x * x).sum::<f64>().sqrt())
+        .fold(0.0, f64::max)
 }
 
 /// Whether the forces failed because the configuration is singular.

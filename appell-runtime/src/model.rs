@@ -205,7 +205,8 @@ pub enum ContactViolation {
 /// [`ModelInfo::contacts`], its body's and its point's names) and how.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactEvent {
-    /// When (the end of the accepted step or the frame where it was seen).
+    /// When: where an integrator's event location put it, or the end of
+    /// the accepted step or the frame where it was seen.
     pub t: f64,
     /// Index in [`ModelInfo::contacts`].
     pub contact: usize,

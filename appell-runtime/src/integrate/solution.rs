@@ -47,11 +47,11 @@ pub enum IntegrateError {
         /// What was wrong.
         what: &'static str,
     },
-    /// A one-sided contact was lost after the step ending at
-    /// [`ContactEvent::t`]: its normal force turned negative or the body
-    /// left the region where the model holds. Raised by the contact watch
-    /// every `solve_model*` of a model with contacts runs (see
-    /// [`contact_watch`](crate::contact_watch), with `std`).
+    /// A one-sided contact was lost at [`ContactEvent::t`]: its normal
+    /// force turned negative or the body left the region where the model
+    /// holds. Raised by the contact watch every `solve_model*` of a model
+    /// with contacts runs (see [`contact_watch`](crate::contact_watch), with
+    /// `std`), at the located event or the end of the step that lost it.
     Contact(ContactEvent),
     /// The right-hand side returned an error.
     Model(ModelError),

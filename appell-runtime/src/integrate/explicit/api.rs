@@ -58,10 +58,12 @@ macro_rules! explicit_api {
 
         /// Whether the `solve_model*` methods watch a model's one-sided
         /// contacts (default `true`; with `std`): for a model with `rolls`
-        /// contacts they check the initial state and every accepted step with
-        /// a stopping [`ContactWatch`](crate::contact_watch::ContactWatch) and
-        /// end with [`IntegrateError::Contact`] where a normal force turns
-        /// negative or the body leaves the region where the model holds. With
+        /// contacts they check the initial state with a stopping
+        /// [`ContactWatch`](crate::contact_watch::ContactWatch), locate where a
+        /// normal force turns negative or the body leaves the region where the
+        /// model holds as an event (or, for `solve_model_until`, check the end
+        /// of each accepted step) and end there with
+        /// [`IntegrateError::Contact`]. With
         /// `false` nothing is checked (give a warning watch as the projection
         /// of `solve_model_projected` to warn instead).
         pub const fn contact_watch(mut self, on: bool) -> Self {
@@ -352,24 +354,32 @@ macro_rules! explicit_api {
             check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            let on = self.set.contact_watch;
-            crate::integrate::watch::watched(model, inputs, on, t0, x0, |watch| {
-                if project.is_none() && watch.is_none() {
-                    return explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, None);
-                }
-                let (mut project, mut watch) = (project, watch);
-                let mut both = |t: f64, x: &mut [T; S]| -> Result<(), crate::integrate::ProjectionFailed> {
-                    if let Some(p) = project.as_mut() {
-                        p(t, x)?;
-                    }
-                    if let Some(w) = watch.as_mut() {
-                        // The watch sees the real parts (of dual numbers).
+            use crate::integrate::watch::{watched, Hook};
+            let (on, has_event) = (self.set.contact_watch, event.is_some());
+            watched(model, inputs, on, t0, x0, has_event, |hook| match hook {
+                Hook::None => explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, project),
+                Hook::Event(margin) => {
+                    // The watch's margin as the event: the run stops where a
+                    // contact is lost, located on the dense output.
+                    let mut g = |t: f64, x: &[T; S]| -> f64 {
                         let real: [f64; S] = core::array::from_fn(|i| x[i].re());
-                        w(t, &real)?;
-                    }
-                    Ok(())
-                };
-                explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, Some(&mut both))
+                        margin(t, &real)
+                    };
+                    explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, Some(&mut g), project)
+                }
+                Hook::Project(watch) => {
+                    // The caller has its own event: the watch checks the
+                    // end of each step, after the caller's projection.
+                    let mut project = project;
+                    let mut both = |t: f64, x: &mut [T; S]| -> Result<(), crate::integrate::ProjectionFailed> {
+                        if let Some(p) = project.as_mut() {
+                            p(t, x)?;
+                        }
+                        let real: [f64; S] = core::array::from_fn(|i| x[i].re());
+                        watch(t, &real)
+                    };
+                    explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, Some(&mut both))
+                }
             })
         }
     };

@@ -182,10 +182,12 @@ impl TrBdf2 {
 
     /// Whether the `solve_model*` methods watch a model's one-sided
     /// contacts (default `true`): for a model with `rolls` contacts they
-    /// check the initial state and every accepted step with a stopping
-    /// [`ContactWatch`](crate::contact_watch::ContactWatch) and end with
-    /// [`IntegrateError::Contact`] where a normal force turns negative or
-    /// the body leaves the region where the model holds. With `false`
+    /// check the initial state with a stopping
+    /// [`ContactWatch`](crate::contact_watch::ContactWatch), locate where a
+    /// normal force turns negative or the body leaves the region where the
+    /// model holds as an event (or, for `solve_model_until`, check the end
+    /// of each accepted step) and end there with
+    /// [`IntegrateError::Contact`]. With `false`
     /// nothing is checked (give a warning watch as the projection of
     /// `solve_model_projected` to warn instead).
     ///

@@ -445,9 +445,16 @@ impl TrBdf2 {
         model.validate()?;
         let rhs = Prepared::new(model);
         let on = self.contact_watch;
-        watched_slices(model, inputs, on, t0, x0, project, |project| {
-            self.run_prepared(&rhs, t0, x0, t_end, inputs, out, event, project)
-        })
+        watched_slices(
+            model,
+            inputs,
+            on,
+            t0,
+            x0,
+            event,
+            project,
+            |event, project| self.run_prepared(&rhs, t0, x0, t_end, inputs, out, event, project),
+        )
     }
 
     /// [`TrBdf2::solve_model_at`] of a prepared rhs (compiled once for

@@ -530,9 +530,16 @@ impl Radau5 {
         model.validate()?;
         let rhs = Prepared::new(model);
         let on = self.contact_watch;
-        watched_slices(model, inputs, on, t0, x0, project, |project| {
-            self.run_prepared(&rhs, inputs, t0, x0, t_end, out, event, project)
-        })
+        watched_slices(
+            model,
+            inputs,
+            on,
+            t0,
+            x0,
+            event,
+            project,
+            |event, project| self.run_prepared(&rhs, inputs, t0, x0, t_end, out, event, project),
+        )
     }
 
     /// [`Radau5::solve_model_at`] of a prepared rhs (the accuracy sweep's,
