@@ -328,3 +328,25 @@ fn the_watch_costs_about_a_contact_force_per_step() {
     );
     assert!(on > 0.0 && off > 0.0);
 }
+
+#[test]
+fn the_command_lines_animate_says_where_the_disc_hits_the_floor() {
+    let args = ["rolling_disc".to_string(), "animate".to_string()];
+    let problem = r#"{"q": {"yaw": 0, "lean": 1.5, "spin": 0, "x": 0, "y": 0},
+                      "u": {"yaw": 0, "lean": 0, "spin": 0}, "t_end": 0.2, "frames": 20}"#;
+    let mut out = Vec::new();
+    let result = appell::cli::run_with(
+        RollingDisc::default(),
+        &args,
+        &mut problem.as_bytes(),
+        &mut out,
+        |_| Ok(()),
+    );
+    match result {
+        Err(appell::cli::CliError::Animate(why)) => {
+            println!("{why}");
+            assert!(why.contains("the contact of `disc` at `P`"), "{why}");
+        }
+        other => panic!("expected the contact named, got {other:?}"),
+    }
+}
