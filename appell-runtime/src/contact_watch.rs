@@ -150,7 +150,7 @@ pub struct ContactWatch<'m, K: DynModel + ?Sized> {
 
 impl<'m, K: DynModel + ?Sized> ContactWatch<'m, K> {
     /// A watch of `model`'s contacts that stops at the first contact lost,
-    /// with [`DEFAULT_TOLERANCE`] and no inputs.
+    /// with [`DEFAULT_TOLERANCE`] and the inputs at zero.
     pub fn new(model: &'m K) -> Self {
         let nc = model.dyn_info().contacts.len();
         ContactWatch {

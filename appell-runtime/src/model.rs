@@ -203,6 +203,22 @@ pub enum ContactViolation {
 
 /// A contact lost at time `t`: the contact (its index in
 /// [`ModelInfo::contacts`], its body's and its point's names) and how.
+///
+/// ```
+/// use appell_runtime::{ContactEvent, ContactViolation};
+///
+/// let event = ContactEvent {
+///     t: 0.9,
+///     contact: 0,
+///     body: "rear_wheel",
+///     point: "P",
+///     kind: ContactViolation::LiftOff { normal: -69.5 },
+/// };
+/// assert_eq!(
+///     event.to_string(),
+///     "the contact of `rear_wheel` at `P` would have to pull (normal force -6.95e1) at t = 0.9: it lifts off"
+/// );
+/// ```
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ContactEvent {
     /// When: where an integrator's event location put it, or the end of
