@@ -265,6 +265,19 @@ fn a_warning_watch_records_the_fall_and_goes_on() {
     let sol = sol.expect("a warning watch lets the integration go on");
     assert_eq!(watch.checks, sol.stats.accepted);
     assert!(sol.x[0] > FRAC_PI_2, "through the floor: lean {}", sol.x[0]);
+    // Each once, though every step after is past the floor: the centre
+    // crosses the plane, then the normal, turned over, would pull.
+    let kinds: Vec<_> = watch.events.iter().map(|e| e.kind).collect();
+    assert!(
+        matches!(
+            kinds[..],
+            [
+                ContactViolation::LeftRegion { .. },
+                ContactViolation::LiftOff { .. }
+            ]
+        ),
+        "{kinds:?}"
+    );
     let first = watch.events.first().expect("the fall recorded");
     assert_eq!((first.body, first.point), ("disc", "P"));
     assert!(first.t >= t_flat - 1e-9 && first.t <= t_flat + 1e-3);

@@ -53,6 +53,12 @@
 //! step with `h_max` when that matters), and a check after each step sees
 //! a region's edge once crossed, one step late at most.
 //!
+//! Not watched: the fixed-step functions ([`rk4`](crate::integrate::rk4)
+//! and its siblings, without `std` and without allocation), the augmented
+//! full-coordinate integrator ([`crate::augmented`]), and the hybrid
+//! driver's phases, whose scenes change where a guard says (give them a
+//! [`Guard::lift_off`](crate::hybrid::Guard::lift_off)).
+//!
 //! A model without contacts has nothing to watch:
 //!
 //! ```
