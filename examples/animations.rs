@@ -30,8 +30,9 @@ mod whipple_bicycle;
 use std::error::Error;
 use std::path::{Path, PathBuf};
 
-use appell::animate::{line_plot, simulate, svg, Curve, Frame, SvgOptions, View};
+use appell::animate::{line_plot, simulate, simulate_watched, svg, Curve, Frame, SvgOptions, View};
 use appell::augmented::{integrate, Settings};
+use appell::contact_watch::ContactWatch;
 use appell::Model;
 
 fn main() -> Result<(), Box<dyn Error>> {
@@ -94,7 +95,16 @@ fn bicycle(dir: &Path) -> Result<(), Box<dyn Error>> {
         ),
     ] {
         let u = [nudge, -v / p.rr, 0.0];
-        let frames = simulate(&p, 0.0, &q, &u, &[0.0], t_end, (t_end * 30.0) as usize)?;
+        // Falling, the steer whips round and by 1.65 s the front wheel's
+        // normal force turns negative: the two-sided contacts hold the wheel
+        // down from there. The picture is drawn to the end, with a warning
+        // watch that says so, instead of stopping there.
+        let mut watch = ContactWatch::new(&p).inputs(&[0.0]).warn();
+        let count = (t_end * 30.0) as usize;
+        let frames = simulate_watched(&p, 0.0, &q, &u, &[0.0], t_end, count, &mut watch)?;
+        for event in &watch.events {
+            println!("{name}: {event}");
+        }
         let lean = frames.iter().map(|f| f.q[3].abs()).fold(0.0, f64::max);
         println!("{name}: largest lean {lean:.3} rad");
         write(dir, name, &svg(&p, &frames, &options(title))?)?;

@@ -66,6 +66,40 @@
 //! }
 //! ```
 //!
+//! ## Contact watch
+//!
+//! `rolls` (like every constraint) is a two-sided equality: the equations
+//! hold whatever force it takes, pulling included. Every `solve_model*` of
+//! a model with contacts therefore watches them ([`contact_watch`]): the
+//! same disc released at rest at lean 1.5 rad falls flat, and the
+//! integration stops where its centre reaches the floor instead of going
+//! on through it.
+//!
+//! ```
+//! use appell::integrate::{Dop853, IntegrateError};
+//! use appell::{Appell, ContactViolation};
+//!
+//! #[derive(Appell)]
+//! #[appell(coordinates(yaw, lean, spin, x, y), speeds(yaw, lean, spin), positive(r, m))]
+//! #[appell(frame(A = N.rotate_z(yaw)), frame(B = A.rotate_x(lean)), frame(C = B.rotate_y(spin)))]
+//! #[appell(point(D = O + x * N.x + y * N.y + r * cos(lean) * N.z), point(P = D - r * B.z))]
+//! #[appell(body(disc, center = D, frame = C, mass = m,
+//!               inertia = principal(m * r * r / 4, m * r * r / 2, m * r * r / 4)))]
+//! #[appell(rolls(disc, contact = P))]
+//! #[appell(gravity(-g * N.z))]
+//! struct Disc { r: f64, m: f64, g: f64 }
+//!
+//! let disc = Disc { r: 0.3, m: 2.0, g: 9.81 };
+//! // The reduced state: lean, then the rates of yaw, lean and spin.
+//! let err = Dop853::new()
+//!     .h_max(Some(1e-3))
+//!     .solve_model(&disc, &[], 0.0, &[1.5, 0.0, 0.0, 0.0], 2.0)
+//!     .unwrap_err();
+//! let IntegrateError::Contact(event) = err else { panic!("{err}") };
+//! assert_eq!((event.body, event.point), ("disc", "P"));
+//! assert!(matches!(event.kind, ContactViolation::LeftRegion { .. } | ContactViolation::Singular));
+//! ```
+//!
 //! The model language is described in `docs/model-language.md`; every
 //! example in `examples/` gets the model command line ([`cli`]) for free.
 #![cfg_attr(not(feature = "std"), no_std)]

@@ -219,3 +219,92 @@ fn the_command_line_evaluates_a_scene_in_its_own_speeds() {
     let v = ev.eval_line(r#"{"t": 0.0, "q": {"z": 0.55, "f": 0.1}, "u": {"z": 0.4}}"#);
     assert!(v.get("warning").is_some(), "{v}");
 }
+
+/// An upright disc (no lean: yaw, then spin about the axle) held on the
+/// ground by `holonomic(z == r)` and rolling there (`rolls` along the
+/// heading and sideways), both of effect `ground`, pulled up by a force
+/// that grows with time, `lift * t`. On the ground the normal force is
+/// m g − lift t: it comes down through zero at t = m g / lift, where the
+/// disc lifts off (the flight scene, without the ground).
+#[allow(clippy::duplicated_attributes)] // the scenes name effects alike
+#[derive(appell::Appell, Clone, Debug, PartialEq)]
+#[appell(coordinates(yaw, spin, x, y, z), speeds(yaw, spin), positive(r, m))]
+#[appell(frame(A = N.rotate_z(yaw)), frame(C = A.rotate_y(spin)))]
+#[appell(point(D = O + x * N.x + y * N.y + z * N.z), point(P = D - r * N.z))]
+#[appell(body(disc, center = D, frame = C, mass = m, inertia = principal(m * r * r / 4, m * r * r / 2, m * r * r / 4)))]
+#[appell(holonomic(z == r, effect = ground))]
+#[appell(rolls(disc, contact = P, along = [A.x, A.y], effect = ground))]
+#[appell(gravity(-g * N.z))]
+#[appell(force(D, lift * t * N.z, effect = lift))]
+#[appell(scene(grounded, effects(gravity, lift, ground)))]
+#[appell(scene(airborne, effects(gravity, lift), speeds(yaw, spin, x, y, z)))]
+struct LiftedDisc {
+    r: f64,
+    m: f64,
+    g: f64,
+    lift: f64,
+}
+
+const LIFTED: LiftedDisc = LiftedDisc {
+    r: 0.15,
+    m: 1.0,
+    g: 9.81,
+    lift: 20.0,
+};
+
+/// Rolling on the ground at yaw rate 0.5 and spin 10: q and u.
+const ROLLING_Q: [f64; 5] = [0.0, 0.0, 0.0, 0.0, 0.15];
+const ROLLING_U: [f64; 2] = [0.5, 10.0];
+
+#[test]
+fn the_lift_off_guard_switches_where_the_normal_force_vanishes() {
+    use appell::hybrid::Guard;
+    let t_lift = LIFTED.m * LIFTED.g / LIFTED.lift;
+    let ground = LiftedDiscGrounded::from_ref(&LIFTED);
+    let air = LiftedDiscAirborne::from_ref(&LIFTED);
+    let phases = vec![
+        Phase::new("grounded", ground).guard(Guard::lift_off(1, ground, 0, &[])),
+        Phase::new("airborne", air),
+    ];
+    let run = Hybrid::new(phases)
+        .run::<10>(0, 0.0, &ROLLING_Q, &ROLLING_U, 1.0)
+        .unwrap();
+    assert_eq!(run.switches.len(), 1);
+    let s = &run.switches[0];
+    assert_eq!((s.from, s.to, s.reason), (0, 1, "lift-off"));
+    println!("lift-off at {} against m g / lift = {t_lift}", s.t);
+    assert!((s.t - t_lift).abs() < 1e-9, "{} vs {t_lift}", s.t);
+    // Nothing jumps where the ground lets go; then the disc rises.
+    assert!(s.energy_lost.abs() < 1e-12, "{}", s.energy_lost);
+    assert!(run.end.q[4] > LIFTED.r + 0.1, "height {}", run.end.q[4]);
+}
+
+#[test]
+fn the_contact_watch_stops_the_grounded_disc_where_it_would_lift_off() {
+    use appell::integrate::IntegrateError;
+    use appell::ContactViolation;
+    let t_lift = LIFTED.m * LIFTED.g / LIFTED.lift;
+    let ground = LiftedDiscGrounded::from_ref(&LIFTED);
+    // Reduced state of the grounded scene: the speeds (every coordinate is
+    // ignorable).
+    assert_eq!(
+        <LiftedDiscGrounded as appell::Model>::info().retained.len(),
+        0
+    );
+    let err = Dop853::new()
+        .h_max(Some(1e-3))
+        .solve_model(ground, &[], 0.0, &ROLLING_U, 1.0)
+        .unwrap_err();
+    println!("{err}");
+    let IntegrateError::Contact(e) = err else {
+        panic!("expected a contact error, got {err:?}");
+    };
+    assert_eq!((e.body, e.point), ("disc", "P"));
+    assert!(matches!(e.kind, ContactViolation::LiftOff { normal } if normal < 0.0));
+    // Located on the dense output (the watch is the event function).
+    assert!((e.t - t_lift).abs() < 1e-9, "{} vs {t_lift}", e.t);
+    // Before the lift-off the same integration is untouched.
+    Dop853::new()
+        .solve_model(ground, &[], 0.0, &ROLLING_U, 0.9 * t_lift)
+        .unwrap();
+}

@@ -262,3 +262,22 @@ fn every_coordinate_acceleration_is_the_rate_of_its_rate() {
     println!("wheel-axle: q̈ against central differences of q̇: {worst:.1e}");
     assert!(worst < 1e-8, "{worst:e}");
 }
+
+#[test]
+fn the_contact_watch_has_nothing_to_watch() {
+    // The wheels' rolling is written as nonholonomic constraints, not
+    // `rolls` contacts: no contact watch runs, and a solve is the same with
+    // the switch either way.
+    use appell::integrate::Dop853;
+    assert!(WheelAxle::info().contacts.is_empty());
+    let p = random_model(&mut Rng(0x5eed_0003));
+    let solver = Dop853::new().rtol(1e-9).atol(1e-12);
+    let x0 = [0.3, 1.0, -2.0];
+    let on = solver.solve_model(&p, &[0.5], 0.0, &x0, 2.0).unwrap();
+    let off = solver
+        .contact_watch(false)
+        .solve_model(&p, &[0.5], 0.0, &x0, 2.0)
+        .unwrap();
+    assert_eq!(on.x, off.x);
+    assert_eq!(on.stats, off.stats);
+}

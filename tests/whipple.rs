@@ -309,3 +309,44 @@ fn a_retained_coordinate_the_constraints_do_not_fix_is_still_required() {
         "missing coordinate `q4` in `q` (the holonomic constraints do not fix it)"
     );
 }
+
+#[test]
+fn a_nudged_ride_is_untouched_by_the_contact_watch() {
+    // Both wheels are `rolls` contacts, so every solve_model watches them:
+    // a ride at 5 m/s nudged by a roll rate of 0.5 rad/s (stable, the
+    // weave decays) is the same with the watch as without, and not stopped.
+    use appell::integrate::{Dop853, IntegrateError};
+    use appell::ContactViolation;
+    let p = WhippleBicycle::default();
+    let q = whipple_bicycle::operating_point(&p).unwrap();
+    let solver = Dop853::new().rtol(1e-9).atol(1e-12);
+    let x0 = [q[3], q[4], q[6], 0.5, -5.0 / p.rr, 0.0];
+    let watched = solver.solve_model(&p, &[0.0], 0.0, &x0, 3.0).unwrap();
+    let free = solver
+        .contact_watch(false)
+        .solve_model(&p, &[0.0], 0.0, &x0, 3.0)
+        .unwrap();
+    assert_eq!(watched.x, free.x);
+    assert_eq!(watched.stats, free.stats);
+    assert!(watched.x[0].abs() < 0.05, "roll {}", watched.x[0]);
+
+    // At 2 m/s it falls, and the steer whips round into the fall (from
+    // 0.75 rad at 1.5 rad/s to 1.1 rad at 11 rad/s between 0.81 s and
+    // 0.9 s): the front contact's normal force jumps past 1600 N and the
+    // rear one would have to pull the wheel down. The watch stops there.
+    let x0 = [q[3], q[4], q[6], 0.5, -2.0 / p.rr, 0.0];
+    let err = solver.solve_model(&p, &[0.0], 0.0, &x0, 2.0).unwrap_err();
+    println!("{err}");
+    let IntegrateError::Contact(e) = err else {
+        panic!("expected a contact error, got {err:?}");
+    };
+    assert_eq!((e.contact, e.body, e.point), (0, "rear_wheel", "P"));
+    assert!(matches!(e.kind, ContactViolation::LiftOff { normal } if normal < 0.0));
+    assert!(e.t > 0.81 && e.t < 0.9, "{}", e.t);
+    let steer = solver
+        .contact_watch(false)
+        .solve_model(&p, &[0.0], 0.0, &x0, e.t)
+        .unwrap()
+        .x[2];
+    assert!(steer > 0.75, "steer {steer}");
+}

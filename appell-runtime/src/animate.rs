@@ -11,7 +11,9 @@
 //! spoke along its longest axis so that a spin shows, each particle a dot,
 //! each rolling contact's path a track on the ground, under a ground grid
 //! and a time readout. [`line_plot`] draws curves, such as eigenvalues
-//! against a parameter.
+//! against a parameter. A model with contacts is watched frame by frame
+//! ([`crate::contact_watch`]): a disc that falls flat stops the picture
+//! where it would go through the floor.
 //!
 //! ```
 //! use appell_runtime::animate::{simulate, svg, SvgOptions};
@@ -65,6 +67,7 @@ mod plot;
 pub use draw::{svg, SvgOptions, View};
 pub use plot::{line_plot, Curve};
 
+use crate::contact_watch::ContactWatch;
 use crate::dynamic::{DynModel, DynRhs};
 use crate::model::{check_len, ModelError};
 
@@ -99,9 +102,17 @@ pub fn steps_needed(t0: f64, t_end: f64, frames: usize) -> f64 {
 /// [`MAX_STEP`] per step ([`steps_needed`] steps in all): accurate enough
 /// for a picture, not a reference (use the adaptive integrators for that).
 ///
+/// A model with `rolls` contacts is checked by a stopping
+/// [`ContactWatch`] at the start and at every frame: where a contact's
+/// normal force turns negative or the body leaves the region where the
+/// model holds (a disc past lean ±π/2) the simulation ends with
+/// [`ModelError::ContactLost`] naming the contact
+/// ([`simulate_watched`] takes a watch of one's own, one that warns).
+///
 /// Errors: wrong lengths, `frames == 0`, a non-finite argument or
-/// `t_end <= t0` (as [`ModelError::NonFinite`] naming it), and any error of
-/// the model along the way (a singular configuration reached).
+/// `t_end <= t0` (as [`ModelError::NonFinite`] naming it), a contact lost,
+/// and any error of the model along the way (a singular configuration
+/// reached).
 pub fn simulate<K: DynModel + ?Sized>(
     model: &K,
     t0: f64,
@@ -111,12 +122,80 @@ pub fn simulate<K: DynModel + ?Sized>(
     t_end: f64,
     frames: usize,
 ) -> Result<Vec<Frame>, ModelError> {
-    simulate_with_progress(model, t0, q0, u0, inputs, t_end, frames, &mut |_, _| {})
+    let mut watch = ContactWatch::new(model).inputs(inputs);
+    simulate_watched(model, t0, q0, u0, inputs, t_end, frames, &mut watch)
+}
+
+/// [`simulate`] with the contacts checked by `watch` at the start and at
+/// every frame: a warning watch records the contacts lost in its
+/// [`ContactWatch::events`] and the simulation goes on. The watch should
+/// have the same `inputs`.
+///
+/// ```
+/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # struct Free;
+/// # static INFO: ModelInfo = ModelInfo {
+/// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
+/// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+/// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
+/// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// # };
+/// # impl Model for Free {
+/// #     type Prepared<T: Scalar> = ();
+/// #     fn info() -> &'static ModelInfo { &INFO }
+/// #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+/// #     fn prepare<T: Scalar>(&self) {}
+/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, s: &[T], _: &[T], d: &mut [T]) -> Result<(), ModelError> { d[0] = s[1]; d[1] = T::zero(); Ok(()) }
+/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], u: &[T], qd: &mut [T]) -> Result<(), ModelError> { qd[0] = u[0]; Ok(()) }
+/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], u: &[T]) -> Result<T, ModelError> { Ok(u[0] * u[0]) }
+/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
+/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
+/// # }
+/// use appell_runtime::animate::simulate_watched;
+/// use appell_runtime::contact_watch::ContactWatch;
+///
+/// // A free particle has no contacts: every frame is checked, nothing found.
+/// let mut watch = ContactWatch::new(&Free).warn();
+/// let frames = simulate_watched(&Free, 0.0, &[0.0], &[1.0], &[], 1.0, 10, &mut watch).unwrap();
+/// assert_eq!(frames.len(), 11);
+/// assert_eq!(watch.checks, 11);
+/// assert!(watch.events.is_empty());
+/// ```
+#[allow(clippy::too_many_arguments)] // simulate's arguments and the watch
+pub fn simulate_watched<K: DynModel + ?Sized>(
+    model: &K,
+    t0: f64,
+    q0: &[f64],
+    u0: &[f64],
+    inputs: &[f64],
+    t_end: f64,
+    frames: usize,
+    watch: &mut ContactWatch<'_, K>,
+) -> Result<Vec<Frame>, ModelError> {
+    run(
+        model,
+        t0,
+        q0,
+        u0,
+        inputs,
+        t_end,
+        frames,
+        watch,
+        &mut |_, _| {},
+    )
 }
 
 /// [`simulate`], calling `progress(done, frames)` after each frame (for a
 /// progress bar on a long run).
-#[allow(clippy::too_many_arguments)]
+#[allow(clippy::too_many_arguments)] // simulate's arguments and the callback
 pub fn simulate_with_progress<K: DynModel + ?Sized>(
     model: &K,
     t0: f64,
@@ -125,6 +204,26 @@ pub fn simulate_with_progress<K: DynModel + ?Sized>(
     inputs: &[f64],
     t_end: f64,
     frames: usize,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<Frame>, ModelError> {
+    let mut watch = ContactWatch::new(model).inputs(inputs);
+    run(
+        model, t0, q0, u0, inputs, t_end, frames, &mut watch, progress,
+    )
+}
+
+/// The simulation itself: RK4 steps, the watch and `progress` at every
+/// frame.
+#[allow(clippy::too_many_arguments)] // simulate's arguments, the watch and the callback
+fn run<K: DynModel + ?Sized>(
+    model: &K,
+    t0: f64,
+    q0: &[f64],
+    u0: &[f64],
+    inputs: &[f64],
+    t_end: f64,
+    frames: usize,
+    watch: &mut ContactWatch<'_, K>,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Frame>, ModelError> {
     let info = model.dyn_info();
@@ -148,6 +247,7 @@ pub fn simulate_with_progress<K: DynModel + ?Sized>(
     let steps = (per_frame / MAX_STEP).ceil().max(1.0) as usize;
     let h = per_frame / steps as f64;
     let mut x: Vec<f64> = q0.iter().chain(u0).copied().collect();
+    watch.check_motion(t0, q0, u0)?;
     let mut out = Vec::with_capacity(frames + 1);
     out.push(Frame {
         t: t0,
@@ -158,8 +258,10 @@ pub fn simulate_with_progress<K: DynModel + ?Sized>(
         for s in 0..steps {
             x = rates.rk4_step(start + s as f64 * h, h, &x)?;
         }
+        let t = t0 + (k + 1) as f64 * per_frame;
+        watch.check_motion(t, &x[..n], &x[n..])?;
         out.push(Frame {
-            t: t0 + (k + 1) as f64 * per_frame,
+            t,
             q: x[..n].to_vec(),
         });
         progress(k + 1, frames);

@@ -42,6 +42,20 @@
 //!   gets [`NormalUnavailable::NotDetermined`].
 //!
 //! Anything else is reported as [`Normal::Unavailable`], never guessed.
+//!
+//! # Two-sided constraints
+//!
+//! Every constraint the model language declares (`holonomic`,
+//! `nonholonomic`, `rolls`, driven constraints) is a two-sided equality:
+//! its multiplier takes whatever sign keeps it, so a normal force here can
+//! be negative, the ground pulling the body. And since the normal is
+//! oriented towards the mass centre, where the centre crosses the contact
+//! plane (the rolling disc past lean ±π/2) the normal turns over without
+//! an error. Contacts are one-sided in the world; that is checked outside
+//! the equations, from these forces: by the contact watch every
+//! integration of a model with contacts runs
+//! ([`crate::contact_watch`]), and in a hybrid run by the lift-off guard
+//! ([`crate::hybrid::Guard::lift_off`]).
 
 use crate::dynamic::DynModel;
 use crate::model::{Model, ModelInfo, RowSource};
@@ -334,9 +348,15 @@ pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
     contact_forces_parts(model, t, q, u, inputs, true).map(|(forces, _)| forces)
 }
 
-/// Contact `c`'s reaction from its rolling rows, and its unit normal (from
-/// the ground into the body) where the declaration gives one; the normal
-/// force itself is left to the callers.
+/// What [`rolling_contact`] finds: the contact's force (its normal force
+/// still unknown), its oriented unit normal and its side.
+type RollingContact = (ContactForce, Option<[f64; 3]>, Option<f64>);
+
+/// Contact `c`'s reaction from its rolling rows, its unit normal (from
+/// the ground into the body) where the declaration gives one and can be
+/// oriented, and the side of the body's mass centre (see
+/// [`ContactParts::sides`]); the normal force itself is left to the
+/// callers.
 #[allow(clippy::too_many_arguments)]
 fn rolling_contact(
     info: &ModelInfo,
@@ -346,7 +366,7 @@ fn rolling_contact(
     directions: &[[f64; 3]],
     multipliers: &[f64],
     motion: &BodyMotion,
-) -> Result<(ContactForce, Option<[f64; 3]>), OracleError> {
+) -> Result<RollingContact, OracleError> {
     if ci.body >= info.bodies.len() {
         return Err(OracleError::InvalidInfo(format!(
             "contact {c} names body {} of {}",
@@ -386,17 +406,33 @@ fn rolling_contact(
         })
     };
     let arm = sub(motion.position[ci.body], points[c]);
-    let (normal, dir) = match raw {
-        None => (Normal::Unavailable(NormalUnavailable::NoDirection), None),
+    let (normal, dir, cosine) = match raw {
+        None => (
+            Normal::Unavailable(NormalUnavailable::NoDirection),
+            None,
+            None,
+        ),
         Some(v) => {
-            let (len, side) = (norm(v), dot(v, arm));
-            if len == 0.0 || side.abs() <= 1e-9 * len * norm(arm) {
-                (Normal::Unavailable(NormalUnavailable::Unorientable), None)
+            let (len, side, reach) = (norm(v), dot(v, arm), norm(arm));
+            // The side of the mass centre, as a cosine (0 where it is in
+            // the tangent plane or the direction degenerates).
+            let cosine = if len == 0.0 || reach == 0.0 {
+                0.0
+            } else {
+                side / (len * reach)
+            };
+            if len == 0.0 || side.abs() <= 1e-9 * len * reach {
+                (
+                    Normal::Unavailable(NormalUnavailable::Unorientable),
+                    None,
+                    Some(cosine),
+                )
             } else {
                 let unit = scale(v, side.signum() / len);
                 (
                     Normal::Unavailable(NormalUnavailable::NotDetermined),
                     Some(unit),
+                    Some(cosine),
                 )
             }
         }
@@ -409,7 +445,7 @@ fn rolling_contact(
         force: rolling,
         normal,
     };
-    Ok((contact, dir))
+    Ok((contact, dir, cosine))
 }
 
 /// What [`contact_forces_parts`] found on the way: the motion, and each
@@ -421,6 +457,13 @@ pub(crate) struct ContactParts {
     pub motion: BodyMotion,
     /// Each contact's unit normal (ground into body), if it has one.
     pub normals: Vec<Option<[f64; 3]>>,
+    /// Each contact's side: the cosine of the angle between the normal
+    /// direction the declaration gives (before it is oriented) and the arm
+    /// from the contact to the body's mass centre, if the declaration
+    /// gives a direction. It changes sign where the mass centre crosses
+    /// the contact's tangent plane (the rolling disc's lean ±π/2), where
+    /// the oriented normal silently turns over.
+    pub sides: Vec<Option<f64>>,
     /// Whether every constraint row's reaction is placed (rolling rows,
     /// holonomic rows found to be normal forces at a contact).
     pub located: bool,
@@ -473,11 +516,13 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
 
     let mut contacts: Vec<ContactForce> = Vec::with_capacity(nc);
     let mut normals: Vec<Option<[f64; 3]>> = Vec::with_capacity(nc);
+    let mut sides: Vec<Option<f64>> = Vec::with_capacity(nc);
     for (c, ci) in info.contacts.iter().enumerate() {
-        let (contact, dir) =
+        let (contact, dir, side) =
             rolling_contact(info, c, ci, &points, &directions, &sol.multipliers, &motion)?;
         contacts.push(contact);
         normals.push(dir);
+        sides.push(side);
     }
 
     // Holonomic rows that are normal forces at a contact.
@@ -553,6 +598,7 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
         qdot,
         motion,
         normals,
+        sides,
         located: located.iter().all(|&x| x),
     };
     Ok((forces, parts))

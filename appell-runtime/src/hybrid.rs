@@ -34,6 +34,10 @@
 //! bouncing to rest) ends with [`HybridError::TooManySwitches`] after
 //! [`Hybrid::max_switches`], with the run so far in the error.
 //!
+//! Every constraint is a two-sided equality in the equations; a contact's
+//! one-sidedness is a guard: [`Guard::lift_off`] leaves a scene where a
+//! `rolls` contact's normal force comes down through zero.
+//!
 //! `tests/hybrid.rs` runs a hopping leg (flight and stance, the lift-off
 //! where the ground's normal force vanishes) against closed forms.
 
@@ -41,9 +45,11 @@ use std::cell::RefCell;
 
 use num_dual::Dual64;
 
+use crate::constraint_forces::{contact_forces_dyn, Normal};
 use crate::dynamic::{DynModel, DynRhs};
 use crate::integrate::{Dop853, IntegrateError, Radau5};
 use crate::model::ModelError;
+use crate::oracle::OracleError;
 use crate::switch::{impact_state, switch_state, SwitchError};
 
 /// A guard's value at `(t, q, u)`: every coordinate, the phase's speeds.
@@ -83,6 +89,63 @@ impl<'a> Guard<'a> {
         }
     }
 
+    /// A lift-off guard: switches to phase `to` where the normal force at
+    /// contact `contact` of `model` (its index in
+    /// [`ModelInfo::contacts`](crate::ModelInfo), of the phase's scene) comes
+    /// down through zero, from [`contact_forces`](crate::constraint_forces::contact_forces)
+    /// at `inputs`. Every `rolls` contact is a two-sided equality in the
+    /// equations, so this is how a hybrid run takes the ground's
+    /// one-sidedness: the scene that holds the contact until the ground
+    /// would have to pull, then one without it. Its reason is `"lift-off"`.
+    ///
+    /// The value's errors: a contact index out of range or a normal force
+    /// the forces do not give ([`ModelError::Contact`]), and the forces'
+    /// own errors.
+    ///
+    /// ```
+    /// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+    /// # struct Free;
+    /// # static INFO: ModelInfo = ModelInfo {
+    /// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
+    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
+    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
+    /// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
+    /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+    /// # };
+    /// # impl Model for Free {
+    /// #     type Prepared<T: Scalar> = ();
+    /// #     fn info() -> &'static ModelInfo { &INFO }
+    /// #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
+    /// #     fn prepare<T: Scalar>(&self) {}
+    /// #     fn rhs<T: Scalar>(&self, _: &(), _: T, s: &[T], _: &[T], d: &mut [T]) -> Result<(), ModelError> { d[0] = s[1]; d[1] = T::zero(); Ok(()) }
+    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], c: &mut [T], c0: &mut [T]) -> Result<(), ModelError> { c[0] = T::one(); c0[0] = T::zero(); Ok(()) }
+    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], u: &[T], qd: &mut [T]) -> Result<(), ModelError> { qd[0] = u[0]; Ok(()) }
+    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], u: &[T]) -> Result<T, ModelError> { Ok(u[0] * u[0]) }
+    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
+    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
+    /// # }
+    /// use appell_runtime::hybrid::Guard;
+    ///
+    /// // A model without contacts: the guard names none, and says so.
+    /// let guard = Guard::lift_off(1, &Free, 0, &[]);
+    /// assert_eq!(guard.reason, "lift-off");
+    /// assert!(matches!((guard.value)(0.0, &[0.0], &[0.0]), Err(ModelError::Contact { .. })));
+    /// ```
+    ///
+    /// `tests/hybrid.rs` lifts a disc off the ground with it.
+    pub fn lift_off(to: usize, model: &'a dyn DynModel, contact: usize, inputs: &[f64]) -> Self {
+        let inputs = inputs.to_vec();
+        Guard::new("lift-off", to, move |t, q: &[f64], u: &[f64]| {
+            normal_force(model, contact, t, q, u, &inputs)
+        })
+    }
+
     /// A guard that never ends the phase it starts: below zero on entry,
     /// it waits until it has been positive and fires where it comes down
     /// again. For guards below zero on entry by design: a slip speed less
@@ -101,6 +164,35 @@ impl<'a> Guard<'a> {
     pub fn impact(mut self, contact: &'a dyn DynModel, restitution: f64) -> Self {
         self.impact = Some((contact, restitution));
         self
+    }
+}
+
+/// The normal force at contact `contact` of `model` (the value of
+/// [`Guard::lift_off`]).
+fn normal_force(
+    model: &dyn DynModel,
+    contact: usize,
+    t: f64,
+    q: &[f64],
+    u: &[f64],
+    inputs: &[f64],
+) -> Result<f64, ModelError> {
+    if contact >= model.dyn_info().contacts.len() {
+        return Err(ModelError::Contact {
+            what: "the lift-off guard names a contact its scene does not have",
+        });
+    }
+    let forces = contact_forces_dyn(model, t, q, u, inputs).map_err(|e| match e {
+        OracleError::Model(e) => e,
+        _ => ModelError::Contact {
+            what: "the contact forces could not be evaluated",
+        },
+    })?;
+    match forces.contacts[contact].normal {
+        Normal::Available { force, .. } => Ok(force),
+        Normal::Unavailable(_) => Err(ModelError::Contact {
+            what: "the lift-off guard's contact has no normal force here (see constraint_forces::Normal)",
+        }),
     }
 }
 

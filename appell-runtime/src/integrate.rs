@@ -34,6 +34,7 @@ pub use dop853::*;
 mod dopri5;
 mod explicit;
 mod solution;
+mod watch;
 pub use dopri5::Dopri5;
 pub use solution::{EventFn, IntegrateError, ProjectFn, ProjectionFailed, Solution, Stats};
 #[cfg(feature = "std")]

@@ -25,6 +25,8 @@ pub mod conditioning;
 #[cfg(feature = "std")]
 pub mod constraint_forces;
 #[cfg(feature = "std")]
+pub mod contact_watch;
+#[cfg(feature = "std")]
 pub mod dynamic;
 #[cfg(feature = "std")]
 pub mod energy;
@@ -48,8 +50,8 @@ pub mod sliding;
 pub mod switch;
 
 pub use model::{
-    check_len, BodyInfo, ContactInfo, Model, ModelError, ModelInfo, OpCounts, RowSource,
-    SceneVisitor,
+    check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, Model, ModelError, ModelInfo,
+    OpCounts, RowSource, SceneVisitor,
 };
 pub use scalar::Scalar;
 

@@ -174,6 +174,87 @@ impl ModelInfo {
     }
 }
 
+/// How a one-sided contact was lost (see
+/// [`contact_watch`](crate::contact_watch)): every `rolls(...)` contact is
+/// a two-sided equality in the equations, so these are the states where
+/// the equations hold but the world does not.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ContactViolation {
+    /// The contact's normal force fell below the watch's tolerance: the
+    /// ground would have to pull the body (it lifts off).
+    LiftOff {
+        /// The normal force (negative, in the model's force units).
+        normal: f64,
+    },
+    /// The body's mass centre reached or crossed the contact's tangent
+    /// plane (the rolling disc's lean at ±π/2): past it the model
+    /// describes a body under the floor.
+    LeftRegion {
+        /// The cosine of the angle between the contact normal the
+        /// declaration gives and the arm from the contact to the mass
+        /// centre, signed so that it was positive where the watch started.
+        side: f64,
+    },
+    /// The forces could not be computed because the configuration is
+    /// singular (the mass matrix or the multiplier system), as the rolling
+    /// disc's is at lean ±π/2.
+    Singular,
+}
+
+/// A contact lost at time `t`: the contact (its index in
+/// [`ModelInfo::contacts`], its body's and its point's names) and how.
+///
+/// ```
+/// use appell_runtime::{ContactEvent, ContactViolation};
+///
+/// let event = ContactEvent {
+///     t: 0.9,
+///     contact: 0,
+///     body: "rear_wheel",
+///     point: "P",
+///     kind: ContactViolation::LiftOff { normal: -69.5 },
+/// };
+/// assert_eq!(
+///     event.to_string(),
+///     "the contact of `rear_wheel` at `P` would have to pull (normal force -6.95e1) at t = 0.9: it lifts off"
+/// );
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ContactEvent {
+    /// When: where an integrator's event location put it, or the end of
+    /// the accepted step or the frame where it was seen.
+    pub t: f64,
+    /// Index in [`ModelInfo::contacts`].
+    pub contact: usize,
+    /// The rolling body's name.
+    pub body: &'static str,
+    /// The contact point's name.
+    pub point: &'static str,
+    /// What happened.
+    pub kind: ContactViolation,
+}
+
+impl core::fmt::Display for ContactEvent {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        let (body, point, t) = (self.body, self.point, self.t);
+        write!(f, "the contact of `{body}` at `{point}` ")?;
+        match self.kind {
+            ContactViolation::LiftOff { normal } => write!(
+                f,
+                "would have to pull (normal force {normal:e}) at t = {t}: it lifts off"
+            ),
+            ContactViolation::LeftRegion { side } => write!(
+                f,
+                "left the region where the model holds at t = {t}: the body's mass centre reached the contact plane (side {side:e})"
+            ),
+            ContactViolation::Singular => write!(
+                f,
+                "reached a singular configuration at t = {t}, where the model stops holding"
+            ),
+        }
+    }
+}
+
 /// Why a generated function could not produce a result.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ModelError {
@@ -264,6 +345,10 @@ pub enum ModelError {
         /// The function.
         function: &'static str,
     },
+    /// A one-sided contact was lost along a simulation
+    /// ([`animate::simulate`](crate::animate::simulate) and the
+    /// [`contact_watch`](crate::contact_watch)).
+    ContactLost(ContactEvent),
 }
 
 impl core::fmt::Display for ModelError {
@@ -322,6 +407,7 @@ impl core::fmt::Display for ModelError {
                 f,
                 "the model's constraints read inputs (driven coordinates), so `{function}` needs them: call `driven_{function}`"
             ),
+            ModelError::ContactLost(event) => write!(f, "{event}"),
         }
     }
 }

@@ -5,7 +5,7 @@
 #![allow(clippy::excessive_precision)]
 
 use super::explicit::{
-    self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, SliceSink,
+    self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, Sink, SliceSink,
 };
 use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
 use crate::model::{check_model, Model, ModelError};

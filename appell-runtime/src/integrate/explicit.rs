@@ -22,4 +22,4 @@ pub(super) use driver::run;
 pub(super) use events::illinois;
 pub(super) use pair::{all_finite, DenseOutput, EmbeddedPair};
 pub(super) use settings::Settings;
-pub(super) use sink::{CallbackSink, SliceSink};
+pub(super) use sink::{CallbackSink, Sink, SliceSink};

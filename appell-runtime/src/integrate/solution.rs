@@ -5,7 +5,7 @@
 //! ([`Dopri5`](super::Dopri5), [`Dop853`](super::Dop853)), the adaptive loop
 //! they run on, and the implicit integrator.
 
-use crate::model::ModelError;
+use crate::model::{ContactEvent, ModelError};
 
 /// Why an adaptive integration stopped without reaching its end.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -47,6 +47,12 @@ pub enum IntegrateError {
         /// What was wrong.
         what: &'static str,
     },
+    /// A one-sided contact was lost at [`ContactEvent::t`]: its normal
+    /// force turned negative or the body left the region where the model
+    /// holds. Raised by the contact watch every `solve_model*` of a model
+    /// with contacts runs (see [`contact_watch`](crate::contact_watch), with
+    /// `std`), at the located event or the end of the step that lost it.
+    Contact(ContactEvent),
     /// The right-hand side returned an error.
     Model(ModelError),
 }
@@ -74,6 +80,7 @@ impl core::fmt::Display for IntegrateError {
                 )
             }
             IntegrateError::InvalidInput { what } => write!(f, "invalid input: {what}"),
+            IntegrateError::Contact(event) => write!(f, "{event}"),
             IntegrateError::Model(e) => write!(f, "model error: {e}"),
         }
     }

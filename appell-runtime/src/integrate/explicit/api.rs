@@ -56,6 +56,21 @@ macro_rules! explicit_api {
             self
         }
 
+        /// Whether the `solve_model*` methods watch a model's one-sided
+        /// contacts (default `true`; with `std`): for a model with `rolls`
+        /// contacts they check the initial state with a stopping
+        /// [`ContactWatch`](crate::contact_watch::ContactWatch), locate where a
+        /// normal force turns negative or the body leaves the region where the
+        /// model holds as an event (or, for `solve_model_until`, check the end
+        /// of each accepted step) and end there with
+        /// [`IntegrateError::Contact`]. With
+        /// `false` nothing is checked (give a warning watch as the projection
+        /// of `solve_model_projected` to warn instead).
+        pub const fn contact_watch(mut self, on: bool) -> Self {
+            self.set.contact_watch = on;
+            self
+        }
+
         /// Integrates `dx/dt = f(t, x)` from `(t0, x0)` to `t_end` (which may
         /// be before `t0`). `f(t, x, dx)` writes the derivative into `dx`.
         ///
@@ -261,10 +276,11 @@ macro_rules! explicit_api {
             x0: &[T; S],
             t_end: f64,
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_model(model, S)?;
-            let p = model.prepare::<T>();
-            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve_projected(f, project, t0, x0, t_end)
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            self.run_model(model, inputs, t0, x0, t_end, &mut sink, None, Some(project))
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve`] of a model's reduced equations ([`Model::rhs`],")]
@@ -278,10 +294,11 @@ macro_rules! explicit_api {
             x0: &[T; S],
             t_end: f64,
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_model(model, S)?;
-            let p = model.prepare::<T>();
-            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve(f, t0, x0, t_end)
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            self.run_model(model, inputs, t0, x0, t_end, &mut sink, None, None)
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve_at`] of a model's reduced equations, as")]
@@ -294,10 +311,8 @@ macro_rules! explicit_api {
             x0: &[T; S],
             out: &mut [(f64, [T; S])],
         ) -> Result<Solution<T, S>, IntegrateError> {
-            check_model(model, S)?;
-            let p = model.prepare::<T>();
-            let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve_at(f, t0, x0, out)
+            let t_end = out.last().map_or(t0, |o| o.0);
+            self.run_model(model, inputs, t0, x0, t_end, &mut SliceSink(out), None, None)
         }
 
         #[doc = concat!("[`", stringify!($ty), "::solve_until`] of a model's reduced equations, as")]
@@ -306,7 +321,7 @@ macro_rules! explicit_api {
             &self,
             model: &M,
             inputs: &[T],
-            g: G,
+            mut g: G,
             t0: f64,
             x0: &[T; S],
             t_end: f64,
@@ -314,10 +329,58 @@ macro_rules! explicit_api {
         where
             G: FnMut(f64, &[T; S]) -> f64,
         {
+            let mut sink = CallbackSink {
+                times: &[],
+                cb: &mut |_, _| {},
+            };
+            self.run_model(model, inputs, t0, x0, t_end, &mut sink, Some(&mut g), None)
+        }
+
+        /// The model methods' common run: the model's reduced equations after
+        /// one [`Model::prepare`], the caller's projection (if any) and then
+        /// the contact watch (see [`watched`](crate::integrate::watch)).
+        #[allow(clippy::too_many_arguments)] // the problem, the outputs and two optional hooks
+        fn run_model<M: Model, T: Scalar, K: Sink<T, S>, const S: usize>(
+            &self,
+            model: &M,
+            inputs: &[T],
+            t0: f64,
+            x0: &[T; S],
+            t_end: f64,
+            sink: &mut K,
+            event: Option<&mut EventFn<'_, T, S>>,
+            project: Option<&mut ProjectFn<'_, T, S>>,
+        ) -> Result<Solution<T, S>, IntegrateError> {
             check_model(model, S)?;
             let p = model.prepare::<T>();
             let f = |t: T, x: &[T; S], dx: &mut [T; S]| model.rhs(&p, t, x, inputs, dx);
-            self.solve_until(f, g, t0, x0, t_end)
+            use crate::integrate::watch::{watched, Hook};
+            let (on, has_event) = (self.set.contact_watch, event.is_some());
+            watched(model, inputs, on, t0, x0, has_event, |hook| match hook {
+                Hook::None => explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, project),
+                Hook::Event(margin) => {
+                    // The watch's margin as the event: the run stops where a
+                    // contact is lost, located on the dense output.
+                    let mut g = |t: f64, x: &[T; S]| -> f64 {
+                        let real: [f64; S] = core::array::from_fn(|i| x[i].re());
+                        margin(t, &real)
+                    };
+                    explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, Some(&mut g), project)
+                }
+                Hook::Project(watch) => {
+                    // The caller has its own event: the watch checks the
+                    // end of each step, after the caller's projection.
+                    let mut project = project;
+                    let mut both = |t: f64, x: &mut [T; S]| -> Result<(), crate::integrate::ProjectionFailed> {
+                        if let Some(p) = project.as_mut() {
+                            p(t, x)?;
+                        }
+                        let real: [f64; S] = core::array::from_fn(|i| x[i].re());
+                        watch(t, &real)
+                    };
+                    explicit::run::<$pair<T, S>, _, _, _, S>(&self.set, f, t0, x0, t_end, sink, event, Some(&mut both))
+                }
+            })
         }
     };
 }

@@ -15,6 +15,7 @@ pub(in crate::integrate) struct Settings {
     pub(in crate::integrate) beta: f64,
     pub(in crate::integrate) event_tol: f64,
     pub(in crate::integrate) adaptive: bool,
+    pub(in crate::integrate) contact_watch: bool,
 }
 
 impl Settings {
@@ -30,6 +31,7 @@ impl Settings {
             beta,
             event_tol: 1e-12,
             adaptive: true,
+            contact_watch: true,
         }
     }
 
@@ -49,6 +51,7 @@ impl Settings {
             .field("beta", &self.beta)
             .field("event_tol", &self.event_tol)
             .field("adaptive", &self.adaptive)
+            .field("contact_watch", &self.contact_watch)
             .finish()
     }
 

@@ -90,6 +90,7 @@ pub struct TrBdf2 {
     pub(super) max_newton: usize,
     pub(super) adaptive: bool,
     pub(super) event_tol: f64,
+    pub(super) contact_watch: bool,
 }
 
 impl Default for TrBdf2 {
@@ -111,6 +112,7 @@ impl TrBdf2 {
             max_newton: 7,
             adaptive: true,
             event_tol: 1e-12,
+            contact_watch: true,
         }
     }
 
@@ -175,6 +177,26 @@ impl TrBdf2 {
     /// [`TrBdf2::solve_until`].
     pub const fn event_tol(mut self, event_tol: f64) -> Self {
         self.event_tol = event_tol;
+        self
+    }
+
+    /// Whether the `solve_model*` methods watch a model's one-sided
+    /// contacts (default `true`): for a model with `rolls` contacts they
+    /// check the initial state with a stopping
+    /// [`ContactWatch`](crate::contact_watch::ContactWatch), locate where a
+    /// normal force turns negative or the body leaves the region where the
+    /// model holds as an event (or, for `solve_model_until`, check the end
+    /// of each accepted step) and end there with
+    /// [`IntegrateError::Contact`]. With `false`
+    /// nothing is checked (give a warning watch as the projection of
+    /// `solve_model_projected` to warn instead).
+    ///
+    /// ```
+    /// use appell_runtime::integrate::TrBdf2;
+    /// assert_ne!(TrBdf2::new().contact_watch(false), TrBdf2::new());
+    /// ```
+    pub const fn contact_watch(mut self, on: bool) -> Self {
+        self.contact_watch = on;
         self
     }
 

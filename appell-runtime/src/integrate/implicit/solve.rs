@@ -7,6 +7,7 @@ use super::shared::ProjectG;
 use super::stats::TrBdf2Solution;
 use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
 use crate::integrate::solution::{IntegrateError, ProjectionFailed};
+use crate::integrate::watch::watched_slices;
 use crate::model::{check_len, Model, ModelError};
 
 // Items the documentation links to.
@@ -442,15 +443,17 @@ impl TrBdf2 {
     ) -> Result<TrBdf2Solution, IntegrateError> {
         check_len("state", x0, M::info().state_len())?;
         model.validate()?;
-        self.run_prepared(
-            &Prepared::new(model),
+        let rhs = Prepared::new(model);
+        let on = self.contact_watch;
+        watched_slices(
+            model,
+            inputs,
+            on,
             t0,
             x0,
-            t_end,
-            inputs,
-            out,
             event,
             project,
+            |event, project| self.run_prepared(&rhs, t0, x0, t_end, inputs, out, event, project),
         )
     }
 

@@ -109,6 +109,7 @@ pub struct Radau5 {
     pub(super) newton_max_iter: usize,
     pub(super) jacobian_reuse: Option<f64>,
     pub(super) event_tol: f64,
+    pub(super) contact_watch: bool,
 }
 
 impl Default for Radau5 {
@@ -134,6 +135,7 @@ impl Radau5 {
             newton_max_iter: 7,
             jacobian_reuse: None,
             event_tol: 1e-12,
+            contact_watch: true,
         }
     }
 
@@ -355,6 +357,26 @@ impl Radau5 {
     /// ```
     pub const fn event_tol(mut self, event_tol: f64) -> Self {
         self.event_tol = event_tol;
+        self
+    }
+
+    /// Whether the `solve_model*` methods watch a model's one-sided
+    /// contacts (default `true`): for a model with `rolls` contacts they
+    /// check the initial state with a stopping
+    /// [`ContactWatch`](crate::contact_watch::ContactWatch), locate where a
+    /// normal force turns negative or the body leaves the region where the
+    /// model holds as an event (or, for `solve_model_until`, check the end
+    /// of each accepted step) and end there with
+    /// [`IntegrateError::Contact`]. With `false`
+    /// nothing is checked (give a warning watch as the projection of
+    /// `solve_model_projected` to warn instead).
+    ///
+    /// ```
+    /// use appell_runtime::integrate::Radau5;
+    /// assert_ne!(Radau5::new().contact_watch(false), Radau5::new());
+    /// ```
+    pub const fn contact_watch(mut self, on: bool) -> Self {
+        self.contact_watch = on;
         self
     }
 

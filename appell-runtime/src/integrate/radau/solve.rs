@@ -7,6 +7,7 @@ use super::stats::Radau5Solution;
 use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
 use crate::integrate::implicit::{EventG, ProjectG};
 use crate::integrate::solution::{IntegrateError, ProjectionFailed};
+use crate::integrate::watch::watched_slices;
 use crate::model::{check_len, Model, ModelError};
 
 // Items the documentation links to.
@@ -528,7 +529,17 @@ impl Radau5 {
         check_len("state", x0, M::info().state_len())?;
         model.validate()?;
         let rhs = Prepared::new(model);
-        self.run_prepared(&rhs, inputs, t0, x0, t_end, out, event, project)
+        let on = self.contact_watch;
+        watched_slices(
+            model,
+            inputs,
+            on,
+            t0,
+            x0,
+            event,
+            project,
+            |event, project| self.run_prepared(&rhs, inputs, t0, x0, t_end, out, event, project),
+        )
     }
 
     /// [`Radau5::solve_model_at`] of a prepared rhs (the accuracy sweep's,
