@@ -42,6 +42,8 @@ pub mod motion;
 #[cfg(feature = "std")]
 pub mod oracle;
 pub mod physical;
+#[cfg(feature = "std")]
+pub mod pinocchio;
 pub mod precision;
 mod scalar;
 #[cfg(feature = "std")]

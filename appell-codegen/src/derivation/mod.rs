@@ -319,9 +319,16 @@ fn project(model: &mut Model, d: &mut Derivation) -> Result<(), SymbolicError> {
     };
     // Scenes keep some effects' loads of the closed form's terms, which the
     // projected tree does not separate.
+    // A ball's speeds are not its coordinates' rates, which the projection
+    // runs the recursions in.
+    let ball = spec
+        .links
+        .iter()
+        .any(|k| matches!(k.motion, Some(crate::model::tree::Motion::Spherical)));
     if spec.plain.is_ok()
         || !matches!(d.elimination, Elimination::Symbolic)
         || !model.scenes.is_empty()
+        || ball
     {
         return Ok(());
     }

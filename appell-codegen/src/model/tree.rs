@@ -26,6 +26,11 @@ pub enum Motion {
     Revolute(JointAxis),
     /// Slide along the axis.
     Prismatic(JointAxis),
+    /// Turn about the joint origin by a unit quaternion (its coordinates
+    /// `{joint}_qw, _qx, _qy, _qz`), at the child's angular velocity
+    /// relative to the joint frame in the child's axes (its speeds
+    /// `{joint}_wx, _wy, _wz`).
+    Spherical,
 }
 
 /// One term of a vector fixed in a link: `coefficient · F.axis`, with `F`
@@ -74,6 +79,12 @@ pub struct LinkSpec {
     pub rpy: Option<[Expr; 3]>,
     /// The joint's motion; None for a weld.
     pub motion: Option<Motion>,
+    /// The coordinates the link's motion reads, by name: the joint's for
+    /// one degree of freedom, a ball's quaternion (none for a weld).
+    pub coordinates: Vec<String>,
+    /// The privileged speeds of its motion, by name, one per column of its
+    /// motion subspace.
+    pub speeds: Vec<String>,
     /// Whether the joint carries the input `tau_{joint}`.
     pub actuated: bool,
     /// The bodies fixed in the link.
@@ -222,11 +233,11 @@ fn tree_checks(ast: &ModelAst) -> Result<(), String> {
     for j in &ast.joints {
         match j.kind {
             JointKind::Revolute(_) | JointKind::Prismatic(_) | JointKind::Weld => {}
-            JointKind::Planar(_) if !j.actuated => {}
+            JointKind::Planar(_) | JointKind::Spherical | JointKind::Free if !j.actuated => {}
             JointKind::Planar(_) => return Err(format!("planar joint `{}` is actuated", j.name)),
             _ => {
                 return Err(format!(
-                    "joint `{}` is not revolute, prismatic, planar or fixed",
+                    "joint `{}` is not revolute, prismatic, planar, spherical, free or fixed",
                     j.name
                 ))
             }
@@ -251,10 +262,21 @@ fn tree_checks(ast: &ModelAst) -> Result<(), String> {
     Ok(())
 }
 
-/// What a plain tree may not have besides: constraints, rolling contacts,
-/// dependent joints, speeds other than the joint rates.
+/// What a plain tree may not have besides: constraints other than its
+/// balls' unit norms, rolling contacts, dependent joints, speeds other
+/// than the joint rates and the balls' angular velocities.
 fn plain_checks(ast: &ModelAst) -> Result<(), String> {
-    if !ast.holonomic.is_empty() || !ast.nonholonomic.is_empty() {
+    let balls: Vec<&JointDef> = ast
+        .joints
+        .iter()
+        .filter(|j| matches!(j.kind, JointKind::Spherical | JointKind::Free))
+        .collect();
+    let norms_only = ast.holonomic.len() == balls.len()
+        && ast
+            .holonomic
+            .iter()
+            .all(|c| balls.iter().any(|j| is_unit_norm(c, &ball_names(j, "_q"))));
+    if !norms_only || !ast.nonholonomic.is_empty() {
         return Err("the model has constraints".into());
     }
     if !ast.rolls.is_empty() {
@@ -263,33 +285,91 @@ fn plain_checks(ast: &ModelAst) -> Result<(), String> {
     if let Some(j) = ast.joints.iter().find(|j| j.dependent) {
         return Err(format!("joint `{}` is dependent", j.name));
     }
-    let coordinates = joint_coordinates(ast);
+    let rates = joint_rates(ast);
+    let angular: Vec<String> = balls.iter().flat_map(|j| ball_names(j, "_w")).collect();
     let speeds_match = ast.speeds.as_ref().is_some_and(|(list, _)| {
-        list.len() == coordinates.len()
-            && list
-                .iter()
-                .zip(&coordinates)
-                .all(|(s, q)| s.definition.is_none() && s.name == q)
+        list.len() == rates.len() + angular.len()
+            && list.iter().all(|s| {
+                let name = s.name.to_string();
+                match &s.definition {
+                    None => rates.contains(&name),
+                    Some(_) => angular.contains(&name),
+                }
+            })
     });
-    if !speeds_match && !coordinates.is_empty() {
-        return Err("the privileged speeds are not the joint rates in joint order".into());
+    if !speeds_match && !rates.is_empty() {
+        return Err("the privileged speeds are not the joint rates".into());
     }
     Ok(())
 }
 
-/// The coordinates the joints make, in order (a planar joint's three).
+/// A ball's quaternion (`_q`: `{joint}_qw` ... `_qz`) or angular velocity
+/// (`_w`: `{joint}_wx` ... `_wz`) names.
+fn ball_names(j: &JointDef, kind: &str) -> Vec<String> {
+    let parts: &[&str] = if kind == "_q" {
+        &["w", "x", "y", "z"]
+    } else {
+        &["x", "y", "z"]
+    };
+    parts
+        .iter()
+        .map(|p| format!("{}{kind}{p}", j.name))
+        .collect()
+}
+
+/// Whether `c` is `Σ e² == 1` over the names `e`, as a ball writes it.
+fn is_unit_norm(c: &crate::ast::ConstraintDef, e: &[String]) -> bool {
+    fn squares(x: &Expr, out: &mut Vec<String>) -> bool {
+        match x {
+            Expr::Binary(BinOp::Add, a, b, _) => squares(a, out) && squares(b, out),
+            Expr::Binary(BinOp::Mul, a, b, _) => match (&**a, &**b) {
+                (Expr::Name(p), Expr::Name(q)) if p == q => {
+                    out.push(p.to_string());
+                    true
+                }
+                _ => false,
+            },
+            _ => false,
+        }
+    }
+    let mut names = Vec::new();
+    squares(&c.lhs, &mut names)
+        && names == e
+        && c.along.is_none()
+        && matches!(c.rhs, Expr::Int(1, _))
+}
+
+/// The coordinates the joints make, in order (a planar joint's three, a
+/// ball's quaternion, a free joint's quaternion and then its slides).
 fn joint_coordinates(ast: &ModelAst) -> Vec<String> {
     let mut out = Vec::new();
     for j in &ast.joints {
         match j.kind {
-            JointKind::Planar(_) => {
-                out.extend(["_x", "_y", "_angle"].map(|s| format!("{}{s}", j.name)))
+            JointKind::Spherical => out.extend(ball_names(j, "_q")),
+            JointKind::Free => {
+                out.extend(ball_names(j, "_q"));
+                out.extend(["_x", "_y", "_z"].map(|s| format!("{}{s}", j.name)));
             }
-            JointKind::Weld => {}
-            _ => out.push(j.name.to_string()),
+            _ => out.extend(joint_rates_of(j)),
         }
     }
     out
+}
+
+/// The coordinates whose rates are privileged speeds of a plain tree.
+fn joint_rates(ast: &ModelAst) -> Vec<String> {
+    ast.joints.iter().flat_map(joint_rates_of).collect()
+}
+
+/// A joint's coordinates whose rates are speeds: all but a quaternion's.
+fn joint_rates_of(j: &JointDef) -> Vec<String> {
+    let named = |s: [&str; 3]| s.map(|s| format!("{}{s}", j.name)).to_vec();
+    match j.kind {
+        JointKind::Planar(_) => named(["_x", "_y", "_angle"]),
+        JointKind::Free => named(["_x", "_y", "_z"]),
+        JointKind::Weld | JointKind::Spherical => Vec::new(),
+        _ => vec![j.name.to_string()],
+    }
 }
 
 /// The names that vary: coordinates, inputs and time.
@@ -362,6 +442,8 @@ fn links_of(
         ));
     }
     let link = |joint: String, motion: Option<Motion>| LinkSpec {
+        coordinates: link_coordinates(&joint, motion.as_ref()),
+        speeds: link_speeds(&joint, motion.as_ref()),
         joint,
         parent,
         parent_turns: parent_turns.clone(),
@@ -372,32 +454,64 @@ fn links_of(
         actuated: j.actuated,
         bodies: Vec::new(),
     };
+    // A link moving on the one before it, in its axes.
+    let next = |joint: String, parent: usize, motion: Option<Motion>| LinkSpec {
+        coordinates: link_coordinates(&joint, motion.as_ref()),
+        speeds: link_speeds(&joint, motion.as_ref()),
+        joint,
+        parent: Some(parent),
+        parent_turns: Vec::new(),
+        parent_origin: Vec::new(),
+        xyz: None,
+        rpy: None,
+        motion,
+        actuated: false,
+        bodies: Vec::new(),
+    };
+    let slide = |k: usize| Some(Motion::Prismatic(JointAxis::Unit(k, false)));
     let name = j.name.to_string();
     Ok(Some(match &j.kind {
         JointKind::Revolute(a) => vec![link(name, Some(Motion::Revolute(a.clone())))],
         JointKind::Prismatic(a) => vec![link(name, Some(Motion::Prismatic(a.clone())))],
         JointKind::Planar(k) => {
-            let slide = |i: usize| Some(Motion::Prismatic(JointAxis::Unit((k + i) % 3, false)));
-            let next = |joint: String, parent: usize, motion: Option<Motion>| LinkSpec {
-                joint,
-                parent: Some(parent),
-                parent_turns: Vec::new(),
-                parent_origin: Vec::new(),
-                xyz: None,
-                rpy: None,
-                motion,
-                actuated: false,
-                bodies: Vec::new(),
-            };
             let turn = Some(Motion::Revolute(JointAxis::Unit(*k, false)));
             vec![
-                link(format!("{name}_x"), slide(1)),
-                next(format!("{name}_y"), first, slide(2)),
+                link(format!("{name}_x"), slide((k + 1) % 3)),
+                next(format!("{name}_y"), first, slide((k + 2) % 3)),
                 next(format!("{name}_angle"), first + 1, turn),
             ]
         }
+        JointKind::Spherical => vec![link(name, Some(Motion::Spherical))],
+        // Three massless slides along the joint frame's axes, then the
+        // ball that carries the child.
+        JointKind::Free => vec![
+            link(format!("{name}_x"), slide(0)),
+            next(format!("{name}_y"), first, slide(1)),
+            next(format!("{name}_z"), first + 1, slide(2)),
+            next(name, first + 2, Some(Motion::Spherical)),
+        ],
         _ => vec![link(name, None)],
     }))
+}
+
+/// The coordinates a link named `joint` reads.
+fn link_coordinates(joint: &str, motion: Option<&Motion>) -> Vec<String> {
+    match motion {
+        None => Vec::new(),
+        Some(Motion::Spherical) => ["w", "x", "y", "z"]
+            .map(|c| format!("{joint}_q{c}"))
+            .to_vec(),
+        Some(_) => vec![joint.to_string()],
+    }
+}
+
+/// The speeds of a link named `joint`'s motion.
+fn link_speeds(joint: &str, motion: Option<&Motion>) -> Vec<String> {
+    match motion {
+        None => Vec::new(),
+        Some(Motion::Spherical) => ["x", "y", "z"].map(|c| format!("{joint}_w{c}")).to_vec(),
+        Some(_) => vec![joint.to_string()],
+    }
 }
 
 /// The link a body is fixed in (None: the ground) and its mass spec.

@@ -19,19 +19,27 @@ pub struct Link {
     pub parent: Option<usize>,
     /// From the parent link to this one.
     pub transform: Transform,
-    /// The joint's motion subspace in this link's axes.
-    pub subspace: V6,
+    /// The joint's motion subspace in this link's axes: one column per
+    /// speed (one for a revolute or prismatic joint, three for a ball).
+    pub subspace: Vec<V6>,
+    /// The index of each column's speed among the speeds the recursions
+    /// are given.
+    pub speeds: Vec<usize>,
     /// The spatial inertia about the origin, in this link's axes (its
     /// welded descendants' included).
     pub inertia: M6,
-    /// The joint's input, or 0.
-    pub input: Id,
+    /// The joint's input along each column, or 0.
+    pub inputs: Vec<Id>,
 }
 
 /// The symbols the links are written in, in speed order.
 pub struct Parts {
     /// q.
     pub coordinates: Vec<Id>,
+    /// The coordinates' names, in order.
+    coordinate_names: Vec<String>,
+    /// The privileged speeds' names, in order.
+    speed_names: Vec<String>,
     /// The privileged speeds (the joint rates).
     pub speeds: Vec<Id>,
     /// Their acceleration symbols.
@@ -64,13 +72,46 @@ impl Parts {
             .iter()
             .map(|(name, s)| Ok((name.to_string(), g.sym(*s)?)))
             .collect::<R<_>>()?;
+        let coordinate_names = model.coords.iter().map(|(c, _)| c.to_string()).collect();
+        let speed_names = model.speed_specs.iter().map(|s| s.name.clone()).collect();
         Ok(Parts {
             coordinates,
+            coordinate_names,
+            speed_names,
             speeds,
             accels,
             inputs,
         })
     }
+
+    /// The index of the coordinate named `name`.
+    fn coordinate(&self, name: &str) -> R<usize> {
+        let found = self.coordinate_names.iter().position(|c| c == name);
+        found.ok_or_else(|| SymbolicError::UnknownSymbol { name: name.into() })
+    }
+
+    /// The index of the link's speed named `name`: among the privileged
+    /// speeds, or (`Index::Coordinates`) among the coordinates.
+    fn speed(&self, name: &str, index: Index) -> R<usize> {
+        match index {
+            Index::Speeds => {
+                let found = self.speed_names.iter().position(|c| c == name);
+                found.ok_or_else(|| SymbolicError::UnknownSymbol { name: name.into() })
+            }
+            Index::Coordinates => self.coordinate(name),
+        }
+    }
+}
+
+/// What the links' speeds are: the privileged speeds (a plain tree), or
+/// the coordinates' rates (a tree whose equations are projected, where a
+/// ball has no place).
+#[derive(Clone, Copy, PartialEq, Eq)]
+pub enum Index {
+    /// The model's privileged speeds.
+    Speeds,
+    /// The coordinates' rates q̇.
+    Coordinates,
 }
 
 /// Where a written link ended up: the moving link it is fixed to (None:
@@ -81,8 +122,15 @@ struct Place {
     from: Transform,
 }
 
-/// The moving links of `spec`, the coordinates in `fixed` taken at zero.
-pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> R<Vec<Link>> {
+/// The moving links of `spec`, the coordinates in `fixed` taken at zero,
+/// their speeds indexed as `index` says.
+pub fn links(
+    g: &mut Graph,
+    spec: &TreeSpec,
+    parts: &Parts,
+    fixed: &[usize],
+    index: Index,
+) -> R<Vec<Link>> {
     let mut a = Algebra::new(g)?;
     let mut places: Vec<Place> = Vec::with_capacity(spec.links.len());
     let mut out: Vec<Link> = Vec::new();
@@ -111,13 +159,21 @@ pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> 
             });
             continue;
         };
-        let k = out.len();
-        let q = if fixed.contains(&k) {
-            a.zero()
-        } else {
-            parts.coordinates[k]
-        };
-        let (transform, subspace) = joint(&mut a, &joint_frame, motion, q)?;
+        let mut q = Vec::with_capacity(link.coordinates.len());
+        for name in &link.coordinates {
+            let r = parts.coordinate(name)?;
+            q.push(if fixed.contains(&r) {
+                a.zero()
+            } else {
+                parts.coordinates[r]
+            });
+        }
+        let speeds = link
+            .speeds
+            .iter()
+            .map(|s| parts.speed(s, index))
+            .collect::<R<Vec<_>>>()?;
+        let (transform, subspace) = joint(&mut a, &joint_frame, motion, &q)?;
         let input = match parts
             .inputs
             .iter()
@@ -126,15 +182,18 @@ pub fn links(g: &mut Graph, spec: &TreeSpec, parts: &Parts, fixed: &[usize]) -> 
             Some((_, id)) if link.actuated => *id,
             _ => a.zero(),
         };
+        let mut inputs = vec![a.zero(); subspace.len()];
+        inputs[0] = input;
         out.push(Link {
             parent: moving,
             transform,
             subspace,
+            speeds,
             inertia,
-            input,
+            inputs,
         });
         places.push(Place {
-            moving: Some(k),
+            moving: Some(out.len() - 1),
             from: identity(&mut a)?,
         });
     }
@@ -147,13 +206,14 @@ pub fn gravity(g: &mut Graph, spec: &TreeSpec) -> R<V3> {
     terms_vector(&mut a, &spec.gravity)
 }
 
-/// The joint's transform from the parent link and its motion subspace.
-fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: Id) -> R<(Transform, V6)> {
+/// The joint's transform from the parent link and its motion subspace's
+/// columns, at the coordinates `q` its motion reads.
+fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<(Transform, Vec<V6>)> {
     let zero = a.zero();
     match motion {
         Motion::Revolute(axis) => {
             let u = unit_axis(a, axis)?;
-            let turn = rotation_about(a, axis, u, q)?;
+            let turn = rotation_about(a, axis, u, q[0])?;
             let rot = a.mat_mul(&frame.rot, &turn)?;
             let s = [u[0], u[1], u[2], zero, zero, zero];
             Ok((
@@ -161,13 +221,13 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: Id) -> R<(Trans
                     rot,
                     pos: frame.pos,
                 },
-                s,
+                vec![s],
             ))
         }
         Motion::Prismatic(axis) => {
             let u = unit_axis(a, axis)?;
             let along = a.mat_vec(&frame.rot, u)?;
-            let slide = a.scale(along, q)?;
+            let slide = a.scale(along, q[0])?;
             let pos = a.add(frame.pos, slide)?;
             let s = [zero, zero, zero, u[0], u[1], u[2]];
             Ok((
@@ -175,10 +235,57 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: Id) -> R<(Trans
                     rot: frame.rot,
                     pos,
                 },
-                s,
+                vec![s],
+            ))
+        }
+        Motion::Spherical => {
+            let turn = quaternion_rotation(a, [q[0], q[1], q[2], q[3]])?;
+            let rot = a.mat_mul(&frame.rot, &turn)?;
+            let one = a.g.int(1)?;
+            let columns = (0..3)
+                .map(|k| {
+                    let mut s = [zero; 6];
+                    s[k] = one;
+                    s
+                })
+                .collect();
+            Ok((
+                Transform {
+                    rot,
+                    pos: frame.pos,
+                },
+                columns,
             ))
         }
     }
+}
+
+/// The rotation by the quaternion e = (e0, e1, e2, e3), scalar first: the
+/// child's axes in the joint frame, the quadratic forms the closed form
+/// writes (a rotation on the unit sphere the model keeps).
+fn quaternion_rotation(a: &mut Algebra, e: [Id; 4]) -> R<M3> {
+    let g = &mut *a.g;
+    let two = g.int(2)?;
+    let mut p = [[e[0]; 4]; 4];
+    for i in 0..4 {
+        for j in i..4 {
+            p[i][j] = g.mul(e[i], e[j])?;
+            p[j][i] = p[i][j];
+        }
+    }
+    let mut r = [[e[0]; 3]; 3];
+    for i in 0..3 {
+        let (j, k) = ((i + 1) % 3, (i + 2) % 3);
+        let plus = g.add(p[0][0], p[i + 1][i + 1])?;
+        let minus = g.add(p[j + 1][j + 1], p[k + 1][k + 1])?;
+        r[i][i] = g.sub(plus, minus)?;
+        // (j, i) and (i, j): 2 (e_i e_j ± e0 e_k).
+        let lower = g.add(p[i + 1][j + 1], p[0][k + 1])?;
+        let upper = g.sub(p[i + 1][j + 1], p[0][k + 1])?;
+        r[j][i] = g.mul(two, lower)?;
+        r[i][j] = g.mul(two, upper)?;
+    }
+    Ok(r)
 }
 
 /// The axis as a unit vector in the joint frame.

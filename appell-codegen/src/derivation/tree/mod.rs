@@ -81,8 +81,9 @@ pub fn structured(
     let mut s = controller(model, spec)?;
     let parts = links::Parts::new(model)?;
     let gravity = links::gravity(&mut model.g, spec)?;
-    let reduced = links::links(&mut model.g, spec, &parts, fixed)?;
-    let mut r = recursions::Recursions::new(&mut model.g, &reduced, gravity)?;
+    let reduced = links::links(&mut model.g, spec, &parts, fixed, links::Index::Speeds)?;
+    let size = parts.speeds.len();
+    let mut r = recursions::Recursions::new(&mut model.g, &reduced, gravity, size)?;
     s.accelerations = r.articulated_body(&parts.speeds)?;
     Ok(s)
 }
@@ -91,9 +92,10 @@ pub fn structured(
 /// and the controller functions need, at the coordinates as they are.
 pub fn controller(model: &mut Model, spec: &TreeSpec) -> Result<Structured, SymbolicError> {
     let parts = links::Parts::new(model)?;
-    let free = links::links(&mut model.g, spec, &parts, &[])?;
+    let free = links::links(&mut model.g, spec, &parts, &[], links::Index::Speeds)?;
     let gravity = links::gravity(&mut model.g, spec)?;
-    let mut r = recursions::Recursions::new(&mut model.g, &free, gravity)?;
+    let size = parts.speeds.len();
+    let mut r = recursions::Recursions::new(&mut model.g, &free, gravity, size)?;
     let inverse = r.newton_euler(&parts.speeds, Some(&parts.accels), true)?;
     let bias = r.newton_euler(&parts.speeds, None, true)?;
     let gravity_term = r.newton_euler(&parts.speeds, None, false)?;

@@ -93,9 +93,9 @@ pub fn projected(
     let c = at_zero.apply_all(g, &map.c)?;
     let qdot = at_zero.apply_all(g, &map.qdot)?;
     let qddot = at_zero.apply_all(g, &rates)?;
-    let tree = links::links(g, spec, &parts, fixed)?;
+    let tree = links::links(g, spec, &parts, fixed, links::Index::Coordinates)?;
     let gravity = links::gravity(g, spec)?;
-    let mut r = Recursions::new(g, &tree, gravity)?;
+    let mut r = Recursions::new(g, &tree, gravity, n)?;
     let forces = r.newton_euler(&qdot, Some(&qddot), true)?;
     let mass_q = r.composite_rigid_body()?;
     let torques = r.inputs();

@@ -16,11 +16,19 @@ pub struct Recursions<'g, 'l> {
     links: &'l [Link],
     /// The ground's acceleration: −gravity.
     ground: V6,
+    /// How many speeds the links' columns index.
+    size: usize,
 }
 
 impl<'g, 'l> Recursions<'g, 'l> {
-    /// The recursions over `links` under `gravity` (in N's axes).
-    pub fn new(g: &'g mut Graph, links: &'l [Link], gravity: V3) -> R<Recursions<'g, 'l>> {
+    /// The recursions over `links`, whose columns index `size` speeds,
+    /// under `gravity` (in N's axes).
+    pub fn new(
+        g: &'g mut Graph,
+        links: &'l [Link],
+        gravity: V3,
+        size: usize,
+    ) -> R<Recursions<'g, 'l>> {
         let a = Algebra::new(g)?;
         let zero = a.zero();
         let up = [
@@ -32,17 +40,29 @@ impl<'g, 'l> Recursions<'g, 'l> {
             a,
             links,
             ground: join([zero; 3], up),
+            size,
         })
+    }
+
+    /// Σ Sᵢ xᵢ over link `i`'s columns, x indexed by speed.
+    fn along_subspace(&mut self, i: usize, x: &[Id]) -> R<V6> {
+        let link = &self.links[i];
+        let mut out = self.a.scale(link.subspace[0], x[link.speeds[0]])?;
+        for c in 1..link.subspace.len() {
+            let more = self.a.scale(link.subspace[c], x[link.speeds[c]])?;
+            out = self.a.add(out, more)?;
+        }
+        Ok(out)
     }
 
     /// Each link's velocity and the joint's velocity S q̇.
     fn velocities(&mut self, speeds: &[Id]) -> R<Vec<(V6, V6)>> {
         let mut out: Vec<(V6, V6)> = Vec::with_capacity(self.links.len());
-        for (i, link) in self.links.iter().enumerate() {
-            let joint = self.a.scale(link.subspace, speeds[i])?;
-            let v = match link.parent {
+        for i in 0..self.links.len() {
+            let joint = self.along_subspace(i, speeds)?;
+            let v = match self.links[i].parent {
                 Some(p) => {
-                    let moved = self.a.motion_to_child(&link.transform, out[p].0)?;
+                    let moved = self.a.motion_to_child(&self.links[i].transform, out[p].0)?;
                     self.a.add(moved, joint)?
                 }
                 None => joint,
@@ -62,10 +82,13 @@ impl<'g, 'l> Recursions<'g, 'l> {
         self.a.motion_to_child(&link.transform, parent)
     }
 
-    /// Sᵀ x.
-    fn project(&mut self, i: usize, x: V6) -> R<Id> {
-        let s = self.links[i].subspace;
-        self.a.dot((0..6).map(|k| (s[k], x[k])))
+    /// Sᵀ x, one entry per column of link `i`.
+    fn project(&mut self, i: usize, x: V6) -> R<Vec<Id>> {
+        let columns = self.links[i].subspace.clone();
+        columns
+            .iter()
+            .map(|s| self.a.dot((0..6).map(|k| (s[k], x[k]))))
+            .collect()
     }
 
     /// The generalized forces M ÿ + h by recursive Newton–Euler, at
@@ -79,7 +102,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
     ) -> R<Vec<Id>> {
         let n = self.links.len();
         let zero = self.a.zero();
-        let rest = vec![zero; n];
+        let rest = vec![zero; self.size];
         let speeds = if moving { speeds } else { &rest[..] };
         let vel = self.velocities(speeds)?;
         let mut acc: Vec<V6> = Vec::with_capacity(n);
@@ -87,7 +110,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
         for i in 0..n {
             let mut a = self.parent_acceleration(i, &acc)?;
             if let Some(qdd) = accels {
-                let sa = self.a.scale(self.links[i].subspace, qdd[i])?;
+                let sa = self.along_subspace(i, qdd)?;
                 a = self.a.add(a, sa)?;
             }
             let (v, joint) = vel[i];
@@ -100,9 +123,12 @@ impl<'g, 'l> Recursions<'g, 'l> {
             forces.push(self.a.add(ia, gyro)?);
             acc.push(a);
         }
-        let mut tau = vec![zero; n];
+        let mut tau = vec![zero; self.size];
         for i in (0..n).rev() {
-            tau[i] = self.project(i, forces[i])?;
+            let projected = self.project(i, forces[i])?;
+            for (c, value) in projected.into_iter().enumerate() {
+                tau[self.links[i].speeds[c]] = value;
+            }
             if let Some(p) = self.links[i].parent {
                 let moved = self
                     .a
@@ -127,12 +153,18 @@ impl<'g, 'l> Recursions<'g, 'l> {
 
     /// The joints' inputs as generalized forces, in speed order.
     pub fn inputs(&self) -> Vec<Id> {
-        self.links.iter().map(|l| l.input).collect()
+        let mut out = vec![self.a.zero(); self.size];
+        for link in self.links {
+            for (c, &input) in link.inputs.iter().enumerate() {
+                out[link.speeds[c]] = input;
+            }
+        }
+        out
     }
 
-    /// M by the composite-rigid-body algorithm, l×l row-major.
+    /// M by the composite-rigid-body algorithm, row-major over the speeds.
     pub fn composite_rigid_body(&mut self) -> R<Vec<Id>> {
-        let n = self.links.len();
+        let (n, size) = (self.links.len(), self.size);
         let mut composite: Vec<M6> = self.links.iter().map(|l| l.inertia).collect();
         for i in (0..n).rev() {
             if let Some(p) = self.links[i].parent {
@@ -140,22 +172,33 @@ impl<'g, 'l> Recursions<'g, 'l> {
                 composite[p] = self.a.add6(&composite[p], &moved)?;
             }
         }
-        let mut m = vec![self.a.zero(); n * n];
+        let mut m = vec![self.a.zero(); size * size];
         for i in 0..n {
-            let mut f = self.a.mat6_vec(&composite[i], self.links[i].subspace)?;
-            m[i * n + i] = self.project(i, f)?;
-            let mut j = i;
-            while let Some(p) = self.links[j].parent {
-                f = self.a.force_to_parent(&self.links[j].transform, f)?;
-                j = p;
-                m[i * n + j] = self.project(j, f)?;
-                m[j * n + i] = m[i * n + j];
+            let columns = self.links[i].subspace.clone();
+            for (c, s) in columns.iter().enumerate() {
+                let row = self.links[i].speeds[c];
+                let mut f = self.a.mat6_vec(&composite[i], *s)?;
+                for (d, value) in self.project(i, f)?.into_iter().enumerate() {
+                    let col = self.links[i].speeds[d];
+                    m[row * size + col] = value;
+                }
+                let mut j = i;
+                while let Some(p) = self.links[j].parent {
+                    f = self.a.force_to_parent(&self.links[j].transform, f)?;
+                    j = p;
+                    for (d, value) in self.project(j, f)?.into_iter().enumerate() {
+                        let col = self.links[j].speeds[d];
+                        m[row * size + col] = value;
+                        m[col * size + row] = value;
+                    }
+                }
             }
         }
         Ok(m)
     }
 
-    /// ÿ by the articulated-body algorithm, the inputs as the joint forces.
+    /// ÿ by the articulated-body algorithm, the inputs as the joint
+    /// forces, in speed order.
     pub fn articulated_body(&mut self, speeds: &[Id]) -> R<Vec<Id>> {
         let n = self.links.len();
         let vel = self.velocities(speeds)?;
@@ -167,47 +210,174 @@ impl<'g, 'l> Recursions<'g, 'l> {
             let iv = self.a.mat6_vec(&self.links[i].inertia, *v)?;
             bias.push(self.a.cross_force(*v, iv)?);
         }
-        let zero = self.a.zero();
-        let (mut u, mut d_inv, mut big_u) = (vec![zero; n], vec![zero; n], vec![[zero; 6]; n]);
+        let mut solved: Vec<Articulated> = Vec::with_capacity(n);
         for i in (0..n).rev() {
-            let s = self.links[i].subspace;
-            big_u[i] = self.a.mat6_vec(&inertia[i], s)?;
-            let d = self.project(i, big_u[i])?;
-            d_inv[i] = self.a.g.recip(d)?;
-            let sp = self.project(i, bias[i])?;
-            u[i] = self.a.g.sub(self.links[i].input, sp)?;
-            let Some(p) = self.links[i].parent else {
-                continue;
-            };
-            let ud = self.a.scale(big_u[i], d_inv[i])?;
-            let mut ia = inertia[i];
-            for r in 0..6 {
-                for c in r..6 {
-                    let outer = self.a.dot([(ud[r], big_u[i][c])])?;
-                    ia[r][c] = self.a.g.sub(ia[r][c], outer)?;
-                    ia[c][r] = ia[r][c];
-                }
+            let step = self.articulate(i, &inertia[i], bias[i])?;
+            if let Some(p) = self.links[i].parent {
+                let (ia, pa) = self.handed_on(i, &step, &inertia[i], bias[i], coriolis[i])?;
+                let transform = self.links[i].transform;
+                let moved = self.a.congruence(&transform, &ia)?;
+                inertia[p] = self.a.add6(&inertia[p], &moved)?;
+                let pushed = self.a.force_to_parent(&transform, pa)?;
+                bias[p] = self.a.add(bias[p], pushed)?;
             }
-            let ic = self.a.mat6_vec(&ia, coriolis[i])?;
-            let uu = self.a.scale(ud, u[i])?;
-            let pa = self.a.add(bias[i], ic)?;
-            let pa = self.a.add(pa, uu)?;
-            let moved = self.a.congruence(&self.links[i].transform, &ia)?;
-            inertia[p] = self.a.add6(&inertia[p], &moved)?;
-            let pushed = self.a.force_to_parent(&self.links[i].transform, pa)?;
-            bias[p] = self.a.add(bias[p], pushed)?;
+            solved.push(step);
         }
+        solved.reverse();
+        let zero = self.a.zero();
         let mut acc: Vec<V6> = Vec::with_capacity(n);
-        let mut qdd = vec![zero; n];
+        let mut qdd = vec![zero; self.size];
         for i in 0..n {
             let parent = self.parent_acceleration(i, &acc)?;
             let a = self.a.add(parent, coriolis[i])?;
-            let ua = self.a.dot((0..6).map(|k| (big_u[i][k], a[k])))?;
-            let num = self.a.g.sub(u[i], ua)?;
-            qdd[i] = self.a.g.mul(num, d_inv[i])?;
-            let sa = self.a.scale(self.links[i].subspace, qdd[i])?;
+            let step = &solved[i];
+            let k = step.u.len();
+            let mut free = Vec::with_capacity(k);
+            for c in 0..k {
+                let ua = self.a.dot((0..6).map(|r| (step.big_u[c][r], a[r])))?;
+                free.push(self.a.g.sub(step.u[c], ua)?);
+            }
+            for c in 0..k {
+                let value = self.a.dot((0..k).map(|d| (free[d], step.d_inv[c][d])))?;
+                qdd[self.links[i].speeds[c]] = value;
+            }
+            let sa = self.along_subspace(i, &qdd)?;
             acc.push(self.a.add(a, sa)?);
         }
         Ok(qdd)
+    }
+
+    /// Link `i`'s articulated quantities: U = I S, D⁻¹ = (Sᵀ U)⁻¹ and
+    /// u = τ − Sᵀ p.
+    fn articulate(&mut self, i: usize, inertia: &M6, bias: V6) -> R<Articulated> {
+        let columns = self.links[i].subspace.clone();
+        let k = columns.len();
+        let mut big_u = Vec::with_capacity(k);
+        for s in &columns {
+            big_u.push(self.a.mat6_vec(inertia, *s)?);
+        }
+        let mut d = vec![vec![self.a.zero(); k]; k];
+        for (c, row) in d.iter_mut().enumerate() {
+            for (e, x) in row.iter_mut().enumerate().skip(c) {
+                *x = self.project(i, big_u[e])?[c];
+            }
+        }
+        for c in 0..k {
+            for e in 0..c {
+                d[c][e] = d[e][c];
+            }
+        }
+        let d_inv = symmetric_inverse(&mut self.a, &d)?;
+        let sp = self.project(i, bias)?;
+        let mut u = Vec::with_capacity(k);
+        for c in 0..k {
+            u.push(self.a.g.sub(self.links[i].inputs[c], sp[c])?);
+        }
+        Ok(Articulated { big_u, d_inv, u })
+    }
+
+    /// What link `i` hands its parent, in its own axes: its articulated
+    /// inertia Iᴬ − U D⁻¹ Uᵀ and bias p + Iᴬ' c + U D⁻¹ u.
+    fn handed_on(
+        &mut self,
+        i: usize,
+        step: &Articulated,
+        inertia: &M6,
+        bias: V6,
+        coriolis: V6,
+    ) -> R<(M6, V6)> {
+        let k = step.u.len();
+        let mut ud = Vec::with_capacity(k);
+        for c in 0..k {
+            let mut column = [self.a.zero(); 6];
+            for (r, x) in column.iter_mut().enumerate() {
+                *x = self
+                    .a
+                    .dot((0..k).map(|e| (step.big_u[e][r], step.d_inv[e][c])))?;
+            }
+            ud.push(column);
+        }
+        // Rows and columns along a coordinate axis of a ball's subspace
+        // vanish: (Iᴬ − U D⁻¹ Uᵀ) S = 0.
+        let axes = if k > 1 { self.axes_of(i) } else { Vec::new() };
+        let mut ia = *inertia;
+        for r in 0..6 {
+            for c in r..6 {
+                if axes.contains(&r) || axes.contains(&c) {
+                    ia[r][c] = self.a.zero();
+                } else {
+                    let outer = self.a.dot((0..k).map(|e| (ud[e][r], step.big_u[e][c])))?;
+                    ia[r][c] = self.a.g.sub(ia[r][c], outer)?;
+                }
+                ia[c][r] = ia[r][c];
+            }
+        }
+        let ic = self.a.mat6_vec(&ia, coriolis)?;
+        let mut pushes = Vec::with_capacity(k);
+        for c in 0..k {
+            pushes.push(self.a.scale(ud[c], step.u[c])?);
+        }
+        let mut pa = self.a.add(bias, ic)?;
+        for uu in pushes {
+            pa = self.a.add(pa, uu)?;
+        }
+        Ok((ia, pa))
+    }
+
+    /// The axes (0..6) along which link `i`'s columns are unit vectors, when
+    /// every column is one.
+    fn axes_of(&self, i: usize) -> Vec<usize> {
+        let g = &*self.a.g;
+        let mut axes = Vec::new();
+        for s in &self.links[i].subspace {
+            let ones: Vec<usize> = (0..6).filter(|&r| !g.is_zero(s[r])).collect();
+            match ones[..] {
+                [r] if g.as_number(s[r]).is_some_and(|x| x.is_one()) => axes.push(r),
+                _ => return Vec::new(),
+            }
+        }
+        axes
+    }
+}
+
+/// One link's quantities of the articulated-body algorithm.
+struct Articulated {
+    /// U = Iᴬ S, a column per speed.
+    big_u: Vec<V6>,
+    /// D⁻¹ = (Sᵀ Iᴬ S)⁻¹.
+    d_inv: Vec<Vec<Id>>,
+    /// u = τ − Sᵀ pᴬ.
+    u: Vec<Id>,
+}
+
+/// The inverse of a symmetric 1×1 or 3×3 matrix (a ball's), by its
+/// cofactors over the determinant.
+fn symmetric_inverse(a: &mut Algebra, d: &[Vec<Id>]) -> R<Vec<Vec<Id>>> {
+    match d.len() {
+        1 => Ok(vec![vec![a.g.recip(d[0][0])?]]),
+        3 => {
+            let mut cof = vec![vec![a.zero(); 3]; 3];
+            for r in 0..3 {
+                for c in r..3 {
+                    let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
+                    let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
+                    let one = a.dot([(d[r1][c1], d[r2][c2])])?;
+                    let two = a.dot([(d[r1][c2], d[r2][c1])])?;
+                    cof[c][r] = a.g.sub(one, two)?;
+                    cof[r][c] = cof[c][r];
+                }
+            }
+            let det = a.dot((0..3).map(|c| (d[0][c], cof[0][c])))?;
+            let inv = a.g.recip(det)?;
+            for row in cof.iter_mut() {
+                for x in row.iter_mut() {
+                    *x = a.g.mul(*x, inv)?;
+                }
+            }
+            Ok(cof)
+        }
+        k => Err(SymbolicError::UnknownSymbol {
+            name: format!("a joint of {k} degrees of freedom in the articulated-body algorithm"),
+        }),
     }
 }

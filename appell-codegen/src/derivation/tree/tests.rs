@@ -59,17 +59,59 @@ fn state(d: &Derived, seed: u64) -> Vec<(String, f64)> {
     for (name, _) in &d.model.inputs {
         out.push((name.to_string(), next()));
     }
+    // Quaternions on the unit sphere, where the model's rotations are.
+    let names: Vec<String> = out.iter().map(|(n, _)| n.clone()).collect();
+    for (k, name) in names.iter().enumerate() {
+        if let Some(joint) = name.strip_suffix("_qw") {
+            let at: Vec<usize> = ["_qw", "_qx", "_qy", "_qz"]
+                .iter()
+                .map(|s| names.iter().position(|n| *n == format!("{joint}{s}")).unwrap())
+                .collect();
+            let norm = at.iter().map(|&i| out[i].1 * out[i].1).sum::<f64>().sqrt();
+            at.iter().for_each(|&i| out[i].1 /= norm);
+            assert_eq!(at[0], k);
+        }
+    }
     out
 }
 
+/// A free base carrying an arm whose second joint is a ball, with the
+/// base's mass centre off its origin.
+const BALLS: &str = r#"
+    #[appell(joint(base, free, parent = N, child = b))]
+    #[appell(joint(j_1, revolute(y), parent = b, child = l_1, xyz = [0.1, 0.05, 0.2], actuated))]
+    #[appell(joint(ball, spherical, parent = l_1, child = l_2, xyz = [0, 0, 0.3], rpy = [0.2, 0, -0.4]))]
+    #[appell(body(base_body, frame = b, mass = m, center = origin(b) + 0.03 * b.x - 0.02 * b.z,
+                  inertia = matrix(0.2, 0.25, 0.3, 0.01, -0.02, 0.015)))]
+    #[appell(body(b_1, frame = l_1, mass = 1.3, center = origin(l_1) + 0.15 * l_1.z,
+                  inertia = principal(0.04, 0.05, 0.02)))]
+    #[appell(body(b_2, frame = l_2, mass = 0.7, center = origin(l_2) + 0.1 * l_2.x + 0.2 * l_2.z,
+                  inertia = principal(0.01, 0.02, 0.015)))]
+    #[appell(gravity(-9.81 * N.z))]
+    struct Balls { m: f64 }
+"#;
+
 #[test]
 fn structured_form_agrees_with_the_closed_form() {
-    let mut d = derived(MIXED);
+    agrees_with_the_closed_form(MIXED, 5, 4);
+}
+
+#[test]
+fn free_and_spherical_joints_agree_with_the_closed_form() {
+    // The free joint's three slides and ball, the revolute, the ball.
+    agrees_with_the_closed_form(BALLS, 6, 10);
+}
+
+/// M, the bias, inverse dynamics, ÿ, the gravity term and T of the
+/// structured form against the closed form's at random states.
+fn agrees_with_the_closed_form(src: &str, links: usize, speeds: usize) {
+    let mut d = derived(src);
     let spec = d.model.tree.clone().expect("a tree");
-    assert_eq!(spec.links.len(), 5);
+    assert_eq!(spec.links.len(), links);
+    spec.plain.clone().expect("plain");
     let s = structured(&mut d.model, &spec, &[]).expect("structured");
     let l = d.full.l;
-    assert_eq!(l, 4);
+    assert_eq!(l, speeds);
     let (mass, forcing) = (
         d.full.equations.mass.clone(),
         d.full.equations.forcing.clone(),
