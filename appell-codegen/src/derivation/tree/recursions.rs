@@ -297,9 +297,9 @@ impl<'g, 'l> Recursions<'g, 'l> {
             }
             ud.push(column);
         }
-        // Rows and columns along a coordinate axis of a ball's subspace
-        // vanish: (Iᴬ − U D⁻¹ Uᵀ) S = 0.
-        let axes = if k > 1 { self.axes_of(i) } else { Vec::new() };
+        // Rows and columns along a coordinate axis of the subspace vanish:
+        // (Iᴬ − U D⁻¹ Uᵀ) S = 0.
+        let axes = self.axes_of(i);
         let mut ia = *inertia;
         for r in 0..6 {
             for c in r..6 {
@@ -324,15 +324,15 @@ impl<'g, 'l> Recursions<'g, 'l> {
         Ok((ia, pa))
     }
 
-    /// The axes (0..6) along which link `i`'s columns are unit vectors, when
-    /// every column is one.
+    /// The axes (0..6) along which link `i`'s columns lie, when every
+    /// column lies along one.
     fn axes_of(&self, i: usize) -> Vec<usize> {
         let g = &*self.a.g;
         let mut axes = Vec::new();
         for s in &self.links[i].subspace {
-            let ones: Vec<usize> = (0..6).filter(|&r| !g.is_zero(s[r])).collect();
-            match ones[..] {
-                [r] if g.as_number(s[r]).is_some_and(|x| x.is_one()) => axes.push(r),
+            let along: Vec<usize> = (0..6).filter(|&r| !g.is_zero(s[r])).collect();
+            match along[..] {
+                [r] => axes.push(r),
                 _ => return Vec::new(),
             }
         }

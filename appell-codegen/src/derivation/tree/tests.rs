@@ -65,7 +65,12 @@ fn state(d: &Derived, seed: u64) -> Vec<(String, f64)> {
         if let Some(joint) = name.strip_suffix("_qw") {
             let at: Vec<usize> = ["_qw", "_qx", "_qy", "_qz"]
                 .iter()
-                .map(|s| names.iter().position(|n| *n == format!("{joint}{s}")).unwrap())
+                .map(|s| {
+                    names
+                        .iter()
+                        .position(|n| *n == format!("{joint}{s}"))
+                        .unwrap()
+                })
                 .collect();
             let norm = at.iter().map(|&i| out[i].1 * out[i].1).sum::<f64>().sqrt();
             at.iter().for_each(|&i| out[i].1 /= norm);
