@@ -321,10 +321,12 @@ fn project(model: &mut Model, d: &mut Derivation) -> Result<(), SymbolicError> {
     // projected tree does not separate.
     // A ball's speeds are not its coordinates' rates, which the projection
     // runs the recursions in.
-    let ball = spec
-        .links
-        .iter()
-        .any(|k| matches!(k.motion, Some(crate::model::tree::Motion::Spherical)));
+    let ball = spec.links.iter().any(|k| {
+        matches!(
+            k.motion,
+            Some(crate::model::tree::Motion::Spherical | crate::model::tree::Motion::Free)
+        )
+    });
     if spec.plain.is_ok()
         || !matches!(d.elimination, Elimination::Symbolic)
         || !model.scenes.is_empty()

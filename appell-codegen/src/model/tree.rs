@@ -31,6 +31,11 @@ pub enum Motion {
     /// relative to the joint frame in the child's axes (its speeds
     /// `{joint}_wx, _wy, _wz`).
     Spherical,
+    /// Slide along the joint frame's axes by `{joint}_x, _y, _z` and turn
+    /// as a ball: the speeds are the ball's and the slides' rates (in the
+    /// joint frame's axes); the recursions run in the child's velocity in
+    /// its own axes and convert (see `derivation::tree::free`).
+    Free,
 }
 
 /// One term of a vector fixed in a link: `coefficient · F.axis`, with `F`
@@ -482,14 +487,7 @@ fn links_of(
             ]
         }
         JointKind::Spherical => vec![link(name, Some(Motion::Spherical))],
-        // Three massless slides along the joint frame's axes, then the
-        // ball that carries the child.
-        JointKind::Free => vec![
-            link(format!("{name}_x"), slide(0)),
-            next(format!("{name}_y"), first, slide(1)),
-            next(format!("{name}_z"), first + 1, slide(2)),
-            next(name, first + 2, Some(Motion::Spherical)),
-        ],
+        JointKind::Free => vec![link(name, Some(Motion::Free))],
         _ => vec![link(name, None)],
     }))
 }
@@ -501,6 +499,9 @@ fn link_coordinates(joint: &str, motion: Option<&Motion>) -> Vec<String> {
         Some(Motion::Spherical) => ["w", "x", "y", "z"]
             .map(|c| format!("{joint}_q{c}"))
             .to_vec(),
+        Some(Motion::Free) => ["_qw", "_qx", "_qy", "_qz", "_x", "_y", "_z"]
+            .map(|c| format!("{joint}{c}"))
+            .to_vec(),
         Some(_) => vec![joint.to_string()],
     }
 }
@@ -510,6 +511,9 @@ fn link_speeds(joint: &str, motion: Option<&Motion>) -> Vec<String> {
     match motion {
         None => Vec::new(),
         Some(Motion::Spherical) => ["x", "y", "z"].map(|c| format!("{joint}_w{c}")).to_vec(),
+        Some(Motion::Free) => ["_wx", "_wy", "_wz", "_x", "_y", "_z"]
+            .map(|c| format!("{joint}{c}"))
+            .to_vec(),
         Some(_) => vec![joint.to_string()],
     }
 }

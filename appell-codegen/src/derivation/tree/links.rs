@@ -30,6 +30,10 @@ pub struct Link {
     pub inertia: M6,
     /// The joint's input along each column, or 0.
     pub inputs: Vec<Id>,
+    /// A free joint's rotation of the child from the joint frame: its
+    /// columns turn the child's velocity, in which the recursions run, into
+    /// the rates of the joint's slides (see [`super::free`]).
+    pub free: Option<M3>,
 }
 
 /// The symbols the links are written in, in speed order.
@@ -173,7 +177,7 @@ pub fn links(
             .iter()
             .map(|s| parts.speed(s, index))
             .collect::<R<Vec<_>>>()?;
-        let (transform, subspace) = joint(&mut a, &joint_frame, motion, &q)?;
+        let (transform, subspace, free) = joint(&mut a, &joint_frame, motion, &q)?;
         let input = match parts
             .inputs
             .iter()
@@ -191,6 +195,7 @@ pub fn links(
             speeds,
             inertia,
             inputs,
+            free,
         });
         places.push(Place {
             moving: Some(out.len() - 1),
@@ -206,9 +211,13 @@ pub fn gravity(g: &mut Graph, spec: &TreeSpec) -> R<V3> {
     terms_vector(&mut a, &spec.gravity)
 }
 
-/// The joint's transform from the parent link and its motion subspace's
-/// columns, at the coordinates `q` its motion reads.
-fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<(Transform, Vec<V6>)> {
+/// What a joint contributes: its transform from the parent link, its
+/// motion subspace's columns and, for a free joint, its rotation.
+type Joint = (Transform, Vec<V6>, Option<M3>);
+
+/// The joint's transform, subspace and rotation at the coordinates `q`
+/// its motion reads.
+fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<Joint> {
     let zero = a.zero();
     match motion {
         Motion::Revolute(axis) => {
@@ -216,13 +225,8 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<(Tr
             let turn = rotation_about(a, axis, u, q[0])?;
             let rot = a.mat_mul(&frame.rot, &turn)?;
             let s = [u[0], u[1], u[2], zero, zero, zero];
-            Ok((
-                Transform {
-                    rot,
-                    pos: frame.pos,
-                },
-                vec![s],
-            ))
+            let pos = frame.pos;
+            Ok((Transform { rot, pos }, vec![s], None))
         }
         Motion::Prismatic(axis) => {
             let u = unit_axis(a, axis)?;
@@ -230,34 +234,35 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<(Tr
             let slide = a.scale(along, q[0])?;
             let pos = a.add(frame.pos, slide)?;
             let s = [zero, zero, zero, u[0], u[1], u[2]];
-            Ok((
-                Transform {
-                    rot: frame.rot,
-                    pos,
-                },
-                vec![s],
-            ))
+            let rot = frame.rot;
+            Ok((Transform { rot, pos }, vec![s], None))
         }
         Motion::Spherical => {
             let turn = quaternion_rotation(a, [q[0], q[1], q[2], q[3]])?;
             let rot = a.mat_mul(&frame.rot, &turn)?;
-            let one = a.g.int(1)?;
-            let columns = (0..3)
-                .map(|k| {
-                    let mut s = [zero; 6];
-                    s[k] = one;
-                    s
-                })
-                .collect();
-            Ok((
-                Transform {
-                    rot,
-                    pos: frame.pos,
-                },
-                columns,
-            ))
+            let pos = frame.pos;
+            Ok((Transform { rot, pos }, unit_columns(a, 3)?, None))
+        }
+        Motion::Free => {
+            let turn = quaternion_rotation(a, [q[0], q[1], q[2], q[3]])?;
+            let rot = a.mat_mul(&frame.rot, &turn)?;
+            let slide = a.mat_vec(&frame.rot, [q[4], q[5], q[6]])?;
+            let pos = a.add(frame.pos, slide)?;
+            Ok((Transform { rot, pos }, unit_columns(a, 6)?, Some(turn)))
         }
     }
+}
+
+/// The first `k` unit vectors of the spatial axes.
+fn unit_columns(a: &mut Algebra, k: usize) -> R<Vec<V6>> {
+    let (one, zero) = (a.g.int(1)?, a.zero());
+    Ok((0..k)
+        .map(|c| {
+            let mut s = [zero; 6];
+            s[c] = one;
+            s
+        })
+        .collect())
 }
 
 /// The rotation by the quaternion e = (e0, e1, e2, e3), scalar first: the

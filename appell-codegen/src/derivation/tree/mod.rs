@@ -14,6 +14,7 @@
 //! Input: the model's [`TreeSpec`]; output: [`Structured`].
 
 pub mod equations;
+mod free;
 mod links;
 pub mod projected;
 mod recursions;
@@ -23,6 +24,7 @@ use appell_symbolic::{Id, SymbolicError};
 
 use crate::model::tree::TreeSpec;
 use crate::model::Model;
+use spatial::Algebra;
 
 pub use links::Link;
 
@@ -82,9 +84,12 @@ pub fn structured(
     let parts = links::Parts::new(model)?;
     let gravity = links::gravity(&mut model.g, spec)?;
     let reduced = links::links(&mut model.g, spec, &parts, fixed, links::Index::Speeds)?;
+    let body = free::speeds_in(&mut Algebra::new(&mut model.g)?, &reduced, &parts.speeds)?;
     let size = parts.speeds.len();
     let mut r = recursions::Recursions::new(&mut model.g, &reduced, gravity, size)?;
-    s.accelerations = r.articulated_body(&parts.speeds)?;
+    let body_accels = r.articulated_body(&body)?;
+    let mut a = Algebra::new(&mut model.g)?;
+    s.accelerations = free::accelerations_out(&mut a, &reduced, &body, &body_accels)?;
     Ok(s)
 }
 
@@ -92,22 +97,34 @@ pub fn structured(
 /// and the controller functions need, at the coordinates as they are.
 pub fn controller(model: &mut Model, spec: &TreeSpec) -> Result<Structured, SymbolicError> {
     let parts = links::Parts::new(model)?;
-    let free = links::links(&mut model.g, spec, &parts, &[], links::Index::Speeds)?;
+    let tree = links::links(&mut model.g, spec, &parts, &[], links::Index::Speeds)?;
     let gravity = links::gravity(&mut model.g, spec)?;
     let size = parts.speeds.len();
-    let mut r = recursions::Recursions::new(&mut model.g, &free, gravity, size)?;
-    let inverse = r.newton_euler(&parts.speeds, Some(&parts.accels), true)?;
-    let bias = r.newton_euler(&parts.speeds, None, true)?;
-    let gravity_term = r.newton_euler(&parts.speeds, None, false)?;
+    // The recursions' speeds and accelerations (a free joint's in its
+    // child's axes), at the model's and at zero model accelerations.
+    let (body, body_accels, resting) = {
+        let mut a = Algebra::new(&mut model.g)?;
+        let body = free::speeds_in(&mut a, &tree, &parts.speeds)?;
+        let accels = free::accelerations_in(&mut a, &tree, &body, &parts.accels)?;
+        let zero = vec![a.zero(); size];
+        let resting = free::accelerations_in(&mut a, &tree, &body, &zero)?;
+        (body, accels, resting)
+    };
+    let mut r = recursions::Recursions::new(&mut model.g, &tree, gravity, size)?;
+    let inverse = r.newton_euler(&body, Some(&body_accels), true)?;
+    let bias = r.newton_euler(&body, Some(&resting), true)?;
+    let gravity_term = r.newton_euler(&body, None, false)?;
     let mass = r.composite_rigid_body()?;
-    let kinetic = r.kinetic_energy(&parts.speeds)?;
+    let kinetic = r.kinetic_energy(&body)?;
+    let inputs = r.inputs();
+    let mut a = Algebra::new(&mut model.g)?;
     Ok(Structured {
         accelerations: Vec::new(),
-        inverse,
-        mass,
-        bias,
-        gravity: gravity_term,
-        inputs: r.inputs(),
+        inverse: free::forces_out(&mut a, &tree, &inverse)?,
+        mass: free::mass_out(&mut a, &tree, &mass, size)?,
+        bias: free::forces_out(&mut a, &tree, &bias)?,
+        gravity: free::forces_out(&mut a, &tree, &gravity_term)?,
+        inputs,
         kinetic,
     })
 }

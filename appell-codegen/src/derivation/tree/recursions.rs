@@ -237,8 +237,8 @@ impl<'g, 'l> Recursions<'g, 'l> {
                 let ua = self.a.dot((0..6).map(|r| (step.big_u[c][r], a[r])))?;
                 free.push(self.a.g.sub(step.u[c], ua)?);
             }
-            for c in 0..k {
-                let value = self.a.dot((0..k).map(|d| (free[d], step.d_inv[c][d])))?;
+            let solved = step.factor.solve(&mut self.a, &free)?;
+            for (c, value) in solved.into_iter().enumerate() {
                 qdd[self.links[i].speeds[c]] = value;
             }
             let sa = self.along_subspace(i, &qdd)?;
@@ -267,13 +267,13 @@ impl<'g, 'l> Recursions<'g, 'l> {
                 d[c][e] = d[e][c];
             }
         }
-        let d_inv = symmetric_inverse(&mut self.a, &d)?;
+        let factor = Factor::new(&mut self.a, &d)?;
         let sp = self.project(i, bias)?;
         let mut u = Vec::with_capacity(k);
         for c in 0..k {
             u.push(self.a.g.sub(self.links[i].inputs[c], sp[c])?);
         }
-        Ok(Articulated { big_u, d_inv, u })
+        Ok(Articulated { big_u, factor, u })
     }
 
     /// What link `i` hands its parent, in its own axes: its articulated
@@ -287,15 +287,18 @@ impl<'g, 'l> Recursions<'g, 'l> {
         coriolis: V6,
     ) -> R<(M6, V6)> {
         let k = step.u.len();
-        let mut ud = Vec::with_capacity(k);
-        for c in 0..k {
-            let mut column = [self.a.zero(); 6];
-            for (r, x) in column.iter_mut().enumerate() {
-                *x = self
-                    .a
-                    .dot((0..k).map(|e| (step.big_u[e][r], step.d_inv[e][c])))?;
+        // U D⁻¹, a row of U at a time (D is symmetric).
+        let mut ud = vec![[self.a.zero(); 6]; k];
+        for r in 0..6 {
+            let row: Vec<Id> = (0..k).map(|e| step.big_u[e][r]).collect();
+            for (c, x) in step
+                .factor
+                .solve(&mut self.a, &row)?
+                .into_iter()
+                .enumerate()
+            {
+                ud[c][r] = x;
             }
-            ud.push(column);
         }
         // Rows and columns along a coordinate axis of the subspace vanish:
         // (Iᴬ − U D⁻¹ Uᵀ) S = 0.
@@ -344,40 +347,69 @@ impl<'g, 'l> Recursions<'g, 'l> {
 struct Articulated {
     /// U = Iᴬ S, a column per speed.
     big_u: Vec<V6>,
-    /// D⁻¹ = (Sᵀ Iᴬ S)⁻¹.
-    d_inv: Vec<Vec<Id>>,
+    /// D = Sᵀ Iᴬ S, factored.
+    factor: Factor,
     /// u = τ − Sᵀ pᴬ.
     u: Vec<Id>,
 }
 
-/// The inverse of a symmetric 1×1 or 3×3 matrix (a ball's), by its
-/// cofactors over the determinant.
-fn symmetric_inverse(a: &mut Algebra, d: &[Vec<Id>]) -> R<Vec<Vec<Id>>> {
-    match d.len() {
-        1 => Ok(vec![vec![a.g.recip(d[0][0])?]]),
-        3 => {
-            let mut cof = vec![vec![a.zero(); 3]; 3];
-            for r in 0..3 {
-                for c in r..3 {
-                    let (r1, r2) = ((r + 1) % 3, (r + 2) % 3);
-                    let (c1, c2) = ((c + 1) % 3, (c + 2) % 3);
-                    let one = a.dot([(d[r1][c1], d[r2][c2])])?;
-                    let two = a.dot([(d[r1][c2], d[r2][c1])])?;
-                    cof[c][r] = a.g.sub(one, two)?;
-                    cof[r][c] = cof[c][r];
-                }
+/// A symmetric positive definite k×k matrix as L diag(d) Lᵀ, unit lower
+/// L, with the reciprocals of d: one joint's D of the articulated-body
+/// algorithm (1×1 for one degree of freedom, 3×3 for a ball, 6×6 for a
+/// free joint).
+struct Factor {
+    /// L below the diagonal, row-major.
+    lower: Vec<Vec<Id>>,
+    /// 1 / dᵢ.
+    reciprocals: Vec<Id>,
+}
+
+impl Factor {
+    /// The factors of `d`.
+    fn new(a: &mut Algebra, d: &[Vec<Id>]) -> R<Factor> {
+        let k = d.len();
+        let mut lower = vec![vec![a.zero(); k]; k];
+        let mut pivots = vec![a.zero(); k];
+        let mut reciprocals = vec![a.zero(); k];
+        for j in 0..k {
+            // dⱼ = Dⱼⱼ − Σ Lⱼₘ² dₘ; Lᵢⱼ = (Dᵢⱼ − Σ Lᵢₘ Lⱼₘ dₘ) / dⱼ.
+            let mut terms = Vec::with_capacity(j);
+            for m in 0..j {
+                let ld = a.g.mul(lower[j][m], pivots[m])?;
+                terms.push((ld, lower[j][m]));
             }
-            let det = a.dot((0..3).map(|c| (d[0][c], cof[0][c])))?;
-            let inv = a.g.recip(det)?;
-            for row in cof.iter_mut() {
-                for x in row.iter_mut() {
-                    *x = a.g.mul(*x, inv)?;
+            let taken = a.dot(terms)?;
+            pivots[j] = a.g.sub(d[j][j], taken)?;
+            reciprocals[j] = a.g.recip(pivots[j])?;
+            for i in j + 1..k {
+                let mut terms = Vec::with_capacity(j);
+                for m in 0..j {
+                    let ld = a.g.mul(lower[j][m], pivots[m])?;
+                    terms.push((ld, lower[i][m]));
                 }
+                let taken = a.dot(terms)?;
+                let rest = a.g.sub(d[i][j], taken)?;
+                lower[i][j] = a.g.mul(rest, reciprocals[j])?;
             }
-            Ok(cof)
         }
-        k => Err(SymbolicError::UnknownSymbol {
-            name: format!("a joint of {k} degrees of freedom in the articulated-body algorithm"),
-        }),
+        Ok(Factor { lower, reciprocals })
+    }
+
+    /// D⁻¹ b.
+    fn solve(&self, a: &mut Algebra, b: &[Id]) -> R<Vec<Id>> {
+        let k = b.len();
+        let mut x = b.to_vec();
+        for i in 0..k {
+            let taken = a.dot((0..i).map(|m| (self.lower[i][m], x[m])))?;
+            x[i] = a.g.sub(x[i], taken)?;
+        }
+        for i in 0..k {
+            x[i] = a.dot([(x[i], self.reciprocals[i])])?;
+        }
+        for i in (0..k).rev() {
+            let taken = a.dot((i + 1..k).map(|m| (self.lower[m][i], x[m])))?;
+            x[i] = a.g.sub(x[i], taken)?;
+        }
+        Ok(x)
     }
 }
