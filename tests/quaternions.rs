@@ -215,7 +215,7 @@ fn the_chaplygin_ball_rolls_through_every_orientation_conserving_its_integrals()
 
 #[test]
 fn the_quaternion_rates_are_solved_in_closed_form() {
-    // ė = Aᵀ ω / (4 |e|²): no run-time solve, and M is I's diagonal.
+    // ė = Aᵀ ω / 4 on the unit sphere: no run-time solve, and M is I's diagonal.
     for info in [FreeBody::info(), ChaplyginBall::info()] {
         println!("{}: {} operations per rhs", info.name, info.rhs_ops.total);
         assert!(info.symbolic_elimination, "{}", info.name);

@@ -96,8 +96,9 @@ pub fn eliminate(
     }
     // Quaternion rates in closed form; the rest of the system without them.
     let quaternions = model.quaternions.clone();
+    let norms = unit_norms(g, &quaternions, &model.coords, &model.holonomic)?;
     let closed = if quasi {
-        closed_form_blocks(g, &quaternions, dependent, &dp, &rhs, l)?
+        closed_form_blocks(g, (&quaternions, &norms), dependent, &dp, &rhs, l)?
     } else {
         ClosedForm::none(k_unknowns)
     };
@@ -160,7 +161,8 @@ pub fn eliminate(
 /// velocity speeds, 2 (e0 ė − ė0 e⃗ − e⃗ × ė)) form a block A with
 /// A Aᵀ = c I for every e (c = 4 |e|²), so A x = R is x = Aᵀ R / c: no
 /// pivot to prove, no run-time solve. A block is used only when that
-/// identity holds symbolically.
+/// identity holds symbolically; where the model holds |e|² = 1 (every
+/// ball's and free joint's norm), c is taken at that value.
 struct ClosedForm {
     /// The unknowns solved here, with their rows of [B | b].
     solved: Vec<(usize, Vec<Id>)>,
@@ -240,7 +242,7 @@ impl ClosedForm {
 /// (`dependent`: every coordinate's rate, with quasi-velocities).
 fn closed_form_blocks(
     g: &mut appell_symbolic::Graph,
-    quaternions: &[[usize; 4]],
+    (quaternions, norms): (&[[usize; 4]], &[Option<Id>]),
     dependent: &[usize],
     dp: &[Id],
     rhs: &[Id],
@@ -248,7 +250,7 @@ fn closed_form_blocks(
 ) -> Result<ClosedForm, SymbolicError> {
     let k = dependent.len();
     let mut closed = ClosedForm::none(k);
-    for q in quaternions {
+    for (q, norm) in quaternions.iter().zip(norms) {
         let Some(cols) = q
             .iter()
             .map(|c| dependent.iter().position(|d| d == c))
@@ -269,9 +271,12 @@ fn closed_form_blocks(
             .iter()
             .map(|r| cols.iter().map(|c| dp[r * k + c]).collect())
             .collect();
-        let Some(c) = orthogonal_scale(g, &a)? else {
+        let Some(mut c) = orthogonal_scale(g, &a)? else {
             continue;
         };
+        if let Some(n2) = norm {
+            c = on_the_unit_sphere(g, c, *n2)?;
+        }
         // x = Aᵀ R / c, one unknown at a time.
         for (i, &col) in cols.iter().enumerate() {
             let mut row = Vec::with_capacity(l + 1);
@@ -292,6 +297,52 @@ fn closed_form_blocks(
         .remaining
         .retain(|c| !closed.solved.iter().any(|(s, _)| s == c));
     Ok(closed)
+}
+
+/// For each quaternion block, |e|² when the model constrains it to 1 (a
+/// holonomic `Σ e² == 1`, as every ball and free joint writes), else None.
+fn unit_norms(
+    g: &mut appell_symbolic::Graph,
+    quaternions: &[[usize; 4]],
+    coords: &[(syn::Ident, appell_symbolic::Coordinate)],
+    holonomic: &[crate::model::Constraint],
+) -> Result<Vec<Option<Id>>, SymbolicError> {
+    let mut out = Vec::with_capacity(quaternions.len());
+    for block in quaternions {
+        let mut squares = Vec::with_capacity(4);
+        for &c in block {
+            let e = g.sym(coords[c].1.q)?;
+            squares.push(g.mul(e, e)?);
+        }
+        let n2 = g.sum(&squares)?;
+        let one = g.int(1)?;
+        let residual = g.sub(n2, one)?;
+        let mut found = false;
+        for h in holonomic {
+            let diff = g.sub(h.residual, residual)?;
+            let diff = g.expand_outside_functions(diff, 64).unwrap_or(diff);
+            found |= g.is_zero(diff);
+        }
+        out.push(found.then_some(n2));
+    }
+    Ok(out)
+}
+
+/// The scale c = k |e|² of a quaternion block's rows as its value k on the
+/// unit sphere the model's constraint keeps (c itself when it is not a
+/// multiple of |e|² = `n2`): the rates lose a division by |e|², the same
+/// on the sphere.
+fn on_the_unit_sphere(g: &mut appell_symbolic::Graph, c: Id, n2: Id) -> Result<Id, SymbolicError> {
+    for k in [4, 1] {
+        let value = g.int(k)?;
+        let multiple = g.mul(value, n2)?;
+        let diff = g.sub(c, multiple)?;
+        let diff = g.expand_outside_functions(diff, 64).unwrap_or(diff);
+        if g.is_zero(diff) {
+            return Ok(value);
+        }
+    }
+    Ok(c)
 }
 
 /// c when the square matrix `a` has A Aᵀ = c I with c not identically
@@ -442,8 +493,8 @@ mod tests {
 
     #[test]
     fn a_quaternions_rates_are_solved_in_closed_form() {
-        // A ball joint: ė = Aᵀ [0; ω] / (4 |e|²), A = 2 [e; G(e)]; so
-        // ė0 = −(e1 ωx + e2 ωy + e3 ωz) / (2 |e|²).
+        // A ball joint: ė = Aᵀ [0; ω] / (4 |e|²), A = 2 [e; G(e)], and its
+        // unit norm makes 4 |e|² = 4: ė0 = −(e1 ωx + e2 ωy + e3 ωz) / 2.
         let src = r#"
             #[appell(joint(j, spherical, parent = N, child = B))]
             #[appell(body(b, center = B_origin, frame = B, mass = m, inertia = principal(a, b, c)))]
@@ -452,11 +503,30 @@ mod tests {
         let (mut m, _, _, _, solved) = testing::solve(src);
         assert!(solved.schur.is_none());
         // Columns: ωx, ωy, ωz, 1.
-        let e2 = "j_qw^2 + j_qx^2 + j_qy^2 + j_qz^2";
-        assert_agrees(&mut m.g, solved.x[0], &format!("-j_qx / (2 * ({e2}))"));
-        assert_agrees(&mut m.g, solved.x[1], &format!("-j_qy / (2 * ({e2}))"));
-        assert_agrees(&mut m.g, solved.x[4], &format!("j_qw / (2 * ({e2}))"));
+        assert_agrees(&mut m.g, solved.x[0], "-j_qx / 2");
+        assert_agrees(&mut m.g, solved.x[1], "-j_qy / 2");
+        assert_agrees(&mut m.g, solved.x[4], "j_qw / 2");
         assert!(m.g.is_zero(solved.x[3]));
+    }
+
+    #[test]
+    fn a_quaternion_held_at_another_norm_keeps_the_division() {
+        // A frame turned by a quaternion of coordinates whose norm is held
+        // at another value: the rates keep 1 / |e|².
+        let src = r#"
+            #[appell(coordinates(e0, e1, e2, e3))]
+            #[appell(frame(B = N.quaternion(e0, e1, e2, e3)))]
+            #[appell(speeds(wx = 2 * (e0 * dt(e1) - dt(e0) * e1 - e2 * dt(e3) + e3 * dt(e2)),
+                            wy = 2 * (e0 * dt(e2) - dt(e0) * e2 - e3 * dt(e1) + e1 * dt(e3)),
+                            wz = 2 * (e0 * dt(e3) - dt(e0) * e3 - e1 * dt(e2) + e2 * dt(e1))))]
+            #[appell(holonomic(e0 * e0 + e1 * e1 + e2 * e2 + e3 * e3 == 2))]
+            #[appell(body(b, center = O, frame = B, mass = m, inertia = principal(a, b, c)))]
+            struct Loose { m: f64, a: f64, b: f64, c: f64 }
+        "#;
+        let (mut m, _, _, _, solved) = testing::solve(src);
+        let e2 = "e0^2 + e1^2 + e2^2 + e3^2";
+        // ė0 along ωx: −e1 / (2 |e|²).
+        assert_agrees(&mut m.g, solved.x[0], &format!("-e1 / (2 * ({e2}))"));
     }
 
     #[test]

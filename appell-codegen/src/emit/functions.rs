@@ -729,6 +729,46 @@ impl Emitter<'_> {
         });
         quote!({ #params_t #(#binds)* #statements #(#tests)* })
     }
+
+    /// A quaternion of the reduced state with zero length is an error in
+    /// `rhs` itself: the rates no longer divide by its length (they hold
+    /// on the unit sphere), so nothing else would turn non-finite. One
+    /// comparison per quaternion, of a sum of the squares the rotation
+    /// computes anyway. Statements for the closure, where the state is
+    /// bound.
+    pub(super) fn quaternion_length_checks(&self) -> TokenStream {
+        let p = p();
+        let model = self.model;
+        let retained = &self.d.reduction.retained;
+        let g = &model.g;
+        let mut checked = Vec::new();
+        for block in &model.quaternions {
+            if !block.iter().all(|c| retained.contains(c)) {
+                continue;
+            }
+            let symbols: Vec<Symbol> = block.iter().map(|&c| model.coords[c].1.q).collect();
+            // The block's squared length: the norm reading its four
+            // coordinates and nothing else.
+            let found = model.norms.iter().find(|(n2, _)| {
+                let deps = g.dependencies(*n2);
+                deps.len() == 4 && symbols.iter().all(|s| deps.contains(*s))
+            });
+            if let Some((id, label)) = found {
+                checked.push((*id, label.clone()));
+            }
+        }
+        if checked.is_empty() {
+            return TokenStream::new();
+        }
+        let roots: Vec<Id> = checked.iter().map(|(n2, _)| *n2).collect();
+        let mut c = code(&model.g, &roots, Target::Generic { hoist: false });
+        let statements = c.take_statements();
+        let tests = checked.iter().enumerate().map(|(k, (_, label))| {
+            let (value, what) = (&c.outputs[k], format!("{label} has zero length"));
+            quote!(if !(#p::Scalar::re(#value) > 1e-20) { return #p::Err(#p::ModelError::NonFinite { what: #what }); })
+        });
+        quote!({ #statements #(#tests)* })
+    }
 }
 
 /// The graph's zero and the identity matrix: N's rotation, which the

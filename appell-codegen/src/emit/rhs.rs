@@ -239,6 +239,7 @@ impl Emitter<'_> {
             self.check("__dstate", ns),
         ];
         let diagnose = self.non_finite_diagnosis();
+        let quaternions = self.quaternion_length_checks();
         let prepare = quote! {
             fn prepare<__T: #p::Scalar>(&self) -> [__T; #hi] {
                 #params_t #prepare_statements
@@ -248,7 +249,7 @@ impl Emitter<'_> {
         let closure_body = braced([
             quote! {
                 let [#(#names),*] = *__prepared;
-                #params_t #(#state_q)* #(#state_u)* #bind_inputs
+                #params_t #(#state_q)* #(#state_u)* #bind_inputs #quaternions
             },
             pieces.body,
             quote! {
