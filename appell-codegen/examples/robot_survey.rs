@@ -305,6 +305,7 @@ fn main() {
             // the errors name, until it derives or an error names none.
             let mut outcome = survey_one(&path, &base, "", timeout);
             let (mut unchecked, mut welds) = (Vec::<String>::new(), Vec::<String>::new());
+            let mut no_mimic = false;
             let mut extra = String::new();
             for _ in 0..3 {
                 let Ok(o) = &outcome else { break };
@@ -325,6 +326,7 @@ fn main() {
                     match (named(e, "unchecked_inertia"), named(e, "weld")) {
                         (Some(n), _) => unchecked.push(n),
                         (None, Some(n)) => welds.push(n),
+                        _ if e.contains("`mimic = false`") => no_mimic = true,
                         _ => all_named = false,
                     }
                 }
@@ -337,6 +339,9 @@ fn main() {
                 }
                 if !welds.is_empty() {
                     extra += &format!(", weld({})", welds.join(", "));
+                }
+                if no_mimic {
+                    extra += ", mimic = false";
                 }
                 outcome = survey_one(&path, &base, &extra, timeout);
             }

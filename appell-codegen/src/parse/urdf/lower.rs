@@ -543,12 +543,16 @@ fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, 
         let Some(other) = read.robot.joints.iter().position(|o| o.name == mimic.joint) else {
             let hint = hint(
                 &mimic.joint,
-                read.robot.joints.iter().map(|o| o.name.clone()),
+                read.robot
+                    .joints
+                    .iter()
+                    .filter(|o| o.name != urdf.name)
+                    .map(|o| o.name.clone()),
             );
             cx.error_at(
                 span,
                 format!(
-                    "URDF {at}: it mimics `{}`, which is not a joint of the file{hint}",
+                    "URDF {at}: it mimics `{}`, which is not a joint of the file{hint}; `mimic = false` among the `urdf(...)` options ignores mimic tags, as Pinocchio's default",
                     mimic.joint
                 ),
             );
