@@ -1,6 +1,9 @@
 //! Models read from URDF files: the UR5's rounded right angles, measured;
 //! numbers of the file promoted to struct fields; the Panda's mimic finger
-//! joint as a constraint; `eval` on the command line with joint names.
+//! joint as a constraint; `eval` on the command line with joint names;
+//! links on fixed joints merged as Pinocchio merges them (an unphysical
+//! dummy, a foot of zero mass with an inertia); `unchecked_inertia`;
+//! `mimic = false`; a link named as a joint; a planar joint in the file.
 
 mod common;
 #[path = "../examples/models/ur5.rs"]
@@ -55,6 +58,43 @@ struct TurnedInertial;
 #[derive(Appell, Clone, Debug, Default)]
 #[appell(urdf("tests/fixtures/turned_inertial_written.urdf"), gravity(-9.81 * N.z))]
 struct TurnedInertialWritten;
+
+/// Links carrying parts on fixed joints (a dummy whose inertia breaks the
+/// triangle inequality, a foot of zero mass with an inertia, a tool), and
+/// the same arm with each link's parts merged into its inertial (NumPy).
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/fixtures/fixed_parts.urdf"), gravity(-9.81 * N.z))]
+struct FixedParts;
+
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/fixtures/fixed_parts_merged.urdf"), gravity(-9.81 * N.z))]
+struct FixedPartsMerged;
+
+/// A link whose inertia breaks the triangle inequality, taken as written.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(
+    urdf("tests/fixtures/lopsided.urdf", unchecked_inertia(arm)),
+    gravity(-9.81 * N.z)
+)]
+struct Lopsided;
+
+/// The Panda with its mimic tag ignored, as Pinocchio's default.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(
+    urdf("examples/robots/panda/panda.urdf", mimic = false),
+    gravity(-9.81 * N.z)
+)]
+struct PandaIndependentFingers;
+
+/// A link and a joint both named `gripper`.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/fixtures/named_alike.urdf"), gravity(-9.81 * N.z))]
+struct NamedAlike;
+
+/// A cart on a planar joint of the file, carrying a pendulum.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/fixtures/planar_inside.urdf"), gravity(-9.81 * N.z))]
+struct PlanarInside;
 
 /// The rhs of two models at the same random states (the first coordinate,
 /// ignorable in both, left out); the largest difference relative to
@@ -240,4 +280,60 @@ fn eval_takes_the_joint_names() {
         .rhs(&model.prepare::<f64>(), 0.0, &s, &inputs, &mut d)
         .unwrap();
     assert_eq!(v["udot"]["elbow_joint"].as_f64(), Some(d[5 + 2]), "{v}");
+}
+
+#[test]
+fn links_on_fixed_joints_are_one_body_with_their_parent() {
+    // Bodies as the file has them (the dummy is one; the foot of zero mass
+    // is not, its inertia is the forearm's).
+    let names: Vec<&str> = FixedParts::info().bodies.iter().map(|b| b.name).collect();
+    assert_eq!(names, ["arm", "dummy", "forearm", "tool"]);
+    let d = largest_difference(&FixedParts, &FixedPartsMerged, 500, 21);
+    println!("parts on fixed joints against their inertias merged by NumPy: {d:.1e}");
+    assert!(d <= 1e-12, "{d:.2e}");
+}
+
+#[test]
+fn an_unphysical_inertia_is_taken_as_written_when_asked() {
+    let info = Lopsided::info();
+    assert_eq!(info.coordinates, ["shoulder"]);
+    // One pendulum: (τ − m g l cos q) / (I_yy + m l²) with l = 0.2 along
+    // x, the axis y; at q = 0 the weight pulls with m g l.
+    let model = Lopsided;
+    let mut d = [0.0; 2];
+    model
+        .rhs(&model.prepare::<f64>(), 0.0, &[0.0, 0.0], &[0.0], &mut d)
+        .unwrap();
+    let want = 9.81 * 0.2 / (0.1 + 0.2 * 0.2);
+    assert!((d[1] - want).abs() < 1e-12, "{} against {want}", d[1]);
+}
+
+#[test]
+fn mimic_false_makes_mimic_joints_independent() {
+    let info = PandaIndependentFingers::info();
+    assert_eq!(info.holonomic, 0);
+    assert!(info.dependent.is_empty());
+    assert_eq!(info.speeds.len(), 9);
+    assert!(info.inputs.contains(&"tau_panda_finger_joint2"));
+}
+
+#[test]
+fn a_link_named_as_its_joint_gets_link_after_its_name() {
+    let info = NamedAlike::info();
+    assert_eq!(info.coordinates, ["gripper"]);
+    assert_eq!(info.inputs, ["tau_gripper"]);
+    let names: Vec<&str> = info.bodies.iter().map(|b| b.name).collect();
+    assert_eq!(names, ["gripper_link"]);
+}
+
+#[test]
+fn a_planar_joint_of_the_file_agrees_with_the_oracle() {
+    let info = PlanarInside::info();
+    assert_eq!(
+        info.coordinates,
+        ["slide_x", "slide_y", "slide_angle", "hinge"]
+    );
+    let worst = common::agree_with_inputs(&PlanarInside, &mut Rng(23), 300, PI, 20.0);
+    println!("cart on a planar joint of its URDF against the oracle: {worst:.1e}");
+    assert!(worst < 1e-9, "{worst:.2e}");
 }

@@ -267,4 +267,8 @@ pub struct ModelAst {
     /// URDF links without mass: frames, but not bodies (for the error of a
     /// `rolls(...)` that names one).
     pub massless_links: Vec<String>,
+    /// URDF bodies whose inertia the model does not check: the URDF reader
+    /// checked the rigid body each is part of (links fixed together), or
+    /// `unchecked_inertia(...)` named it.
+    pub unchecked_inertia: Vec<String>,
 }

@@ -37,7 +37,9 @@ impl Builder<'_> {
         }
     }
 
-    pub(super) fn add_body(&mut self, d: &BodyDef) -> Option<Body> {
+    /// The body `d` declares; its inertia checked when `check` (a URDF
+    /// body the URDF reader checked is not checked again).
+    pub(super) fn add_body(&mut self, d: &BodyDef, check: bool) -> Option<Body> {
         let center = self.point_named(&d.center);
         let frame = match &d.frame {
             Some(f) => Some(self.frame_named(f)?),
@@ -62,7 +64,7 @@ impl Builder<'_> {
             }
             None => {}
         }
-        if let Some(i) = &d.inertia {
+        if let (Some(i), true) = (&d.inertia, check) {
             self.check_inertia(d, i, &inertia);
         }
         Some(Body {

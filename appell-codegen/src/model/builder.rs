@@ -87,7 +87,11 @@ pub(super) fn build_in(
         duplicate_bodies(cx, ast);
     }
     b.frames_and_points(ast)?;
-    let bodies: Vec<super::Body> = ast.bodies.iter().filter_map(|d| b.add_body(d)).collect();
+    let bodies: Vec<super::Body> = ast
+        .bodies
+        .iter()
+        .filter_map(|d| b.add_body(d, !ast.unchecked_inertia.contains(&d.name.to_string())))
+        .collect();
     let holonomic: Vec<_> = ast.holonomic.iter().flat_map(|c| b.constraint(c)).collect();
     let nonholonomic: Vec<_> = ast
         .nonholonomic
@@ -260,8 +264,14 @@ impl Builder<'_> {
             }
         }
         if ast.coordinates.is_empty() {
+            // A URDF of one rigid body (a quadrotor) held by a fixed base.
+            let urdf = if ast.files.is_empty() {
+                ""
+            } else {
+                "; the URDF's joints are all fixed, so its robot moves only on a base of its own: `urdf(\"...\", base = free)`"
+            };
             self.cx
-                .error_at(ast.name.span(), "the model declares no coordinates, so nothing in it moves: declare `coordinates(...)` (or a joint that is not welded), then name their independent rates in `speeds(...)`");
+                .error_at(ast.name.span(), format!("the model declares no coordinates, so nothing in it moves: declare `coordinates(...)` (or a joint that is not welded), then name their independent rates in `speeds(...)`{urdf}"));
         }
         for c in &ast.coordinates {
             if check(self.cx, c, "coordinate") {

@@ -57,8 +57,12 @@ impl FileRoots {
         self.manifest_dir.is_none() && self.source_dir.is_none()
     }
 
-    /// The paths `written` may name, in the order they are tried.
+    /// The paths `written` may name, in the order they are tried (an
+    /// absolute path names itself, with or without roots).
     pub fn candidates(&self, written: &str) -> Vec<PathBuf> {
+        if Path::new(written).is_absolute() {
+            return vec![normalized(Path::new(written))];
+        }
         [&self.manifest_dir, &self.source_dir]
             .into_iter()
             .flatten()
@@ -71,6 +75,9 @@ impl FileRoots {
         let candidates = self.candidates(written);
         if let Some(found) = candidates.iter().find(|p| p.is_file()) {
             return Ok(found.clone());
+        }
+        if Path::new(written).is_absolute() {
+            return Err(format!("cannot find the URDF file `{written}`"));
         }
         Err(match (&self.manifest_dir, &self.source_dir) {
             (_, Some(_)) => format!(
@@ -148,5 +155,23 @@ mod tests {
     fn without_roots_the_error_names_the_missing_variable() {
         let e = FileRoots::default().find("r.urdf").unwrap_err();
         assert!(e.contains("CARGO_MANIFEST_DIR"), "{e}");
+    }
+
+    #[test]
+    fn an_absolute_path_needs_no_root() {
+        let dir = std::env::temp_dir().join(format!("appell-roots-abs-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let file = dir.join("r.urdf");
+        std::fs::write(&file, "<robot/>").unwrap();
+        let written = file.to_str().unwrap();
+        assert_eq!(FileRoots::default().find(written).unwrap(), file);
+        let e = FileRoots::default()
+            .find(dir.join("s.urdf").to_str().unwrap())
+            .unwrap_err();
+        assert!(
+            e.contains("s.urdf") && !e.contains("CARGO_MANIFEST_DIR"),
+            "{e}"
+        );
+        std::fs::remove_dir_all(&dir).unwrap();
     }
 }

@@ -55,6 +55,7 @@ pub fn parse_in(cx: &Ctxt, input: &syn::DeriveInput, roots: &FileRoots) -> Model
         files: Vec::new(),
         urdf_names: Vec::new(),
         massless_links: Vec::new(),
+        unchecked_inertia: Vec::new(),
     };
     match &input.data {
         syn::Data::Struct(s) => match &s.fields {

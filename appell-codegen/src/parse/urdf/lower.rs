@@ -23,13 +23,13 @@ struct JointNumbers {
 
 /// A link's numbers: its inertial. `inertia` is ixx, iyy, izz, ixy, iyz,
 /// ixz.
-struct LinkNumbers {
-    mass: Expr,
-    xyz: [Expr; 3],
-    rpy: [Expr; 3],
-    inertia: [Expr; 6],
+pub(super) struct LinkNumbers {
+    pub mass: Expr,
+    pub xyz: [Expr; 3],
+    pub rpy: [Expr; 3],
+    pub inertia: [Expr; 6],
     /// The fields `parameters(...)` replaced.
-    promoted: Vec<String>,
+    pub promoted: Vec<String>,
 }
 
 /// The fields `parameters(...)` may name, on a joint and on a link.
@@ -124,14 +124,25 @@ pub(super) fn lower(
         promote(cx, tree, p, &mut joints, &mut links);
     }
     let welded = welds(cx, robot, tree, &spec.welds);
-    let bodies = masses(cx, read, &links, span);
     let kinds = kinds(cx, read, &welded, span);
+    let origins: Vec<([Expr; 3], [Expr; 3])> = joints
+        .iter()
+        .map(|j| (j.xyz.clone(), j.rpy.clone()))
+        .collect();
+    let bodies = super::bodies::bodies(cx, read, tree, spec, &kinds, &origins, &mut links);
     if cx.has_errors() {
         return Ok(());
     }
+    unloaded(cx, read, tree, spec, &kinds, &bodies.body);
+    if cx.has_errors() {
+        return Ok(());
+    }
+    for &l in &bodies.unchecked {
+        ast.unchecked_inertia.push(tree.links[l].to_string());
+    }
     root(ast, tree, spec)?;
     let body_of = |ast: &mut ModelAst, l: usize| {
-        if bodies[l] {
+        if bodies.body[l] {
             body(ast, &tree.links[l], &links[l], span);
         } else {
             ast.massless_links.push(tree.links[l].to_string());
@@ -142,7 +153,7 @@ pub(super) fn lower(
         let urdf = &robot.joints[j];
         let (parent, child) = tree.ends[j];
         let kind = kinds[j].clone().expect("checked");
-        let mimic = urdf.mimic.is_some() && !welded[j];
+        let mimic = spec.mimic && urdf.mimic.is_some() && !matches!(kind, JointKind::Weld);
         let joint = JointDef {
             name: tree.joints[j].clone(),
             actuated: matches!(kind, JointKind::Revolute(_) | JointKind::Prismatic(_)) && !mimic,
@@ -163,6 +174,66 @@ pub(super) fn lower(
     mimics(cx, ast, read, tree, spec, &welded);
     record_names(ast, robot, tree);
     Ok(())
+}
+
+/// An error for each joint that moves no body: its speed has no inertia,
+/// a zero row in the mass matrix, and the accelerations are undefined
+/// (Pinocchio loads such a robot, and its ABA gives NaN: Romeo's hands,
+/// whose fingers are links without inertial). A joint moves a body when a
+/// link below it is one, or when a mimic joint that does is tied to it.
+fn unloaded(
+    cx: &Ctxt,
+    read: &Read,
+    tree: &Tree,
+    spec: &Spec,
+    kinds: &[Option<JointKind>],
+    body: &[bool],
+) {
+    let robot = &read.robot;
+    // Whether the subtree below each link has a body, leaves first.
+    let mut loaded = body.to_vec();
+    for &j in tree.order.iter().rev() {
+        let (p, c) = tree.ends[j];
+        loaded[p] |= loaded[c];
+    }
+    let moving = |j: usize| !matches!(kinds[j], Some(JointKind::Weld) | None);
+    let mimicked = |j: usize| spec.mimic && moving(j) && robot.joints[j].mimic.is_some();
+    // Joints loaded through the mimic joints tied to them (chains too).
+    let mut carries: Vec<bool> = (0..robot.joints.len())
+        .map(|j| loaded[tree.ends[j].1])
+        .collect();
+    loop {
+        let mut changed = false;
+        for j in 0..robot.joints.len() {
+            if !(mimicked(j) && carries[j]) {
+                continue;
+            }
+            let name = &robot.joints[j].mimic.as_ref().expect("mimic").joint;
+            if let Some(o) = robot.joints.iter().position(|x| x.name == *name) {
+                if !carries[o] {
+                    carries[o] = true;
+                    changed = true;
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+    let span = spec.path.span();
+    for &j in &tree.order {
+        if !moving(j) || mimicked(j) || carries[j] {
+            continue;
+        }
+        let name = &tree.joints[j];
+        cx.error_at(
+            span,
+            format!(
+                "URDF {}: it moves no link with mass, so nothing resists its acceleration (a zero row of the mass matrix; Pinocchio's ABA gives NaN for it): `weld({name})` among the `urdf(...)` options fixes it at 0, or give a link it moves an `<inertial>`",
+                read.lines.describe("joint", &robot.joints[j].name)
+            ),
+        );
+    }
 }
 
 /// Replaces a number by the expression `parameters(...)` gives for it.
@@ -242,23 +313,6 @@ fn welds(cx: &Ctxt, robot: &urdf_rs::Robot, tree: &Tree, names: &[Ident]) -> Vec
     welded
 }
 
-/// Which links are bodies: those with a positive mass, or whose mass is a
-/// parameter; an error for each link whose inertial cannot be a body's.
-fn masses(cx: &Ctxt, read: &Read, links: &[LinkNumbers], span: Span) -> Vec<bool> {
-    let mut out = Vec::new();
-    for (l, n) in read.robot.links.iter().zip(links) {
-        let at = read.lines.describe("link", &l.name);
-        match is_body(&l.inertial, &n.promoted) {
-            Ok(body) => out.push(body),
-            Err(e) => {
-                cx.error_at(span, format!("URDF {at}: {e}"));
-                out.push(false)
-            }
-        }
-    }
-    out
-}
-
 /// The links' inertials checked when the joints do not make a tree, so
 /// that one build reports what is wrong with both; a number `parameters`
 /// names is promoted as [`lower`] would promote it.
@@ -280,7 +334,7 @@ pub(super) fn check_links(cx: &Ctxt, read: &Read, spec: &Spec, span: Span) {
 
 /// Whether an inertial is a body's, its numbers checked where they are the
 /// file's (a parameter is checked by nobody at compile time).
-fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, String> {
+pub(super) fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, String> {
     let mass_promoted = promoted.iter().any(|f| f == "mass");
     let inertia_promoted = promoted.iter().any(|f| f.starts_with('i'));
     let (mass, i) = (inertial.mass.value, &inertial.inertia);
@@ -469,43 +523,53 @@ fn body(ast: &mut ModelAst, link: &Ident, n: &LinkNumbers, span: Span) {
 }
 
 /// `holonomic(joint == multiplier * other + offset)` for each mimic joint
-/// not welded (the other's term left out when it is welded at 0).
+/// that moves (unless `mimic = false`): a fixed or welded joint's mimic
+/// tag is ignored, as Pinocchio ignores it, and a joint that mimics a
+/// fixed or welded one is held at the offset.
 fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, welded: &[bool]) {
+    use urdf_rs::JointType as T;
+    if !spec.mimic {
+        return;
+    }
     let span = spec.path.span();
     let path = &spec.path;
+    let still = |k: usize| welded[k] || read.robot.joints[k].joint_type == T::Fixed;
     for (j, urdf) in read.robot.joints.iter().enumerate() {
         let Some(mimic) = &urdf.mimic else { continue };
-        if welded[j] {
+        if still(j) {
             continue;
         }
         let at = read.lines.describe("joint", &urdf.name);
         let Some(other) = read.robot.joints.iter().position(|o| o.name == mimic.joint) else {
             let hint = hint(
                 &mimic.joint,
-                read.robot.joints.iter().map(|o| o.name.clone()),
+                read.robot
+                    .joints
+                    .iter()
+                    .filter(|o| o.name != urdf.name)
+                    .map(|o| o.name.clone()),
             );
             cx.error_at(
                 span,
                 format!(
-                    "URDF {at}: it mimics `{}`, which is not a joint of the file{hint}",
+                    "URDF {at}: it mimics `{}`, which is not a joint of the file{hint}; `mimic = false` among the `urdf(...)` options ignores mimic tags, as Pinocchio's default",
                     mimic.joint
                 ),
             );
             continue;
         };
         let single = |k: usize| {
-            use urdf_rs::JointType as T;
             matches!(
                 read.robot.joints[k].joint_type,
                 T::Revolute | T::Continuous | T::Prismatic
             )
         };
-        if !single(j) || !single(other) {
-            cx.error_at(span, format!("URDF {at}: a mimic joint and the joint it mimics must be revolute, continuous or prismatic"));
+        if !single(j) || !(single(other) || still(other)) {
+            cx.error_at(span, format!("URDF {at}: a mimic joint and the joint it mimics must be revolute, continuous or prismatic; `mimic = false` among the `urdf(...)` options makes every mimic joint an independent joint, as Pinocchio's default"));
             continue;
         }
         let offset = Expr::Float(mimic.offset.unwrap_or(0.0), span);
-        let rhs = if welded[other] {
+        let rhs = if still(other) {
             offset
         } else {
             let scaled = times(

@@ -1,5 +1,6 @@
 //! What `urdf(...)` says beside the path: `weld(...)`, `parameters(...)`,
-//! `parent = A`, `at = P` and `base = free | planar | fixed`.
+//! `parent = A`, `at = P`, `base = free | planar | fixed`,
+//! `unchecked_inertia(link, ...)` and `mimic = true | false`.
 
 use syn::parse::ParseStream;
 use syn::punctuated::Punctuated;
@@ -11,7 +12,15 @@ use crate::ctxt::did_you_mean;
 use crate::parse::convert;
 
 /// The options of `urdf(...)`.
-const OPTIONS: &[&str] = &["weld", "parameters", "parent", "at", "base"];
+const OPTIONS: &[&str] = &[
+    "weld",
+    "parameters",
+    "parent",
+    "at",
+    "base",
+    "unchecked_inertia",
+    "mimic",
+];
 
 /// The kinds of `base = ...`.
 const BASES: &[&str] = &["free", "floating", "planar", "fixed"];
@@ -42,6 +51,13 @@ pub(super) struct Spec {
     pub at: Option<Ident>,
     /// How the root link is held.
     pub base: Base,
+    /// Links whose inertia is taken as written, physical or not (the rigid
+    /// body each belongs to is not checked).
+    pub unchecked_inertia: Vec<Ident>,
+    /// Whether mimic joints are tied to the joints they mimic (`true`, the
+    /// default) or independent joints (`mimic = false`, Pinocchio's
+    /// default).
+    pub mimic: bool,
 }
 
 /// `element.field = expression` or `element.field.component = expression`
@@ -78,6 +94,8 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
         parent: None,
         at: None,
         base: Base::Fixed,
+        unchecked_inertia: Vec::new(),
+        mimic: true,
     };
     while !s.is_empty() {
         s.parse::<Token![,]>()?;
@@ -86,11 +104,25 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
         }
         let key: Ident = s.parse()?;
         match key.to_string().as_str() {
-            "weld" => {
+            "weld" | "unchecked_inertia" => {
                 let content;
                 syn::parenthesized!(content in s);
                 let list = Punctuated::<Ident, Token![,]>::parse_terminated(&content)?;
-                spec.welds.extend(list);
+                if key == "weld" {
+                    spec.welds.extend(list);
+                } else {
+                    spec.unchecked_inertia.extend(list);
+                }
+            }
+            "mimic" => {
+                s.parse::<Token![=]>()?;
+                let value: syn::LitBool = s.parse().map_err(|e| {
+                    syn::Error::new(
+                        e.span(),
+                        "`mimic = true` ties each mimic joint to the joint it mimics (the default); `mimic = false` makes it an independent joint, as Pinocchio's default",
+                    )
+                })?;
+                spec.mimic = value.value;
             }
             "parameters" => {
                 let content;
@@ -133,7 +165,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     .unwrap_or_default();
                 return Err(syn::Error::new(
                     key.span(),
-                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A`, `at = P` and `base = free | planar | fixed`"),
+                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A`, `at = P`, `base = free | planar | fixed`, `unchecked_inertia(link, ...)` and `mimic = true | false`"),
                 ));
             }
         }

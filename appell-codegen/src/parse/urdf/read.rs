@@ -7,6 +7,12 @@
 //! its line and column, and an element `urdf-rs` rejects is found by reading
 //! each top-level element alone, so every bad element is reported, each by
 //! its tag, name and line.
+//!
+//! Only what the dynamics reads is given to `urdf-rs`: the links with their
+//! first `<inertial>` (as urdfdom, Pinocchio's reader, takes it) and the
+//! joints. Visuals, collisions, materials, `<transmission>`, `<gazebo>` and
+//! any other element are left out unread, so a geometry urdfdom accepts and
+//! `urdf-rs` does not (a `<texture/>` without a file name) stops nothing.
 
 use std::path::Path;
 
@@ -52,19 +58,25 @@ pub(super) fn read(path: &Path) -> Result<Read, Vec<String>> {
         )]
     })?;
     let lines = walk(&text).map_err(|e| vec![format!("the URDF is not well-formed XML: {e}")])?;
-    let root: xml::Element = text
+    let whole: xml::Element = text
         .parse()
         .map_err(|e| vec![format!("the URDF is not well-formed XML: {e}")])?;
-    if root.name != "robot" {
+    if whole.name != "robot" {
         return Err(vec![format!(
             "the URDF's root element is `<{}>`; a URDF is a `<robot>`",
-            root.name
+            whole.name
         )]);
+    }
+    let root = dynamics_only(&whole);
+    if root.get_children("link", None).next().is_none() {
+        return Err(vec![
+            "the URDF has no `<link>`: a robot is at least one link".into(),
+        ]);
     }
     // Joints of unknown type and elements `urdf-rs` rejects are reported
     // together, so one build shows every mistake of the file.
     let mut errors = joint_types(&root, &lines);
-    match urdf_rs::read_from_string(&text) {
+    match urdf_rs::read_from_string(&root.to_string()) {
         Ok(robot) if errors.is_empty() => return Ok(Read { robot, lines }),
         Ok(_) => {}
         Err(whole) => {
@@ -73,6 +85,35 @@ pub(super) fn read(path: &Path) -> Result<Read, Vec<String>> {
         }
     }
     Err(errors)
+}
+
+/// The robot with its links (name and first `<inertial>`) and joints
+/// only.
+fn dynamics_only(robot: &xml::Element) -> xml::Element {
+    let mut out = robot.clone();
+    out.children = robot
+        .children
+        .iter()
+        .filter_map(|node| {
+            let xml::Xml::ElementNode(e) = node else {
+                return None;
+            };
+            match e.name.as_str() {
+                "joint" => Some(node.clone()),
+                "link" => {
+                    let mut link = e.clone();
+                    link.children = e
+                        .get_children("inertial", None)
+                        .take(1)
+                        .map(|i| xml::Xml::ElementNode(i.clone()))
+                        .collect();
+                    Some(xml::Xml::ElementNode(link))
+                }
+                _ => None,
+            }
+        })
+        .collect();
+    out
 }
 
 /// Walks the XML: checks that it is well-formed and records the line of
@@ -166,7 +207,7 @@ fn element_errors(
         let xml::Xml::ElementNode(e) = node else {
             continue;
         };
-        if !matches!(e.name.as_str(), "link" | "joint" | "material") {
+        if !matches!(e.name.as_str(), "link" | "joint") {
             continue;
         }
         let typed = e.get_attribute("type", None);
@@ -206,6 +247,52 @@ mod tests {
         assert!(e.starts_with("line 2, column"), "{e}");
         let e = walk("<robot>\n<link name=\"a\">\n").unwrap_err();
         assert_eq!(e, "`<link>` is never closed");
+    }
+
+    fn read_text(text: &str) -> Result<Read, Vec<String>> {
+        let dir =
+            std::env::temp_dir().join(format!("appell-read-{}-{}", std::process::id(), text.len()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("r.urdf");
+        std::fs::write(&path, text).unwrap();
+        let out = read(&path);
+        std::fs::remove_dir_all(&dir).unwrap();
+        out
+    }
+
+    #[test]
+    fn only_the_dynamics_is_read() {
+        // A texture without a file (iCub, Romeo), a transmission, a gazebo
+        // tag, a visual whose geometry urdf-rs would reject: none matters.
+        let read = read_text(
+            r#"<robot name="r">
+              <material name="grey"><texture/><color rgba="1 1 1 1"/></material>
+              <link name="a">
+                <visual><geometry><mesh/></geometry><material name="m"><texture/></material></visual>
+                <inertial><mass value="2"/><inertia ixx="1" iyy="1" izz="1" ixy="0" iyz="0" ixz="0"/></inertial>
+                <inertial><mass value="3"/><inertia ixx="1" iyy="1" izz="1" ixy="0" iyz="0" ixz="0"/></inertial>
+              </link>
+              <link name="b"/>
+              <joint name="j" type="continuous"><parent link="a"/><child link="b"/></joint>
+              <transmission name="t"><joint name="j"/></transmission>
+              <gazebo reference="a"><mu1>0.2</mu1></gazebo>
+            </robot>"#,
+        )
+        .map_err(|e| e.join("; "))
+        .unwrap();
+        assert_eq!(read.robot.links.len(), 2);
+        // The first inertial, as urdfdom reads it.
+        assert_eq!(read.robot.links[0].inertial.mass.value, 2.0);
+        assert_eq!(read.robot.joints.len(), 1);
+    }
+
+    #[test]
+    fn a_robot_without_links_is_named_so() {
+        let e = read_text("<robot>\n</robot>").map(|_| ()).unwrap_err();
+        assert_eq!(
+            e,
+            ["the URDF has no `<link>`: a robot is at least one link"]
+        );
     }
 
     #[test]

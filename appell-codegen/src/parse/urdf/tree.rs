@@ -56,7 +56,7 @@ impl Tree {
         span: Span,
     ) -> Result<Tree, Vec<String>> {
         let mut errors = Vec::new();
-        let links = names(
+        let mut links = names(
             robot.links.iter().map(|l| l.name.as_str()),
             "link",
             lines,
@@ -70,6 +70,7 @@ impl Tree {
             span,
             &mut errors,
         );
+        apart_from_joints(&mut links, &joints);
         let link_names: Vec<&str> = robot.links.iter().map(|l| l.name.as_str()).collect();
         let find = |name: &str, joint: &urdf_rs::Joint, role: &str, errors: &mut Vec<String>| {
             let found = link_names.iter().position(|l| *l == name);
@@ -168,6 +169,23 @@ fn names<'a>(
     out.into_iter().map(|(i, _)| i).collect()
 }
 
+/// A link named as a joint (URDF keeps links and joints apart; the SO-100
+/// arm's `gripper` is both) gets `_link` after its name, as often as it
+/// takes to be a name of neither: the joint keeps its name, which its
+/// coordinate and Pinocchio's vectors go by.
+fn apart_from_joints(links: &mut [Ident], joints: &[Ident]) {
+    for k in 0..links.len() {
+        if !joints.contains(&links[k]) {
+            continue;
+        }
+        let mut name = links[k].to_string();
+        while joints.iter().chain(links.iter()).any(|i| *i == name) {
+            name.push_str("_link");
+        }
+        links[k] = Ident::new(&name, links[k].span());
+    }
+}
+
 /// The joints from the root, depth first, each link's children in the
 /// order of the file: a joint, then the joints below its child, then its
 /// next sibling.
@@ -197,6 +215,15 @@ mod tests {
         assert_eq!(model_name("type"), "type_");
         assert_eq!(model_name("2nd"), "_2nd");
         assert_eq!(model_name("panda_joint1"), "panda_joint1");
+    }
+
+    #[test]
+    fn a_link_named_as_a_joint_is_renamed() {
+        let span = Span::call_site();
+        let ids = |v: &[&str]| -> Vec<Ident> { v.iter().map(|n| Ident::new(n, span)).collect() };
+        let mut links = ids(&["base", "gripper", "gripper_link"]);
+        apart_from_joints(&mut links, &ids(&["gripper", "wrist"]));
+        assert_eq!(links, ids(&["base", "gripper_link_link", "gripper_link"]));
     }
 
     #[test]

@@ -1,0 +1,289 @@
+//! Which links are bodies, checked as the rigid bodies the dynamics sees.
+//!
+//! Links joined by fixed (or welded) joints move as one rigid body, and
+//! Pinocchio merges their inertias into one. Real URDFs lean on it: a dummy
+//! root link of 1e-6 kg with an inertia no body can have (ANYmal, Go1, B1,
+//! HyQ), a camera whose inertia breaks the triangle inequality, a foot of
+//! zero mass with a small inertia (Bolt). So the physical rules apply to the
+//! merged body of each such group, not to each link: a link whose own
+//! inertia is unphysical is a body as written when its group's is not, and
+//! the model does not check it again. A link of zero mass with an inertia
+//! has it added to a link of its group that has mass. A group whose merged
+//! inertia is still unphysical is an error that names `unchecked_inertia`,
+//! which takes the links it names as written, as Pinocchio does.
+//!
+//! Entries below 1e-12 of the robot's largest inertia entry are rounding
+//! noise to the check (iCub's head: a point mass of 1.3 kg written with
+//! ixz 2.4e-35), which takes them as zero.
+//!
+//! The group of the root link does not move when the robot is fixed in N
+//! (`base = fixed` and no `parent`): its inertia takes no part in the
+//! dynamics (Pinocchio puts it on the universe) and is not checked.
+//!
+//! A group with a number `parameters(...)` made an expression (a link's
+//! inertial, a fixed joint's origin) is checked link by link, its numbers
+//! that are expressions by nobody at compile time.
+
+use super::inertia::{self, from_six, merged, part, turned, Mass, Part, Pose};
+use super::lower::{is_body, LinkNumbers};
+use super::options::{Base, Spec};
+use super::read::Read;
+use super::tree::Tree;
+use crate::ast::Expr;
+use crate::ctxt::Ctxt;
+use crate::parse::joints::JointKind;
+
+/// The links that are bodies, and those the model must take as they are.
+pub(super) struct Bodies {
+    /// Whether each link is a body.
+    pub body: Vec<bool>,
+    /// Links whose inertia the model does not check: the reader checked
+    /// the rigid body they are part of, or was told not to.
+    pub unchecked: Vec<usize>,
+}
+
+fn number(e: &Expr) -> Option<f64> {
+    match e {
+        Expr::Float(x, _) => Some(*x),
+        _ => None,
+    }
+}
+
+fn numbers<const N: usize>(e: &[Expr; N]) -> Option<[f64; N]> {
+    let v: Vec<f64> = e.iter().map(number).collect::<Option<_>>()?;
+    v.try_into().ok()
+}
+
+/// A link's inertial as numbers: mass, xyz, rpy, the six inertia entries.
+type Numbers = (f64, [f64; 3], [f64; 3], [f64; 6]);
+
+fn link_numbers(n: &LinkNumbers) -> Option<Numbers> {
+    Some((
+        number(&n.mass)?,
+        numbers(&n.xyz)?,
+        numbers(&n.rpy)?,
+        numbers(&n.inertia)?,
+    ))
+}
+
+/// The bodies of the robot; errors go to `cx`. `links` may change: the
+/// inertia of a link of zero mass is added to a link of its group with
+/// mass. `joint_origins` are each joint's xyz and rpy, as numbers where
+/// they are.
+pub(super) fn bodies(
+    cx: &Ctxt,
+    read: &Read,
+    tree: &Tree,
+    spec: &Spec,
+    kinds: &[Option<JointKind>],
+    joint_origins: &[([Expr; 3], [Expr; 3])],
+    links: &mut [LinkNumbers],
+) -> Bodies {
+    let span = spec.path.span();
+    let n = links.len();
+    // Each link's group (its first link: the child of a moving joint, or
+    // the root) and its pose in that link's frame, `None` where an origin
+    // is an expression.
+    let mut group: Vec<usize> = (0..n).collect();
+    let mut pose: Vec<Option<Pose>> = vec![Some(Pose::IDENTITY); n];
+    let mut parent_in_group: Vec<Option<usize>> = vec![None; n];
+    for &j in &tree.order {
+        let (p, c) = tree.ends[j];
+        if matches!(kinds[j], Some(JointKind::Weld)) {
+            group[c] = group[p];
+            parent_in_group[c] = Some(p);
+            let (xyz, rpy) = &joint_origins[j];
+            pose[c] = match (pose[p], numbers(xyz), numbers(rpy)) {
+                (Some(at), Some(xyz), Some(rpy)) => Some(at.then(xyz, rpy)),
+                _ => None,
+            };
+        }
+    }
+    let mut unchecked_group = vec![false; n];
+    for name in &spec.unchecked_inertia {
+        match tree.links.iter().position(|l| l == name) {
+            Some(l) => unchecked_group[group[l]] = true,
+            None => {
+                let all: Vec<String> = tree.links.iter().map(|l| l.to_string()).collect();
+                let hint = crate::ctxt::suggest(&name.to_string(), all.iter().map(|s| s.as_str()))
+                    .map(|s| format!("; did you mean `{s}`?"))
+                    .unwrap_or_default();
+                cx.error_spanned_by(name, format!("`{name}` is not a link of the URDF{hint}"));
+            }
+        }
+    }
+    let frozen_root = spec.base == Base::Fixed && spec.parent.is_none();
+    let mut out = Bodies {
+        body: vec![false; n],
+        unchecked: Vec::new(),
+    };
+    let describe = |l: usize| read.lines.describe("link", &read.robot.links[l].name);
+    let noise = 1e-12
+        * links
+            .iter()
+            .filter_map(link_numbers)
+            .flat_map(|(_, _, _, six)| six)
+            .filter(|x| x.is_finite())
+            .fold(0.0f64, |a, x| a.max(x.abs()));
+    for g in 0..n {
+        if group[g] != g {
+            continue;
+        }
+        let members: Vec<usize> = (0..n).filter(|&l| group[l] == g).collect();
+        let numeric: Option<Vec<Numbers>> = members
+            .iter()
+            .map(|&l| pose[l].and(link_numbers(&links[l])))
+            .collect();
+        let Some(numeric) = numeric else {
+            // Expressions: each link on its own, as written.
+            for &l in &members {
+                match is_body(&read.robot.links[l].inertial, &links[l].promoted) {
+                    Ok(b) => out.body[l] = b,
+                    Err(e) => cx.error_at(span, format!("URDF {}: {e}", describe(l))),
+                }
+            }
+            continue;
+        };
+        // Each link's own mass and numbers first.
+        let mut sound = true;
+        for (&l, (mass, _, _, six)) in members.iter().zip(&numeric) {
+            let problem = if !mass.is_finite() || six.iter().any(|x| !x.is_finite()) {
+                Some("its mass or inertia is not a finite number".to_string())
+            } else if *mass < 0.0 {
+                Some(format!("its mass {mass} is negative"))
+            } else {
+                None
+            };
+            if let Some(p) = problem {
+                cx.error_at(span, format!("URDF {}: {p}", describe(l)));
+                sound = false;
+            }
+        }
+        if !sound {
+            continue;
+        }
+        let parts: Vec<(usize, Part)> = members
+            .iter()
+            .zip(&numeric)
+            .filter(|(_, (m, _, _, six))| *m > 0.0 || six.iter().any(|x| *x != 0.0))
+            .map(|(&l, &(m, xyz, rpy, six))| {
+                let at = pose[l].expect("numeric");
+                (l, part(&at, m, xyz, rpy, &from_six(six)))
+            })
+            .collect();
+        for &(l, ref p) in &parts {
+            out.body[l] = p.mass > 0.0;
+        }
+        let frozen = frozen_root && g == tree.root;
+        let whole = merged(&parts.iter().map(|(_, p)| *p).collect::<Vec<_>>());
+        if !frozen && whole.mass == 0.0 {
+            for &(l, _) in &parts {
+                let alone = if members.len() == 1 {
+                    ""
+                } else {
+                    ", and no link fixed to it has mass"
+                };
+                cx.error_at(
+                    span,
+                    format!(
+                        "URDF {}: its mass is zero but its inertia is not{alone}: a body needs a positive mass",
+                        describe(l)
+                    ),
+                );
+            }
+            continue;
+        }
+        if !frozen && !unchecked_group[g] {
+            let cleaned = whole
+                .inertia
+                .map(|row| row.map(|x| if x.abs() < noise { 0.0 } else { x }));
+            if let Err(rule) = inertia::check_matrix(&cleaned) {
+                let (at, what) = match parts[..] {
+                    [(l, _)] => (l, format!("{}: {rule}", describe(l))),
+                    _ => {
+                        let first = if parts.iter().any(|(l, _)| *l == g) {
+                            g
+                        } else {
+                            parts[0].0
+                        };
+                        let others: Vec<String> = parts
+                            .iter()
+                            .filter(|(l, _)| *l != first)
+                            .map(|(l, _)| format!("`{}`", read.robot.links[*l].name))
+                            .collect();
+                        let rule = rule.replacen(
+                            "its inertia",
+                            "their inertia about their centre of mass",
+                            1,
+                        );
+                        (
+                            first,
+                            format!(
+                                "{} with the links fixed to it ({}): {rule}",
+                                describe(first),
+                                others.join(", ")
+                            ),
+                        )
+                    }
+                };
+                cx.error_at(
+                    span,
+                    format!(
+                        "URDF {what}; `unchecked_inertia({})` among the `urdf(...)` options takes it as written, as Pinocchio does",
+                        tree.links[at]
+                    ),
+                );
+                continue;
+            }
+        }
+        // A link of zero mass with an inertia: its inertia goes to the
+        // nearest link with mass above it in the group, or any with mass.
+        for &(l, ref p) in &parts {
+            if p.mass > 0.0 || frozen {
+                continue;
+            }
+            let mut carrier = parent_in_group[l];
+            while let Some(c) = carrier {
+                if out.body[c] {
+                    break;
+                }
+                carrier = parent_in_group[c];
+            }
+            let carrier = carrier
+                .or_else(|| members.iter().copied().find(|&m| out.body[m]))
+                .expect("the group has mass");
+            let (_, _, rpy, _) = numeric[members.iter().position(|&m| m == carrier).unwrap()];
+            let axes = pose[carrier].expect("numeric").then([0.0; 3], rpy).axes;
+            // The inertia along the carrier's inertial axes.
+            let transpose = |a: &inertia::Mat| [0, 1, 2].map(|r| [0, 1, 2].map(|c| a[c][r]));
+            let along = turned(&transpose(&axes), &p.inertia);
+            let six = &mut links[carrier].inertia;
+            for (k, (r, c)) in [(0, 0), (1, 1), (2, 2), (0, 1), (1, 2), (0, 2)]
+                .into_iter()
+                .enumerate()
+            {
+                let before = number(&six[k]).expect("numeric");
+                six[k] = Expr::Float(before + along[r][c], span);
+            }
+        }
+        // Bodies whose own inertia the model's check would refuse.
+        for &l in &members {
+            if !out.body[l] {
+                continue;
+            }
+            let (mass, _, _, six) = link_numbers(&links[l]).expect("numeric");
+            let i = urdf_rs::Inertia {
+                ixx: six[0],
+                iyy: six[1],
+                izz: six[2],
+                ixy: six[3],
+                iyz: six[4],
+                ixz: six[5],
+            };
+            if inertia::check(mass, &i) != Ok(Mass::Body) || unchecked_group[group[l]] {
+                out.unchecked.push(l);
+            }
+        }
+    }
+    out
+}
