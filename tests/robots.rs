@@ -14,8 +14,17 @@
 //! double pendulum: Pinocchio's q is (cos θ, sin θ), the model's θ), mimic
 //! tags on fixed joints (Talos's gripper), names that are no Rust names
 //! (the Allegro hand's `joint_0.0` is `joint_0_0`), non-unit axes (Tiago,
-//! Kinova). The floating-base robots of the reference set are not tested
-//! here (their state mapping is another piece of work).
+//! Kinova).
+//!
+//! The floating-base robots (Solo12, ANYmal, Go1, HyQ on a free base; G1
+//! and Talos with `large-models`) are compared through
+//! `appell::pinocchio::PinocchioMap`: Pinocchio's q and v made the model's,
+//! its M, RNEA, nle and gravity made of the model's functions and turned
+//! into Pinocchio's terms. Pinocchio's τ acts on the base too, which the
+//! model's inputs (the joints' torques) cannot, so the rhs is checked by
+//! the residual of Pinocchio's own equations, M ddq + nle − τ, at the
+//! model's accelerations with the base's part of τ left out; inverse
+//! dynamics at Pinocchio's ddq gives all of its τ back.
 //!
 //! A joint of the model is matched with Pinocchio's by name: Pinocchio's
 //! name made a Rust name as the reader makes it. Coordinates left out of
@@ -141,6 +150,162 @@ fn reference(robot: &str) -> (Vec<Joint>, Vec<Value>) {
         .collect();
     let states = data["states"].as_array().expect("states").clone();
     (joints, states)
+}
+
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/solo/solo12.urdf", base = free), gravity(-9.81 * N.z))]
+struct Solo12;
+
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/anymal_b_simple/anymal.urdf", base = free), gravity(-9.81 * N.z))]
+struct Anymal;
+
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/go1/go1.urdf", base = free), gravity(-9.81 * N.z))]
+struct Go1;
+
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/hyq/hyq_no_sensors.urdf", base = free), gravity(-9.81 * N.z))]
+struct Hyq;
+
+#[cfg(feature = "large-models")]
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/g1/g1_29dof_rev_1_0.urdf", base = free), gravity(-9.81 * N.z))]
+struct G1;
+
+/// A floating-base reference: its joints after the free flyer, in
+/// Pinocchio's order and as the model names them, and its states.
+fn free_reference(robot: &str) -> (Vec<String>, Vec<Value>) {
+    let path = format!(
+        "{}/tests/reference/pinocchio/robots/{robot}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let data: Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("file")).expect("JSON");
+    assert_eq!(data["base"], "free");
+    assert_eq!(data["gravity"], serde_json::json!([0.0, 0.0, -9.81]));
+    let joints = data["joints"].as_array().expect("joints");
+    assert_eq!(joints[0]["type"], "JointModelFreeFlyer");
+    let names = joints[1..]
+        .iter()
+        .map(|j| {
+            assert_eq!(j["nq"], 1, "{robot}: one coordinate a joint");
+            model_name(j["name"].as_str().expect("name"))
+        })
+        .collect();
+    (names, data["states"].as_array().expect("states").clone())
+}
+
+/// The worst relative difference to a floating-base reference, through
+/// the Pinocchio map.
+fn worst_free_difference<M: Model + Default>(robot: &str) -> f64 {
+    use appell::pinocchio::PinocchioMap;
+    let model = M::default();
+    let info = M::info();
+    let (names, states) = free_reference(robot);
+    let joints: Vec<&str> = names.iter().map(String::as_str).collect();
+    let map = PinocchioMap::free("root_joint", info.coordinates, info.speeds, &joints)
+        .unwrap_or_else(|e| panic!("{robot}: {e}"));
+    let (n, l, nv) = (info.coordinates.len(), info.speeds.len(), map.nv());
+    let prepared = model.prepare::<f64>();
+    let to_pin = |q: &[f64], tau: &[f64]| {
+        let mut out = vec![0.0; nv];
+        map.tau_to_pinocchio(q, tau, &mut out).unwrap();
+        out
+    };
+    let mut worst = 0.0f64;
+    for s in &states {
+        let (q_pin, v) = (numbers(&s["q"]), numbers(&s["v"]));
+        let (tau, nle) = (numbers(&s["tau"]), numbers(&s["nle"]));
+        let rows: Vec<Vec<f64>> = s["mass_matrix"]
+            .as_array()
+            .expect("rows")
+            .iter()
+            .map(numbers)
+            .collect();
+        let (mut q, mut u) = (vec![0.0; n], vec![0.0; l]);
+        map.q_from_pinocchio(&q_pin, &mut q).unwrap();
+        map.v_from_pinocchio(&q, &v, &mut u).unwrap();
+        // M against CRBA.
+        let (mut m, mut m_pin) = (vec![0.0; l * l], vec![0.0; nv * nv]);
+        model.mass_matrix(0.0, &q, &mut m).unwrap();
+        map.mass_to_pinocchio(&q, &m, &mut m_pin).unwrap();
+        worst = worst.max(relative(&m_pin, &rows.concat()));
+        // Inverse dynamics at Pinocchio's a and ddq: RNEA and all of τ.
+        let mut u_dot = vec![0.0; l];
+        let mut forces = vec![0.0; l];
+        for (a, expected) in [("a", "rnea"), ("ddq", "tau")] {
+            map.a_from_pinocchio(&q, &v, &numbers(&s[a]), &mut u_dot)
+                .unwrap();
+            model
+                .inverse_dynamics(0.0, &q, &u, &u_dot, &mut forces)
+                .unwrap();
+            worst = worst.max(relative(&to_pin(&q, &forces), &numbers(&s[expected])));
+        }
+        // nle: inverse dynamics where Pinocchio's a is zero.
+        map.a_from_pinocchio(&q, &v, &vec![0.0; nv], &mut u_dot)
+            .unwrap();
+        model
+            .inverse_dynamics(0.0, &q, &u, &u_dot, &mut forces)
+            .unwrap();
+        worst = worst.max(relative(&to_pin(&q, &forces), &nle));
+        model.gravity_forces(0.0, &q, &mut forces).unwrap();
+        worst = worst.max(relative(
+            &to_pin(&q, &forces),
+            &numbers(&s["gravity_torque"]),
+        ));
+        // The rhs with the joints' torques: M ddq + nle = τ without the
+        // base's part, in Pinocchio's own M and nle.
+        let inputs: Vec<f64> = info
+            .inputs
+            .iter()
+            .map(|i| {
+                let k = joints
+                    .iter()
+                    .position(|j| Some(*j) == i.strip_prefix("tau_"));
+                tau[6 + k.expect("an actuated joint")]
+            })
+            .collect();
+        let mut state: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|c| q[info.coordinate_index(c).unwrap()])
+            .collect();
+        let k = state.len();
+        state.extend(&u);
+        let mut d = vec![0.0; state.len()];
+        model.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
+        let mut a = vec![0.0; nv];
+        map.a_to_pinocchio(&q, &u, &d[k..], &mut a).unwrap();
+        let mut joint_tau = tau.clone();
+        joint_tau[..6].iter_mut().for_each(|x| *x = 0.0);
+        let residual: Vec<f64> = (0..nv)
+            .map(|i| (0..nv).map(|j| rows[i][j] * a[j]).sum::<f64>() + nle[i] - joint_tau[i])
+            .collect();
+        let scale = 1.0 + joint_tau.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        worst = worst.max(residual.iter().fold(0.0f64, |m, r| m.max(r.abs())) / scale);
+    }
+    println!(
+        "{robot} (free base, {} joints, {}): worst relative difference to Pinocchio over {} states {worst:.1e}",
+        joints.len(),
+        info.form.split(':').next().unwrap_or_default(),
+        states.len()
+    );
+    worst
+}
+
+#[test]
+fn floating_base_robots_agree_with_pinocchio() {
+    for (robot, worst) in [
+        ("solo12", worst_free_difference::<Solo12>("solo12")),
+        ("anymal", worst_free_difference::<Anymal>("anymal")),
+        ("go1", worst_free_difference::<Go1>("go1")),
+        ("hyq", worst_free_difference::<Hyq>("hyq")),
+        #[cfg(feature = "large-models")]
+        ("g1", worst_free_difference::<G1>("g1")),
+    ] {
+        assert!(worst <= 1e-10, "{robot}: {worst:.2e}");
+    }
 }
 
 /// |a − b| / (1 + max |b|).
