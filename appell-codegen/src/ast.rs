@@ -164,6 +164,23 @@ pub struct RollsDef {
     pub at: proc_macro2::TokenStream,
 }
 
+/// `contact(link, point | flat, effect = name)`: a foot on the ground. A
+/// point contact holds the origin of `link` (a frame a joint made) still,
+/// three rows; a flat one holds the frame still, six rows. Unlike the
+/// other constraints it is held only in the scenes that name its effect:
+/// the model itself is the robot with every foot in the air.
+#[derive(Clone, Debug)]
+pub struct ContactDef {
+    /// The frame in contact.
+    pub link: Ident,
+    /// Whether the frame's turning is held too (`flat`).
+    pub flat: bool,
+    /// The effect it belongs to (the link's name when not given).
+    pub effect: Ident,
+    /// The item's tokens, for errors.
+    pub at: proc_macro2::TokenStream,
+}
+
 /// A rolling contact's sliding friction: `friction(P, ...)` at the
 /// contact, on the rolling body, in effect `effect`.
 #[derive(Clone, Debug)]
@@ -245,6 +262,9 @@ pub struct ModelAst {
     pub gravity: Option<Expr>,
     /// `rolls(body, contact = P)`.
     pub rolls: Vec<RollsDef>,
+    /// `contact(link, point | flat)`: constraints held only in the scenes
+    /// that name them.
+    pub contacts: Vec<ContactDef>,
     /// `scene(name, effects(...), outputs(...))`.
     pub scenes: Vec<SceneDef>,
     /// Frames made by joints, with their origin points (`B`, `B_origin`).

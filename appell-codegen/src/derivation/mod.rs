@@ -68,6 +68,7 @@ pub use speeds::SpeedDefinitions;
 pub use structure::{singleton_rows, SingletonOrder};
 
 use crate::ctxt::Ctxt;
+use crate::model::tree as tree_spec;
 use crate::model::{ConstraintSet, Kinematics, Model, Scene, Twin};
 
 /// Choices the derivation makes by operation count, forced for tests that
@@ -300,12 +301,27 @@ fn complete(
     }
 }
 
+/// Whether the model as it stands is its plain tree: a scene that holds
+/// contacts (or names speeds of its own) makes it a constrained one.
+fn plain_now(model: &Model, spec: &tree_spec::TreeSpec) -> bool {
+    let same_speeds = model.speed_specs.len() == model.declared_speeds.len()
+        && model
+            .speed_specs
+            .iter()
+            .zip(&model.declared_speeds)
+            .all(|(a, b)| a.name == b.name);
+    spec.plain.is_ok() && model.nonholonomic.is_empty() && same_speeds
+}
+
 /// The structured form of a plain tree of joints (stage 13), the
 /// `ignorable` coordinates fixed at zero in its accelerations; else why
 /// there is none.
 fn structured_form(model: &mut Model, ignorable: &[usize]) -> Result<tree::Structured, String> {
     let spec = model.tree.clone()?;
     spec.plain.clone()?;
+    if !plain_now(model, &spec) {
+        return Err("the scene holds contacts".into());
+    }
     tree::structured(model, &spec, ignorable)
         .map_err(|e| format!("the structured form failed: {e}"))
 }
@@ -442,19 +458,35 @@ fn stages(
         )?),
         None => Elimination::Symbolic,
     };
-    let large_tree = model.tree.as_ref().ok().filter(|spec| {
-        !options.closed_form_only
-            && spec.plain.is_ok()
-            && matches!(elimination, Elimination::Symbolic)
-            && tree::moving_links(spec) >= tree::STRUCTURED_ONLY_LINKS
+    let large_tree = model.tree.clone().ok().filter(|spec| {
+        !options.closed_form_only && tree::moving_links(spec) >= tree::STRUCTURED_ONLY_LINKS
     });
-    let (mut equations, mut energies, folded_lines) = match large_tree.cloned() {
+    let plain = large_tree
+        .as_ref()
+        .filter(|spec| plain_now(model, spec) && matches!(elimination, Elimination::Symbolic));
+    // A large tree whose scene holds contacts: its recursions projected
+    // onto the scene's speeds.
+    let contacts = large_tree
+        .as_ref()
+        .filter(|spec| spec.plain.is_ok() && !plain_now(model, spec));
+    let projected = match contacts {
         Some(spec) => {
+            let own = model.declared_speeds.clone();
+            tree::projected::in_speeds(model, spec, &map, &rates.reduced, &own)?
+        }
+        None => None,
+    };
+    let (mut equations, mut energies, folded_lines) = match (plain.cloned(), projected) {
+        (Some(spec), _) => {
             let s = tree::controller(model, &spec)?;
             let (equations, energies) = tree::equations::equations(model, &s)?;
             (equations, energies, None)
         }
-        None => {
+        (None, Some(p)) => {
+            let (equations, energies) = tree::equations::projected(model, p)?;
+            (equations, energies, None)
+        }
+        (None, None) => {
             let parts = ClosedForm {
                 speeds: &speeds,
                 map: &map,

@@ -101,6 +101,7 @@ pub(super) fn build_in(
     let input_rates = b.driving_inputs(&holonomic, &nonholonomic);
     let loads = b.loads(ast, &bodies)?;
     let rolling = b.rolling_contacts(ast, &bodies);
+    let contacts = b.contacts(ast);
     let (speed_specs, speeds_at) = b.speeds(ast);
     let speeds: Vec<usize> = speed_specs.iter().filter_map(|s| s.coordinate).collect();
     // Effects: the loads', then those only constraints name.
@@ -119,7 +120,14 @@ pub(super) fn build_in(
             effects.push(e.clone());
         }
     }
-    let scenes = b.scenes(ast, &effects, &constraint_effects, &speed_specs);
+    // A contact's effect adds its rows where named: leaving it out is the
+    // model as declared.
+    for c in &contacts {
+        if !effects.contains(&c.effect) {
+            effects.push(c.effect.clone());
+        }
+    }
+    let scenes = b.scenes(ast, &effects, &constraint_effects, &speed_specs, &contacts);
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
             ast.name.span(),
@@ -135,6 +143,7 @@ pub(super) fn build_in(
         params: b.params,
         coords: b.coords,
         speeds,
+        declared_speeds: speed_specs.clone(),
         speed_specs,
         speeds_at,
         speeds_declared: ast.speeds.is_some(),
@@ -147,6 +156,7 @@ pub(super) fn build_in(
         holonomic,
         nonholonomic,
         rolling,
+        contacts,
         forces: loads.forces,
         torques: loads.torques,
         effects,

@@ -18,6 +18,7 @@
 mod bodies;
 mod builder;
 mod calls;
+mod contacts;
 mod expr;
 mod frames;
 mod scenes;
@@ -31,6 +32,7 @@ use crate::ast::ModelAst;
 use crate::ctxt::Ctxt;
 
 pub use crate::algebra::{Mat3, Vec3};
+pub use contacts::Contact;
 
 /// A parameter (struct field).
 #[derive(Clone)]
@@ -157,7 +159,24 @@ pub struct Scene {
     pub speeds: Option<(Vec<SpeedSpec>, proc_macro2::TokenStream)>,
 }
 
+/// The rows of the contacts `scene` holds, in declaration order.
+fn held_rows(contacts: &[Contact], scene: &Scene) -> Vec<Constraint> {
+    scene
+        .contacts(contacts)
+        .into_iter()
+        .flat_map(|c| c.rows.iter().cloned())
+        .collect()
+}
+
 impl Scene {
+    /// The contacts the scene holds: those whose effect it names.
+    pub fn contacts<'a>(&self, contacts: &'a [Contact]) -> Vec<&'a Contact> {
+        contacts
+            .iter()
+            .filter(|c| self.effects.contains(&c.effect))
+            .collect()
+    }
+
     /// Whether the scene keeps a constraint of `effect` (one without an
     /// effect is in every scene).
     pub fn keeps_constraint(&self, effect: &Option<String>) -> bool {
@@ -194,7 +213,7 @@ impl ConstraintSet {
             .chain(&model.nonholonomic)
             .any(|c| !keeps(&c.effect))
             || model.rolling.iter().any(|r| !keeps(&r.effect));
-        if !drops && scene.speeds.is_none() {
+        if !drops && scene.speeds.is_none() && scene.contacts(&model.contacts).is_empty() {
             return None;
         }
         let (speed_specs, speeds_at) = scene
@@ -206,7 +225,10 @@ impl ConstraintSet {
         };
         Some(ConstraintSet {
             holonomic: kept(&model.holonomic),
-            nonholonomic: kept(&model.nonholonomic),
+            nonholonomic: kept(&model.nonholonomic)
+                .into_iter()
+                .chain(held_rows(&model.contacts, scene))
+                .collect(),
             rolling: model
                 .rolling
                 .iter()
@@ -236,6 +258,7 @@ impl ConstraintSet {
         let mut t = twin.clone();
         t.holonomic.retain(|c| keeps(&c.effect));
         t.nonholonomic.retain(|c| keeps(&c.effect));
+        t.nonholonomic.extend(held_rows(&t.contacts, scene));
         t.rolling.retain(|r| keeps(&r.effect));
         t
     }
@@ -283,6 +306,9 @@ pub struct Model {
     pub speeds: Vec<usize>,
     /// All privileged speeds, in order.
     pub speed_specs: Vec<SpeedSpec>,
+    /// The model's own privileged speeds, which a scene's derivation does
+    /// not swap: a tree's recursions run in them.
+    pub declared_speeds: Vec<SpeedSpec>,
     /// The tokens of `speeds(...)`, for errors.
     pub speeds_at: proc_macro2::TokenStream,
     /// Whether the model names its speeds (`speeds(...)` or joints); the
@@ -309,6 +335,8 @@ pub struct Model {
     pub nonholonomic: Vec<Constraint>,
     /// Rolling contacts.
     pub rolling: Vec<Rolling>,
+    /// `contact(...)`s: held only in the scenes that name their effects.
+    pub contacts: Vec<Contact>,
     /// Forces.
     pub forces: Vec<Load>,
     /// Torques.
@@ -404,6 +432,8 @@ pub struct Twin {
     pub nonholonomic: Vec<Constraint>,
     /// The rolling contacts.
     pub rolling: Vec<Rolling>,
+    /// The contacts.
+    pub contacts: Vec<Contact>,
     /// The direction-cosine symbols.
     pub cuts: Vec<Cut>,
 }
@@ -456,6 +486,7 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Kinematics> {
                 holonomic: t.holonomic,
                 nonholonomic: t.nonholonomic,
                 rolling: t.rolling,
+                contacts: t.contacts,
                 cuts,
             })
         }

@@ -14,6 +14,7 @@ impl Builder<'_> {
         effects: &[String],
         constraint_effects: &[String],
         model_speeds: &[SpeedSpec],
+        contacts: &[super::Contact],
     ) -> Vec<Scene> {
         let cx = self.cx;
         let mut scenes = Vec::new();
@@ -51,6 +52,7 @@ impl Builder<'_> {
                         && ast.holonomic.is_empty()
                         && ast.nonholonomic.is_empty()
                         && ast.rolls.is_empty()
+                        && ast.contacts.is_empty()
                     {
                         cx.error_spanned_by(
                             kind,
@@ -127,7 +129,7 @@ impl Builder<'_> {
                         None
                     }
                 },
-                None => None,
+                None => self.contact_speeds(ast, sc, contacts, model_speeds, &mut ok),
             };
             if ok {
                 scenes.push(Scene {
@@ -140,6 +142,37 @@ impl Builder<'_> {
             }
         }
         scenes
+    }
+
+    /// The speeds of a scene that names no speeds: the model's, less the
+    /// joints its contacts make dependent (None when it holds none).
+    fn contact_speeds(
+        &self,
+        ast: &ModelAst,
+        sc: &SceneDef,
+        contacts: &[super::Contact],
+        model_speeds: &[SpeedSpec],
+        ok: &mut bool,
+    ) -> Option<(Vec<SpeedSpec>, proc_macro2::TokenStream)> {
+        let held: Vec<&super::Contact> = contacts
+            .iter()
+            .filter(|c| sc.effects.iter().any(|e| *e == c.effect))
+            .collect();
+        if held.is_empty() {
+            return None;
+        }
+        match super::contacts::scene_speeds(ast, &held, model_speeds) {
+            Ok(speeds) => {
+                let name = &sc.name;
+                Some((speeds, quote::quote!(#name)))
+            }
+            Err(message) => {
+                self.cx
+                    .error_spanned_by(&sc.name, format!("scene `{}`: {message}", sc.name));
+                *ok = false;
+                None
+            }
+        }
     }
 
     /// A scene's `speeds(...)`: each a coordinate (its rate) or one of the

@@ -227,11 +227,16 @@ pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
     })
 }
 
-/// What a tree of joints may not have: scenes, coordinates no joint
+/// What a tree of joints may not have: scenes that leave out loads (a
+/// scene may differ only in the contacts it holds), coordinates no joint
 /// makes, inputs and loads other than the joints' own.
 fn tree_checks(ast: &ModelAst) -> Result<(), String> {
-    if !ast.scenes.is_empty() {
-        return Err("the model declares scenes".into());
+    let actuated = ast.joints.iter().any(|j| j.actuated);
+    for sc in &ast.scenes {
+        let keeps = |e: &str| sc.effects.iter().any(|x| x == e);
+        if (ast.gravity.is_some() && !keeps("gravity")) || (actuated && !keeps("actuation")) {
+            return Err(format!("scene `{}` leaves out loads", sc.name));
+        }
     }
     let mut expected_loads = 0;
     let mut inputs = Vec::new();

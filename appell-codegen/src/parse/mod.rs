@@ -9,6 +9,7 @@ use syn::{Ident, Token};
 use crate::ast::*;
 use crate::ctxt::Ctxt;
 
+mod contacts;
 mod elements;
 mod expr;
 mod files;
@@ -47,6 +48,7 @@ pub fn parse_in(cx: &Ctxt, input: &syn::DeriveInput, roots: &FileRoots) -> Model
         torques: Vec::new(),
         gravity: None,
         rolls: Vec::new(),
+        contacts: Vec::new(),
         scenes: Vec::new(),
         origins: Vec::new(),
         joints: Vec::new(),
@@ -331,6 +333,7 @@ const ITEMS: &[&str] = &[
     "damper",
     "friction",
     "rolls",
+    "contact",
     "scene",
     "joint",
     "repeat",
@@ -415,6 +418,13 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
                 let at = item.all.clone();
                 ast.rolls.push(Parser::parse2(
                     move |s: ParseStream| parse_rolls(s, at),
+                    tokens,
+                )?)
+            }
+            "contact" => {
+                let at = item.all.clone();
+                ast.contacts.push(Parser::parse2(
+                    move |s: ParseStream| contacts::parse_contact(s, at),
                     tokens,
                 )?)
             }

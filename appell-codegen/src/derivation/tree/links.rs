@@ -55,19 +55,24 @@ pub struct Parts {
 impl Parts {
     /// The model's symbols.
     pub fn new(model: &mut Model) -> R<Parts> {
+        let speeds = model.speed_specs.clone();
+        Parts::with_speeds(model, &speeds)
+    }
+
+    /// The model's symbols with `speed_specs` as the privileged speeds (a
+    /// scene's tree keeps the model's own).
+    pub fn with_speeds(model: &mut Model, speed_specs: &[crate::model::SpeedSpec]) -> R<Parts> {
         let g = &mut model.g;
         let coordinates = model
             .coords
             .iter()
             .map(|(_, c)| g.sym(c.q))
             .collect::<R<_>>()?;
-        let speeds = model
-            .speed_specs
+        let speeds = speed_specs
             .iter()
             .map(|s| g.sym(s.symbol))
             .collect::<R<_>>()?;
-        let accels = model
-            .speed_specs
+        let accels = speed_specs
             .iter()
             .map(|s| g.sym(s.accel))
             .collect::<R<_>>()?;
@@ -77,7 +82,7 @@ impl Parts {
             .map(|(name, s)| Ok((name.to_string(), g.sym(*s)?)))
             .collect::<R<_>>()?;
         let coordinate_names = model.coords.iter().map(|(c, _)| c.to_string()).collect();
-        let speed_names = model.speed_specs.iter().map(|s| s.name.clone()).collect();
+        let speed_names = speed_specs.iter().map(|s| s.name.clone()).collect();
         Ok(Parts {
             coordinates,
             coordinate_names,

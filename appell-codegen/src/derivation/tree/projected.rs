@@ -18,11 +18,13 @@
 
 use appell_symbolic::{Graph, Id, RateRules, Substitution, SymbolicError};
 
+use super::free;
 use super::links::{self, Parts};
 use super::recursions::Recursions;
+use super::spatial::Algebra;
 use crate::derivation::SpeedMap;
 use crate::model::tree::TreeSpec;
-use crate::model::Model;
+use crate::model::{Model, SpeedSpec};
 
 type R<T> = Result<T, SymbolicError>;
 
@@ -107,6 +109,91 @@ pub fn projected(
         mass: congruence(g, &c, &mass_q, n, l)?,
         forcing: transposed_product(g, &c, &net, n, l)?,
     })
+}
+
+/// The tree's equations in its own speeds u (the model's declared ones,
+/// `tree_speeds`: a ball's angular velocity, the joint rates), projected
+/// onto a scene's privileged speeds ẏ through u = C_u ẏ + c_u: a scene
+/// speed is one of u, a dependent joint rate is its row of q̇ = C ẏ + c
+/// (stage 4; under a numeric elimination its entries are X's symbols).
+/// u̇ at ÿ = 0 is u's rate on the reduced system (`reduced`, where X moves
+/// as w) with ÿ set to zero. M = C_uᵀ M_u C_u and f = C_uᵀ (τ − RNEA(q,
+/// u, u̇)), with the energies T = ½ Σ vᵢ · Iᵢ vᵢ and the input power τ · u.
+/// None when a speed of the tree is neither a scene speed nor a
+/// coordinate's rate (a ball's angular velocity the scene does not keep).
+pub fn in_speeds(
+    model: &mut Model,
+    spec: &TreeSpec,
+    map: &SpeedMap,
+    reduced: &RateRules,
+    tree_speeds: &[SpeedSpec],
+) -> R<Option<InSpeeds>> {
+    let (n, l) = (tree_speeds.len(), model.speed_specs.len());
+    let parts = Parts::with_speeds(model, tree_speeds)?;
+    let g = &mut model.g;
+    let (zero, one) = (g.int(0)?, g.int(1)?);
+    let mut c = vec![zero; n * l];
+    let mut u = Vec::with_capacity(n);
+    for (i, t) in tree_speeds.iter().enumerate() {
+        if let Some(k) = model.speed_specs.iter().position(|s| s.name == t.name) {
+            c[i * l + k] = one;
+            u.push(g.sym(model.speed_specs[k].symbol)?);
+        } else if let Some(r) = t.coordinate {
+            c[i * l..(i + 1) * l].copy_from_slice(&map.c[r * l..(r + 1) * l]);
+            u.push(map.qdot[r]);
+        } else {
+            return Ok(None);
+        }
+    }
+    let mut at_rest = Substitution::new();
+    for s in &model.speed_specs {
+        at_rest.insert(s.accel, zero);
+    }
+    let rates = g.time_derivatives(&u, reduced)?;
+    let u_dot = at_rest.apply_all(g, &rates)?;
+    let tree = links::links(g, spec, &parts, &[], links::Index::Speeds)?;
+    let gravity = links::gravity(g, spec)?;
+    let (body, accels) = {
+        let mut a = Algebra::new(g)?;
+        let body = free::speeds_in(&mut a, &tree, &u)?;
+        let accels = free::accelerations_in(&mut a, &tree, &body, &u_dot)?;
+        (body, accels)
+    };
+    let mut r = Recursions::new(g, &tree, gravity, n)?;
+    let forces = r.newton_euler(&body, Some(&accels), true)?;
+    let mass_u = r.composite_rigid_body()?;
+    let kinetic = r.kinetic_energy(&body)?;
+    let torques = r.inputs();
+    let (forces, mass_u) = {
+        let mut a = Algebra::new(g)?;
+        (
+            free::forces_out(&mut a, &tree, &forces)?,
+            free::mass_out(&mut a, &tree, &mass_u, n)?,
+        )
+    };
+    let mut net = Vec::with_capacity(n);
+    for (&tau, &force) in torques.iter().zip(&forces) {
+        net.push(g.sub(tau, force)?);
+    }
+    let input_power = dot(g, &torques, &u)?;
+    Ok(Some(InSpeeds {
+        projected: Projected {
+            mass: congruence(g, &c, &mass_u, n, l)?,
+            forcing: transposed_product(g, &c, &net, n, l)?,
+        },
+        kinetic,
+        input_power,
+    }))
+}
+
+/// [`in_speeds`]'s output: M and f, T and the input power.
+pub struct InSpeeds {
+    /// M and f on the scene's speeds.
+    pub projected: Projected,
+    /// The kinetic energy.
+    pub kinetic: Id,
+    /// τ · u.
+    pub input_power: Id,
 }
 
 /// The coordinates' and inputs' symbols the rates are differentiated in.

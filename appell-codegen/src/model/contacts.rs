@@ -1,0 +1,205 @@
+//! Contacts (`contact(link, point | flat)`): their rows, held only in the
+//! scenes that name their effects, and the privileged speeds such a scene
+//! takes when it names none: each contact makes the joints nearest its link
+//! dependent, as many as it has rows (a leg's joints under a stance foot),
+//! so the base and the free legs keep theirs.
+
+use super::builder::{hint, Builder};
+use super::{Constraint, SpeedSpec};
+use crate::ast::*;
+use crate::parse::joints::JointKind;
+
+/// A resolved contact.
+#[derive(Clone)]
+pub struct Contact {
+    /// The frame in contact.
+    pub link: syn::Ident,
+    /// The effect whose scenes hold it.
+    pub effect: String,
+    /// Whether its frame's turning is held too.
+    pub flat: bool,
+    /// Its rows: the origin's velocity along N's axes (identically zero
+    /// components dropped), then for a flat contact the frame's angular
+    /// velocity.
+    pub rows: Vec<Constraint>,
+}
+
+impl Builder<'_> {
+    /// The model's contacts; a link that no joint made is reported.
+    pub(super) fn contacts(&mut self, ast: &ModelAst) -> Vec<Contact> {
+        let mut out = Vec::new();
+        for c in &ast.contacts {
+            let Some((_, origin)) = ast.origins.iter().find(|(f, _)| *f == c.link) else {
+                let h = hint(
+                    &c.link.to_string(),
+                    ast.origins.iter().map(|(f, _)| f.to_string()),
+                );
+                self.cx.error_spanned_by(
+                    &c.link,
+                    format!("`contact` names a frame a joint made (a URDF link), and `{}` is not one{h}", c.link),
+                );
+                continue;
+            };
+            if out.iter().any(|o: &Contact| o.link == c.link) {
+                self.cx
+                    .error_spanned_by(&c.link, format!("`{}` has a contact already", c.link));
+                continue;
+            }
+            let rows: Vec<Constraint> = contact_rows(c, origin)
+                .iter()
+                .flat_map(|r| self.constraint(r))
+                .collect();
+            out.push(Contact {
+                link: c.link.clone(),
+                effect: c.effect.to_string(),
+                flat: c.flat,
+                rows,
+            });
+        }
+        out
+    }
+}
+
+/// `velocity(origin) == 0`, and for a flat contact `omega(link) == 0`.
+fn contact_rows(c: &ContactDef, origin: &syn::Ident) -> Vec<ConstraintDef> {
+    let span = c.link.span();
+    let call = |f: &str, arg: &syn::Ident| {
+        Expr::Call(
+            syn::Ident::new(f, span),
+            vec![Expr::Name(arg.clone())],
+            span,
+        )
+    };
+    let row = |lhs: Expr| ConstraintDef {
+        lhs,
+        rhs: Expr::Int(0, span),
+        along: None,
+        effect: Some(c.effect.clone()),
+        at: c.at.clone(),
+    };
+    let mut rows = vec![row(call("velocity", origin))];
+    if c.flat {
+        rows.push(row(call("omega", &c.link)));
+    }
+    rows
+}
+
+/// The privileged speeds of a scene that holds `held` (contacts) and names
+/// no speeds: `speeds` less, for each contact in turn, the one-axis joints
+/// nearest its link (deepest first) not taken already, as many as its rows.
+/// An error names the contact whose leg has too few joints.
+pub(super) fn scene_speeds(
+    ast: &ModelAst,
+    held: &[&Contact],
+    speeds: &[SpeedSpec],
+) -> Result<Vec<SpeedSpec>, String> {
+    let mut dependent: Vec<String> = Vec::new();
+    for c in held {
+        let path = one_axis_joints_above(ast, &c.link);
+        let free: Vec<&String> = path
+            .iter()
+            .filter(|q| !dependent.contains(q) && speeds.iter().any(|s| s.name == **q))
+            .collect();
+        let rows = c.rows.len();
+        if free.len() < rows {
+            let names: Vec<String> = free.iter().map(|q| format!("`{q}`")).collect();
+            let above = match names.len() {
+                0 => "no revolute or prismatic joint above it is free to give way".to_string(),
+                k => format!(
+                    "only {k} revolute or prismatic joint{} above it {} free to give way ({})",
+                    if k == 1 { "" } else { "s" },
+                    if k == 1 { "is" } else { "are" },
+                    names.join(", ")
+                ),
+            };
+            return Err(format!(
+                "the contact of `{}` holds {rows} rows, and {above}: name the scene's privileged speeds with `speeds(...)`",
+                c.link
+            ));
+        }
+        dependent.extend(free.into_iter().take(rows).cloned());
+    }
+    Ok(speeds
+        .iter()
+        .filter(|s| !dependent.contains(&s.name))
+        .cloned()
+        .collect())
+}
+
+/// The coordinates of the revolute and prismatic joints from `link` up to
+/// the ground, nearest first (mimic and other dependent joints left out).
+fn one_axis_joints_above(ast: &ModelAst, link: &syn::Ident) -> Vec<String> {
+    let mut out = Vec::new();
+    let mut frame = link.clone();
+    while let Some(j) = ast.joints.iter().find(|j| j.child == frame) {
+        if matches!(j.kind, JointKind::Revolute(_) | JointKind::Prismatic(_)) && !j.dependent {
+            out.push(j.name.to_string());
+        }
+        frame = j.parent.clone();
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use crate::ctxt::Ctxt;
+    use crate::{model, parse};
+
+    /// A body on a leg of `joints` revolute joints, a foot at its end.
+    fn leg(joints: usize, scene: &str) -> String {
+        let mut src = String::from("#[appell(joint(base, free, parent = N, child = B))]\n");
+        src += "#[appell(body(B, frame = B, center = origin(B), mass = 1.0, inertia = principal(0.1, 0.1, 0.1)))]\n";
+        let mut parent = "B".to_string();
+        for k in 0..joints {
+            src += &format!("#[appell(joint(j{k}, revolute(y), parent = {parent}, child = L{k}, xyz = [0.0, 0.0, -0.2]))]\n");
+            src += &format!("#[appell(body(L{k}, frame = L{k}, center = origin(L{k}), mass = 0.1, inertia = principal(0.01, 0.01, 0.01)))]\n");
+            parent = format!("L{k}");
+        }
+        src += &format!(
+            "#[appell(joint(ankle, weld, parent = {parent}, child = F, xyz = [0.0, 0.0, -0.2]))]\n"
+        );
+        src += "#[appell(contact(F, point, effect = down), gravity(-9.81 * N.z))]\n";
+        src + scene + "\nstruct Leg;"
+    }
+
+    fn build(src: &str) -> (Ctxt, Option<model::Kinematics>) {
+        let cx = Ctxt::new();
+        let input: syn::DeriveInput = syn::parse_str(src).unwrap();
+        let ast = parse::parse(&cx, &input);
+        let k = model::build(&cx, &ast);
+        (cx, k)
+    }
+
+    #[test]
+    fn a_held_foot_takes_the_speeds_of_the_joints_nearest_it() {
+        let (cx, k) = build(&leg(
+            4,
+            "#[appell(scene(standing, effects(gravity, down)))]",
+        ));
+        cx.check().expect("no errors");
+        let model = k.expect("a model").model;
+        // The rows are the foot's velocity along N's axes; the model
+        // itself holds none of them.
+        assert_eq!(model.contacts[0].rows.len(), 3);
+        assert!(model.nonholonomic.is_empty());
+        let (speeds, _) = model.scenes[0].speeds.clone().expect("speeds");
+        let names: Vec<&str> = speeds.iter().map(|s| s.name.as_str()).collect();
+        assert_eq!(
+            names,
+            ["base_wx", "base_wy", "base_wz", "base_x", "base_y", "base_z", "j0"]
+        );
+    }
+
+    #[test]
+    fn a_leg_too_short_for_its_foot_is_an_error_naming_its_joints() {
+        let (cx, _) = build(&leg(
+            2,
+            "#[appell(scene(standing, effects(gravity, down)))]",
+        ));
+        let errors = cx.check().expect_err("an error").to_string();
+        assert!(
+            errors.contains("holds 3 rows, and only 2 revolute or prismatic joints above it are free to give way (`j1`, `j0`)"),
+            "{errors}"
+        );
+    }
+}

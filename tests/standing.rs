@@ -1,0 +1,167 @@
+//! Legged robots standing on their feet: a `contact(foot, point)` per foot
+//! and a scene per contact set, against Pinocchio 4.1.0's constrained
+//! forward dynamics (`forwardDynamics` with the feet's Jacobians and
+//! drifts) at 20 random states a set that keep the feet still
+//! (`tests/reference/pinocchio/contacts/`, written by
+//! `make_contacts_reference.py`).
+//!
+//! A scene holds its feet; the model itself is the robot in the air. The
+//! scene's rhs gives the accelerations of its privileged speeds (the base's
+//! and the free legs' joints: each stance foot makes its leg's three joints
+//! dependent), `appell::constraint_forces` the multipliers, which are the
+//! ground's forces on the feet in the world's axes, and the joint
+//! accelerations of the stance legs. Both are compared with Pinocchio's
+//! ddq and λ through `appell::pinocchio::PinocchioMap`.
+
+use appell::constraint_forces::contact_forces;
+use appell::pinocchio::PinocchioMap;
+use appell::{Appell, Model, RowSource};
+use serde_json::Value;
+
+/// Solo12 on a free base with a point contact at each foot, standing on
+/// all four or trotting on a diagonal pair.
+#[allow(clippy::duplicated_attributes)] // the scenes name effects alike
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/solo/solo12.urdf", base = free), gravity(-9.81 * N.z))]
+#[appell(contact(FL_FOOT, point, effect = fl), contact(FR_FOOT, point, effect = fr))]
+#[appell(contact(HL_FOOT, point, effect = hl), contact(HR_FOOT, point, effect = hr))]
+#[appell(scene(standing, effects(gravity, actuation, fl, fr, hl, hr)))]
+#[appell(scene(trotting, effects(gravity, actuation, fl, hr)))]
+struct Solo12;
+
+fn numbers(v: &Value) -> Vec<f64> {
+    v.as_array()
+        .expect("a list")
+        .iter()
+        .map(|x| x.as_f64().expect("a number"))
+        .collect()
+}
+
+/// max |a − b| / (1 + max |b|).
+fn relative(a: &[f64], b: &[f64]) -> f64 {
+    assert_eq!(a.len(), b.len());
+    let scale = 1.0 + b.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+    let worst = a
+        .iter()
+        .zip(b)
+        .fold(0.0f64, |m, (x, y)| m.max((x - y).abs()));
+    worst / scale
+}
+
+/// The worst relative differences of the scene's accelerations and contact
+/// forces to Pinocchio's, over the reference's states.
+fn worst_difference<S: Model>(scene: &S, set: &str) -> (f64, f64) {
+    let path = format!(
+        "{}/tests/reference/pinocchio/contacts/{set}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let data: Value =
+        serde_json::from_str(&std::fs::read_to_string(path).expect("file")).expect("JSON");
+    let joints: Vec<&str> = data["joints"].as_array().expect("joints")[1..]
+        .iter()
+        .map(|j| j["name"].as_str().expect("name"))
+        .collect();
+    let (full, info) = (Solo12::info(), S::info());
+    let map = PinocchioMap::free("root_joint", full.coordinates, full.speeds, &joints).unwrap();
+    let (n, l, nv) = (full.coordinates.len(), full.speeds.len(), map.nv());
+    let prepared = scene.prepare::<f64>();
+    let (mut worst_a, mut worst_f) = (0.0f64, 0.0f64);
+    for s in data["states"].as_array().expect("states") {
+        let (q_pin, v_pin, tau) = (numbers(&s["q"]), numbers(&s["v"]), numbers(&s["tau"]));
+        let (mut q, mut u) = (vec![0.0; n], vec![0.0; l]);
+        map.q_from_pinocchio(&q_pin, &mut q).unwrap();
+        map.v_from_pinocchio(&q, &v_pin, &mut u).unwrap();
+        let speed = |name: &str| full.speeds.iter().position(|s| *s == name).unwrap();
+        let scene_u: Vec<f64> = info.speeds.iter().map(|s| u[speed(s)]).collect();
+        let inputs: Vec<f64> = info
+            .inputs
+            .iter()
+            .map(|i| {
+                let j = joints
+                    .iter()
+                    .position(|j| Some(*j) == i.strip_prefix("tau_"));
+                tau[6 + j.expect("an actuated joint")]
+            })
+            .collect();
+        // The scene's rhs on its reduced state.
+        let mut state: Vec<f64> = info
+            .retained
+            .iter()
+            .map(|c| q[info.coordinate_index(c).unwrap()])
+            .collect();
+        let k = state.len();
+        state.extend(&scene_u);
+        let mut d = vec![0.0; state.len()];
+        scene.rhs(&prepared, 0.0, &state, &inputs, &mut d).unwrap();
+        // The multipliers and the stance joints' accelerations.
+        let forces = contact_forces(scene, 0.0, &q, &scene_u, &inputs).unwrap();
+        let u_dot: Vec<f64> = full
+            .speeds
+            .iter()
+            .map(|s| match info.speeds.iter().position(|x| x == s) {
+                Some(k_s) => d[k + k_s],
+                None => forces.qddot[full.coordinate_index(s).expect("a joint's rate")],
+            })
+            .collect();
+        let mut a = vec![0.0; nv];
+        map.a_to_pinocchio(&q, &u, &u_dot, &mut a).unwrap();
+        worst_a = worst_a.max(relative(&a, &numbers(&s["ddq"])));
+        // The feet's rows (the base's unit quaternion has a row too).
+        let feet: Vec<f64> = info
+            .row_sources
+            .iter()
+            .zip(&forces.multipliers)
+            .filter(|(r, _)| matches!(r, RowSource::Nonholonomic { .. }))
+            .map(|(_, m)| *m)
+            .collect();
+        worst_f = worst_f.max(relative(&feet, &numbers(&s["lambda"])));
+    }
+    println!(
+        "{set}: {} speeds, {} operations per rhs call; worst relative difference to Pinocchio: accelerations {worst_a:.1e}, contact forces {worst_f:.1e}",
+        info.speeds.len(),
+        info.rhs_ops.total
+    );
+    (worst_a, worst_f)
+}
+
+#[test]
+fn a_stance_foot_makes_its_legs_joints_dependent() {
+    let four = Solo12Standing::info();
+    assert_eq!(
+        four.speeds,
+        [
+            "root_joint_wx",
+            "root_joint_wy",
+            "root_joint_wz",
+            "root_joint_x",
+            "root_joint_y",
+            "root_joint_z"
+        ]
+    );
+    let trot = Solo12Trotting::info();
+    assert_eq!(trot.speeds.len(), 12);
+    for leg in ["FR", "HL"] {
+        for joint in ["HAA", "HFE", "KFE"] {
+            assert!(trot.speeds.contains(&format!("{leg}_{joint}").as_str()));
+        }
+    }
+    // The model itself is the robot in the air, in its structured form.
+    let info = Solo12::info();
+    assert_eq!(info.speeds.len(), 18);
+    // Its one row is the base quaternion's unit norm.
+    assert_eq!((info.holonomic, info.constraints), (1, 1));
+    assert!(info.form.starts_with("structured"), "{}", info.form);
+}
+
+#[test]
+fn solo12_on_its_feet_agrees_with_pinocchio() {
+    let robot = Solo12;
+    let four = worst_difference(Solo12Standing::from_ref(&robot), "solo12_four_feet");
+    let trot = worst_difference(Solo12Trotting::from_ref(&robot), "solo12_trot_fl_hr");
+    for (set, (a, f)) in [("four feet", four), ("trot", trot)] {
+        assert!(
+            a < 1e-9 && f < 1e-9,
+            "{set}: accelerations {a:.1e}, forces {f:.1e}"
+        );
+    }
+}
