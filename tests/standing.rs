@@ -111,7 +111,7 @@ fn worst_difference<S: Model>(scene: &S, set: &str) -> (f64, f64) {
             .row_sources
             .iter()
             .zip(&forces.multipliers)
-            .filter(|(r, _)| matches!(r, RowSource::Nonholonomic { .. }))
+            .filter(|(r, _)| matches!(r, RowSource::Contact { .. }))
             .map(|(_, m)| *m)
             .collect();
         worst_f = worst_f.max(relative(&feet, &numbers(&s["lambda"])));
@@ -164,4 +164,127 @@ fn solo12_on_its_feet_agrees_with_pinocchio() {
             "{set}: accelerations {a:.1e}, forces {f:.1e}"
         );
     }
+}
+
+/// A body on one leg (`tests/data/one_leg.urdf`), in the air or standing.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/data/one_leg.urdf", base = free), gravity(-9.81 * N.z))]
+#[appell(contact(foot, point, effect = stance))]
+#[appell(scene(standing, effects(gravity, actuation, stance)))]
+struct OneLeg;
+
+#[test]
+fn a_falling_robot_lands_on_its_foot_with_the_impulse_that_stops_it() {
+    use appell::hybrid::{Guard, Hybrid, Phase};
+    let robot = OneLeg;
+    let standing = OneLegStanding::from_ref(&robot);
+    assert_eq!(OneLeg::contact_links(), ["foot"]);
+    let phases = vec![
+        Phase::new("flight", &robot).guard(Guard::touchdown(1, &robot, 0).impact(standing, 0.0)),
+        Phase::new("standing", standing),
+    ];
+    // Upright, the knee bent, 0.5 m up and at rest: it falls as one body
+    // (no torque turns a joint in free fall) until the foot reaches the
+    // ground.
+    let info = OneLeg::info();
+    let at = |name: &str| info.coordinate_index(name).unwrap();
+    let mut q = vec![0.0; info.coordinates.len()];
+    q[at("root_joint_qw")] = 1.0;
+    q[at("root_joint_z")] = 0.5;
+    q[at("hip_pitch")] = 0.3;
+    q[at("knee")] = -0.6;
+    let mut feet = [[0.0; 3]];
+    robot.contact_points(0.0, &q, &mut feet).unwrap();
+    let height = feet[0][2];
+    assert!((height - (0.5 - 0.05 - 0.2 * 0.3f64.cos() - 0.2 * 0.3f64.cos())).abs() < 1e-12);
+    let run = Hybrid::new(phases)
+        .run::<19>(0, 0.0, &q, &[0.0; 9], 0.2)
+        .expect("a landing");
+    assert_eq!(run.switches.len(), 1);
+    let landing = &run.switches[0];
+    assert_eq!(
+        (landing.reason, landing.from, landing.to),
+        ("touchdown", 0, 1)
+    );
+    // The free fall's time and speed at the ground.
+    let t = (2.0 * height / 9.81).sqrt();
+    assert!((landing.t - t).abs() < 1e-6, "{} against {t}", landing.t);
+    // The ground's impulse on the foot pushes up, at most what stops the
+    // whole robot (4 kg at g t), and the plastic landing loses energy.
+    let row = OneLegStanding::info()
+        .row_sources
+        .iter()
+        .position(|r| {
+            *r == RowSource::Contact {
+                contact: 0,
+                axis: 2,
+            }
+        })
+        .unwrap();
+    let up = landing.impulses[row];
+    assert!(up > 0.0 && up < 4.0 * 9.81 * t, "impulse {up}");
+    assert!(landing.energy_lost > 0.0);
+    // Standing, the foot stays where it landed.
+    let mut after = [[0.0; 3]];
+    robot.contact_points(0.0, &run.end.q, &mut after).unwrap();
+    let mut at_landing = [[0.0; 3]];
+    let sample = run
+        .samples
+        .iter()
+        .find(|s| s.phase == 1)
+        .expect("a standing sample");
+    robot
+        .contact_points(0.0, &sample.q, &mut at_landing)
+        .unwrap();
+    for k in 0..3 {
+        assert!(
+            (after[0][k] - at_landing[0][k]).abs() < 1e-9,
+            "{after:?} {at_landing:?}"
+        );
+    }
+    assert!(after[0][2].abs() < 1e-6);
+}
+
+#[test]
+fn the_lift_off_guard_is_the_grounds_push_along_n_z() {
+    use appell::constraint_forces::contact_forces;
+    use appell::hybrid::Guard;
+    let robot = OneLeg;
+    let standing = OneLegStanding::from_ref(&robot);
+    let info = OneLegStanding::info();
+    let at = |name: &str| info.coordinate_index(name).unwrap();
+    let mut q = vec![0.0; info.coordinates.len()];
+    q[at("root_joint_qw")] = 1.0;
+    q[at("root_joint_z")] = 0.4;
+    q[at("hip_pitch")] = 0.3;
+    q[at("knee")] = -0.6;
+    let u = [0.1, -0.2, 0.05, 0.3, 0.0, -0.1];
+    let inputs = [0.5, -1.0, 2.0];
+    let guard = Guard::contact_lift_off(0, standing, 0, &inputs);
+    let push = (guard.value)(0.0, &q, &u).unwrap();
+    let forces = contact_forces(standing, 0.0, &q, &u, &inputs).unwrap();
+    let row = info
+        .row_sources
+        .iter()
+        .position(|r| {
+            *r == RowSource::Contact {
+                contact: 0,
+                axis: 2,
+            }
+        })
+        .unwrap();
+    assert_eq!(push, forces.multipliers[row]);
+    assert!(push > 0.0);
+    // The model in the air holds no contact: the guard says so.
+    let in_the_air = Guard::contact_lift_off(0, &robot, 0, &inputs);
+    assert!(matches!(
+        (in_the_air.value)(0.0, &q, &[0.0; 9]),
+        Err(appell::ModelError::Contact { .. })
+    ));
+    // A touchdown guard past the declared contacts says so too.
+    let nowhere = Guard::touchdown(0, &robot, 3);
+    assert!(matches!(
+        (nowhere.value)(0.0, &q, &[0.0; 9]),
+        Err(appell::ModelError::Contact { .. })
+    ));
 }

@@ -538,6 +538,17 @@ pub trait DynModel: sealed::Sealed {
         directions: &mut [[f64; 3]],
     ) -> Result<(), ModelError>;
 
+    /// [`Model::contact_links`].
+    fn dyn_contact_links(&self) -> &'static [&'static str];
+
+    /// [`Model::contact_points`].
+    fn dyn_contact_points(
+        &self,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+    ) -> Result<(), ModelError>;
+
     /// [`Model::load_values`].
     fn dyn_load_values(
         &self,
@@ -872,6 +883,19 @@ impl<M: Model> DynModel for M {
         directions: &mut [[f64; 3]],
     ) -> Result<(), ModelError> {
         self.contact_geometry(t, q, points, directions)
+    }
+
+    fn dyn_contact_links(&self) -> &'static [&'static str] {
+        M::contact_links()
+    }
+
+    fn dyn_contact_points(
+        &self,
+        t: f64,
+        q: &[f64],
+        points: &mut [[f64; 3]],
+    ) -> Result<(), ModelError> {
+        self.contact_points(t, q, points)
     }
 
     fn dyn_load_values(

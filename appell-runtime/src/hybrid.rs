@@ -146,6 +146,62 @@ impl<'a> Guard<'a> {
         })
     }
 
+    /// A lift-off guard for a `contact(link, ...)` the phase's scene holds
+    /// on level ground: switches to phase `to` where the ground's push on
+    /// the link along N.z (the multiplier of the contact's
+    /// [`RowSource::Contact`](crate::RowSource::Contact) row of axis 2, from
+    /// [`contact_forces`](crate::constraint_forces::contact_forces) at
+    /// `inputs`) comes down through zero: a foot that would have to be
+    /// pulled leaves the ground. `contact` indexes
+    /// [`Model::contact_links`](crate::Model::contact_links). Its reason
+    /// is `"lift-off"`; a scene that does not hold the contact is
+    /// [`ModelError::Contact`].
+    pub fn contact_lift_off(
+        to: usize,
+        model: &'a dyn DynModel,
+        contact: usize,
+        inputs: &[f64],
+    ) -> Self {
+        let inputs = inputs.to_vec();
+        let row = model
+            .dyn_info()
+            .row_sources
+            .iter()
+            .position(|r| *r == crate::RowSource::Contact { contact, axis: 2 });
+        Guard::new("lift-off", to, move |t, q: &[f64], u: &[f64]| {
+            let row = row.ok_or(ModelError::Contact {
+                what: "the lift-off guard names a contact its scene does not hold",
+            })?;
+            let forces =
+                contact_forces_dyn(model, t, q, u, &inputs).map_err(|_| ModelError::NonFinite {
+                    what: "the contact forces",
+                })?;
+            Ok(forces.multipliers[row])
+        })
+    }
+
+    /// A touchdown guard for a `contact(link, ...)` on level ground at
+    /// height zero: switches to phase `to` where the link's origin (from
+    /// [`Model::contact_points`](crate::Model::contact_points) of `model`)
+    /// comes down through N.z = 0. Give it [`Guard::impact`] with the scene
+    /// that holds the contact, so the foot lands with the impulse that
+    /// stops it. Its reason is `"touchdown"`; an index past
+    /// [`Model::contact_links`](crate::Model::contact_links) is
+    /// [`ModelError::Contact`].
+    pub fn touchdown(to: usize, model: &'a dyn DynModel, contact: usize) -> Self {
+        Guard::new("touchdown", to, move |t, q: &[f64], _u: &[f64]| {
+            let count = model.dyn_contact_links().len();
+            if contact >= count {
+                return Err(ModelError::Contact {
+                    what: "the touchdown guard names a contact the model does not declare",
+                });
+            }
+            let mut points = vec![[0.0; 3]; count];
+            model.dyn_contact_points(t, q, &mut points)?;
+            Ok(points[contact][2])
+        })
+    }
+
     /// A guard that never ends the phase it starts: below zero on entry,
     /// it waits until it has been positive and fires where it comes down
     /// again. For guards below zero on entry by design: a slip speed less

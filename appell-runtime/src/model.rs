@@ -42,7 +42,8 @@ pub struct BodyInfo {
 /// Where a velocity constraint row (a row of D in D q̇ + d = 0) comes from.
 ///
 /// Rows are ordered: the differentiated `holonomic(...)` constraints, then
-/// the `nonholonomic(...)` ones, then the components of each `rolls(...)`.
+/// the `nonholonomic(...)` ones and after them the rows of the
+/// `contact(...)`s a scene holds, then the components of each `rolls(...)`.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum RowSource {
     /// The time derivative of the `index`-th holonomic constraint.
@@ -78,6 +79,16 @@ pub enum RowSource {
         /// 0, 1, 2 for N.x, N.y, N.z (a contact without `along`), or the
         /// index into the contact's `along = [...]` list.
         direction: usize,
+    },
+    /// A row of a `contact(link, point | flat)` that a scene holds.
+    Contact {
+        /// Index into [`Model::contact_links`] (declaration order).
+        contact: usize,
+        /// 0, 1, 2: the link origin's velocity along N.x, N.y, N.z (its
+        /// multiplier is the ground's force on the link along that axis);
+        /// 3, 4, 5: the link's angular velocity about N.x, N.y, N.z (a
+        /// `flat` contact; the multiplier is the ground's moment).
+        axis: usize,
     },
 }
 
@@ -893,6 +904,27 @@ pub trait Model {
             *d = [T::zero(); 3];
         }
         Ok(())
+    }
+
+    /// The links of the model's `contact(link, point | flat)` declarations,
+    /// in order: [`RowSource::Contact`] rows name them by index. Empty by
+    /// default (a model without such contacts).
+    fn contact_links() -> &'static [&'static str] {
+        &[]
+    }
+
+    /// The origin (N components) of every link of
+    /// [`Model::contact_links`] at `(q, t)`: where each foot is, for a
+    /// touchdown guard. The default serves models without such contacts.
+    fn contact_points<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        points: &mut [[T; 3]],
+    ) -> Result<(), ModelError> {
+        let _ = t;
+        check_len("q", q, Self::info().coordinates.len())?;
+        check_len("points", points, Self::contact_links().len())
     }
 
     /// Calls `visitor` with scene `scene` (an index into

@@ -147,7 +147,10 @@ fn nonholonomic_rows(model: &Model, calculus: &Calculus) -> Vec<Row> {
             holonomic: false,
             as_written,
             direction: None,
-            source: RowSource::Nonholonomic { index },
+            source: match c.contact {
+                Some((contact, axis)) => RowSource::Contact { contact, axis },
+                None => RowSource::Nonholonomic { index },
+            },
         });
     }
     rows

@@ -56,7 +56,7 @@ pub(super) struct Common {
     pub(super) params_t: TokenStream,
     params_f: TokenStream,
     pub(super) positivity: TokenStream,
-    bind_q: TokenStream,
+    pub(super) bind_q: TokenStream,
     bind_qdot: TokenStream,
     bind_u: TokenStream,
     pub(super) bind_inputs: TokenStream,
@@ -90,6 +90,7 @@ impl Emitter<'_> {
         let parameters = self.parameter_access();
         let equations = self.equations_functions(&common);
         let kinematics = self.kinematics_functions(&common);
+        let contacts = self.contact_functions(&common);
         let loads = self.load_functions(&common);
         let controller = self.controller_functions(&common);
         quote! {
@@ -106,6 +107,7 @@ impl Emitter<'_> {
                 #rhs_fn
                 #equations
                 #kinematics
+                #contacts
                 #loads
                 #controller
             }

@@ -62,6 +62,10 @@ impl Emitter<'_> {
                     let (c, k) = (int(contact), int(direction));
                     quote!(#p::RowSource::Rolling { contact: #c, direction: #k })
                 }
+                RowSource::Contact { contact, axis } => {
+                    let (c, k) = (int(contact), int(axis));
+                    quote!(#p::RowSource::Contact { contact: #c, axis: #k })
+                }
                 RowSource::Driven { .. } => unreachable!("the derivation labels no row driven"),
             },
         );

@@ -12,6 +12,7 @@
 
 mod build_hint;
 mod code;
+mod contacts;
 mod controller;
 mod functions;
 mod info;

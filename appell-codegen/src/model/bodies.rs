@@ -158,6 +158,7 @@ impl Builder<'_> {
                     residual,
                     at: c.at.clone(),
                     effect: c.effect.as_ref().map(|e| e.to_string()),
+                    contact: None,
                 })
                 .collect(),
             Err(e) => {
@@ -169,7 +170,7 @@ impl Builder<'_> {
 
     /// Both sides of `c`, as scalars or as vectors (a point's position, or
     /// zero where a side is the literal `0` facing a point or a vector).
-    fn constraint_sides(&mut self, c: &ConstraintDef) -> Option<Side> {
+    pub(super) fn constraint_sides(&mut self, c: &ConstraintDef) -> Option<Side> {
         let zero_literal = |e: &Expr| matches!(e, Expr::Int(0, _));
         let (l, r) = match (zero_literal(&c.lhs), zero_literal(&c.rhs)) {
             (true, false) => {
@@ -370,7 +371,7 @@ impl Builder<'_> {
 }
 
 /// The two sides of a constraint.
-enum Side {
+pub(super) enum Side {
     /// lhs and rhs, scalars.
     Scalar(Id, Id),
     /// lhs and rhs, N components of points or vectors.

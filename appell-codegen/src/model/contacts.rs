@@ -4,8 +4,9 @@
 //! dependent, as many as it has rows (a leg's joints under a stance foot),
 //! so the base and the free legs keep theirs.
 
+use super::bodies::Side;
 use super::builder::{hint, Builder};
-use super::{Constraint, SpeedSpec};
+use super::{Constraint, SpeedSpec, Vec3};
 use crate::ast::*;
 use crate::parse::joints::JointKind;
 
@@ -20,8 +21,10 @@ pub struct Contact {
     pub flat: bool,
     /// Its rows: the origin's velocity along N's axes (identically zero
     /// components dropped), then for a flat contact the frame's angular
-    /// velocity.
+    /// velocity, each with its axis.
     pub rows: Vec<Constraint>,
+    /// The link's origin (N components).
+    pub origin: Vec3,
 }
 
 impl Builder<'_> {
@@ -45,18 +48,54 @@ impl Builder<'_> {
                     .error_spanned_by(&c.link, format!("`{}` has a contact already", c.link));
                 continue;
             }
-            let rows: Vec<Constraint> = contact_rows(c, origin)
-                .iter()
-                .flat_map(|r| self.constraint(r))
-                .collect();
+            let Some(position) = self.points.iter().find(|p| *origin == p.name) else {
+                continue;
+            };
+            let position = position.pos;
+            let index = out.len();
+            let mut rows = Vec::new();
+            for (k, def) in contact_rows(c, origin).iter().enumerate() {
+                rows.extend(self.contact_row(def, (index, 3 * k)));
+            }
             out.push(Contact {
                 link: c.link.clone(),
                 effect: c.effect.to_string(),
                 flat: c.flat,
                 rows,
+                origin: position,
             });
         }
         out
+    }
+}
+
+impl Builder<'_> {
+    /// The N components of a contact's vector equation, identically zero
+    /// ones dropped, each tagged with its contact and axis (`first` the
+    /// axis of its x component).
+    fn contact_row(
+        &mut self,
+        def: &ConstraintDef,
+        (contact, first): (usize, usize),
+    ) -> Vec<Constraint> {
+        self.context = "a contact".to_string();
+        let Some(Side::Vector(l, r)) = self.constraint_sides(def) else {
+            return Vec::new();
+        };
+        let mut rows = Vec::new();
+        for axis in 0..3 {
+            match self.g.sub(l[axis], r[axis]) {
+                Ok(residual) if self.g.is_zero(residual) => {}
+                Ok(residual) => rows.push(Constraint {
+                    residual,
+                    at: def.at.clone(),
+                    effect: def.effect.as_ref().map(|e| e.to_string()),
+                    contact: Some((contact, first + axis)),
+                }),
+                Err(e) => self.cx.error_spanned_by(&def.at, e),
+            }
+        }
+        rows
     }
 }
 

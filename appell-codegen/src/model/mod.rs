@@ -288,6 +288,9 @@ pub struct Constraint {
     pub at: proc_macro2::TokenStream,
     /// The effect it belongs to; None: every scene keeps it.
     pub effect: Option<String>,
+    /// For a row of a `contact(...)`: the contact's index and the row's
+    /// axis (see `appell_runtime::RowSource::Contact`).
+    pub contact: Option<(usize, usize)>,
 }
 
 /// The resolved model.

@@ -28,6 +28,7 @@ pub(super) fn contact_forces_json(
     inputs: &[f64],
 ) -> Result<Value, String> {
     let info = model.dyn_info();
+    let info_links = model.dyn_contact_links();
     let f = contact_forces_dyn(model, t, q, u, inputs).map_err(|e| e.to_string())?;
     let v3 = |v: [f64; 3]| {
         json!([
@@ -44,6 +45,15 @@ pub(super) fn contact_forces_json(
                 RowSource::Holonomic { index } => format!("holonomic {index}"),
                 RowSource::Nonholonomic { index } => format!("nonholonomic {index}"),
                 RowSource::Driven { constraint, .. } => format!("driven, {constraint}"),
+                RowSource::Contact { contact, axis } => {
+                    let link = info_links.get(contact).copied().unwrap_or("?");
+                    let what = ["x", "y", "z"][axis % 3];
+                    if axis < 3 {
+                        format!("contact of {link}, force along N.{what}")
+                    } else {
+                        format!("contact of {link}, moment about N.{what}")
+                    }
+                }
                 RowSource::Rolling { contact, direction } => {
                     let point = info.contacts.get(contact).map_or("?", |c| c.point);
                     match info.contacts.get(contact) {
