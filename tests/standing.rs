@@ -288,3 +288,27 @@ fn the_lift_off_guard_is_the_grounds_push_along_n_z() {
         Err(appell::ModelError::Contact { .. })
     ));
 }
+
+#[test]
+fn the_urdfs_joint_limits_are_kept() {
+    let limits = OneLeg::joint_limits();
+    let joints: Vec<&str> = limits.iter().map(|l| l.joint).collect();
+    assert_eq!(joints, ["hip_roll", "hip_pitch", "knee"]);
+    let knee = limits[2];
+    assert_eq!(
+        (knee.lower, knee.upper, knee.velocity, knee.effort),
+        (-2.5, 0.0, 10.0, 10.0)
+    );
+    // A scene has the model's.
+    assert_eq!(OneLegStanding::joint_limits(), limits);
+    // Solo12's knees, as its URDF gives them (`<limit effort="1000"
+    // lower="-10" upper="10" velocity="1000"/>`).
+    let kfe = Solo12::joint_limits()
+        .iter()
+        .find(|l| l.joint == "FL_KFE")
+        .expect("FL_KFE");
+    assert_eq!(
+        (kfe.lower, kfe.upper, kfe.velocity, kfe.effort),
+        (-10.0, 10.0, 1000.0, 1000.0)
+    );
+}

@@ -284,6 +284,8 @@ pub struct ModelAst {
     /// Names a URDF made, with the element that made each (`the URDF's
     /// link `forearm_link``), for errors about them.
     pub urdf_names: Vec<(String, String)>,
+    /// The URDF's joint limits: joint, lower, upper, velocity, effort.
+    pub joint_limits: Vec<(String, [f64; 4])>,
     /// URDF links without mass: frames, but not bodies (for the error of a
     /// `rolls(...)` that names one).
     pub massless_links: Vec<String>,

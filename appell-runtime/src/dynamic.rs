@@ -541,6 +541,9 @@ pub trait DynModel: sealed::Sealed {
     /// [`Model::contact_links`].
     fn dyn_contact_links(&self) -> &'static [&'static str];
 
+    /// [`Model::joint_limits`].
+    fn dyn_joint_limits(&self) -> &'static [crate::model::JointLimit];
+
     /// [`Model::contact_points`].
     fn dyn_contact_points(
         &self,
@@ -887,6 +890,10 @@ impl<M: Model> DynModel for M {
 
     fn dyn_contact_links(&self) -> &'static [&'static str] {
         M::contact_links()
+    }
+
+    fn dyn_joint_limits(&self) -> &'static [crate::model::JointLimit] {
+        M::joint_limits()
     }
 
     fn dyn_contact_points(

@@ -92,6 +92,23 @@ pub enum RowSource {
     },
 }
 
+/// A joint's limits as the URDF gives them (`<limit>`): Pinocchio's
+/// `lowerPositionLimit`, `upperPositionLimit`, `velocityLimit` and
+/// `effortLimit`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct JointLimit {
+    /// The joint (its coordinate).
+    pub joint: &'static str,
+    /// The lowest position (−∞ for a continuous joint or none given).
+    pub lower: f64,
+    /// The highest position (+∞ for a continuous joint or none given).
+    pub upper: f64,
+    /// The largest speed (0 where the file gives none).
+    pub velocity: f64,
+    /// The largest torque or force (0 where the file gives none).
+    pub effort: f64,
+}
+
 /// A `rolls(...)` contact of the model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ContactInfo {
@@ -904,6 +921,13 @@ pub trait Model {
             *d = [T::zero(); 3];
         }
         Ok(())
+    }
+
+    /// The limits of the joints a URDF declares, in the model's coordinate
+    /// order (its revolute and prismatic joints, continuous and mimic ones
+    /// included). Empty by default (a model without a URDF).
+    fn joint_limits() -> &'static [JointLimit] {
+        &[]
     }
 
     /// The links of the model's `contact(link, point | flat)` declarations,

@@ -1,9 +1,10 @@
-//! `contact_links` and `contact_points`: the links of the model's
-//! `contact(...)` declarations and where their origins are, for the guards
-//! of a hybrid run (a foot's height at touchdown). Nothing (the trait's
-//! defaults) for a model without such contacts.
+//! What a robot's description adds to the model: `contact_links` and
+//! `contact_points` (the links of the model's `contact(...)` declarations
+//! and where their origins are, for the guards of a hybrid run: a foot's
+//! height at touchdown), and `joint_limits` (its URDF's `<limit>`s).
+//! Nothing (the trait's defaults) for a model without them.
 
-use proc_macro2::TokenStream;
+use proc_macro2::{Literal, TokenStream};
 use quote::quote;
 
 use super::code::{code, Target};
@@ -40,6 +41,35 @@ impl Emitter<'_> {
                 #chk_q #chk_points #params_t #bind_q #body #(#out)*
                 #p::Ok(())
             }
+        }
+    }
+}
+
+impl Emitter<'_> {
+    /// `joint_limits`, or nothing.
+    pub(super) fn limit_function(&self) -> TokenStream {
+        let limits = &self.model.joint_limits;
+        if limits.is_empty() {
+            return TokenStream::new();
+        }
+        let p = p();
+        let number = |x: f64| {
+            if x == f64::INFINITY {
+                quote!(f64::INFINITY)
+            } else if x == f64::NEG_INFINITY {
+                quote!(f64::NEG_INFINITY)
+            } else {
+                let lit = Literal::f64_suffixed(x);
+                quote!(#lit)
+            }
+        };
+        let entries = limits.iter().map(|(joint, [lower, upper, velocity, effort])| {
+            let (lower, upper, velocity, effort) =
+                (number(*lower), number(*upper), number(*velocity), number(*effort));
+            quote!(#p::JointLimit { joint: #joint, lower: #lower, upper: #upper, velocity: #velocity, effort: #effort })
+        });
+        quote! {
+            fn joint_limits() -> &'static [#p::JointLimit] { &[#(#entries),*] }
         }
     }
 }

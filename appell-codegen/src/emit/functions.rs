@@ -91,6 +91,7 @@ impl Emitter<'_> {
         let equations = self.equations_functions(&common);
         let kinematics = self.kinematics_functions(&common);
         let contacts = self.contact_functions(&common);
+        let limits = self.limit_function();
         let loads = self.load_functions(&common);
         let controller = self.controller_functions(&common);
         quote! {
@@ -108,6 +109,7 @@ impl Emitter<'_> {
                 #equations
                 #kinematics
                 #contacts
+                #limits
                 #loads
                 #controller
             }

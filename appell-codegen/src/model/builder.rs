@@ -157,6 +157,7 @@ pub(super) fn build_in(
         nonholonomic,
         rolling,
         contacts,
+        joint_limits: ast.joint_limits.clone(),
         forces: loads.forces,
         torques: loads.torques,
         effects,

@@ -340,6 +340,8 @@ pub struct Model {
     pub rolling: Vec<Rolling>,
     /// `contact(...)`s: held only in the scenes that name their effects.
     pub contacts: Vec<Contact>,
+    /// The URDF's joint limits: joint, lower, upper, velocity, effort.
+    pub joint_limits: Vec<(String, [f64; 4])>,
     /// Forces.
     pub forces: Vec<Load>,
     /// Torques.

@@ -49,6 +49,7 @@ pub fn parse_in(cx: &Ctxt, input: &syn::DeriveInput, roots: &FileRoots) -> Model
         gravity: None,
         rolls: Vec::new(),
         contacts: Vec::new(),
+        joint_limits: Vec::new(),
         scenes: Vec::new(),
         origins: Vec::new(),
         joints: Vec::new(),

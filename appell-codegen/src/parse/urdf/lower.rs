@@ -168,12 +168,26 @@ pub(super) fn lower(
             elements: Default::default(),
             span,
         };
+        if matches!(joint.kind, JointKind::Revolute(_) | JointKind::Prismatic(_)) {
+            ast.joint_limits
+                .push((joint.name.to_string(), limits(urdf)));
+        }
         crate::parse::add_joint(ast, &joint)?;
         body_of(ast, child);
     }
     mimics(cx, ast, read, tree, spec, &welded);
     record_names(ast, robot, tree);
     Ok(())
+}
+
+/// A joint's lower, upper, velocity and effort limits as written; a
+/// continuous joint's positions are unbounded.
+fn limits(j: &urdf_rs::Joint) -> [f64; 4] {
+    let l = &j.limit;
+    match j.joint_type {
+        urdf_rs::JointType::Continuous => [f64::NEG_INFINITY, f64::INFINITY, l.velocity, l.effort],
+        _ => [l.lower, l.upper, l.velocity, l.effort],
+    }
 }
 
 /// An error for each joint that moves no body: its speed has no inertia,
