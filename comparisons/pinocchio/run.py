@@ -10,7 +10,9 @@ Steps:
 1. `make -j1` (the C++ and C drivers) and `cargo build --release` of rust/,
    once for the default x86-64 target and once with -C target-cpu=native,
    into $CARGO_TARGET_DIR/{generic,native} (default build/target/...),
-   with CARGO_BUILD_JOBS=1 unless it is set.
+   with CARGO_BUILD_JOBS=1 unless it is set; `make cg` (pinocchio_cg_bench,
+   Pinocchio's code-generated functions) unless --no-cg, whose generated
+   libraries are made once per run in build/cg.
 2. URDFs of the chains without one in examples/robots (n = 24, 48, 64; appell
    times 64 too when the Rust driver is built with --features large-models,
    run.py's default) are written into build/urdf/ with make_urdf.py's
@@ -18,8 +20,10 @@ Steps:
    copies (no <visual>/<collision>, the Panda's fingers fixed) go to
    build/mujoco/.
 3. Correctness: both Pinocchio builds evaluate the states of
-   tests/reference/pinocchio/*.json (computed by Pinocchio's Python
-   bindings) and must agree with them to 1e-9 relative.
+   tests/reference/pinocchio/*.json and, on a free flyer, of
+   tests/reference/pinocchio/robots/ for the floating-base robots (computed
+   by Pinocchio's Python bindings) and must agree with them to 1e-9
+   relative.
 4. Timing: ROUNDS rounds; in each, every model is timed by every
    implementation, one process each, TRIES times over (the order of the
    implementations reversed from one round to the next). Each process
@@ -356,6 +360,7 @@ def measure(args):
     # Pinocchio's code generation: record, generate and compile each
     # function once per model (untimed; the libraries stay in build/cg).
     cg_prepare = {}
+    meta_cg_compiled = {}
     if cg_bin:
         os.makedirs(cg_dir, exist_ok=True)
         for name, urdf, weld, _ in models:
@@ -365,6 +370,8 @@ def measure(args):
             lines = run_driver([cg_bin, urdf, "--name", name, "--batch", "1", "--reps", "1"] + wl + fl, cwd=cg_dir)
             cg_prepare[name] = {x["prepare"]: x["seconds"] for x in lines if "prepare" in x}
             cg_prepare[name]["total"] = round(time.time() - t0, 1)
+            compiled = [x["compiled"] for x in lines if "prepare" in x]
+            meta_cg_compiled[name] = all(compiled) if compiled else False
             log(f"  code generation for {name}: {cg_prepare[name]}")
 
     path = os.path.join(BUILD, "results.jsonl")
@@ -385,6 +392,7 @@ def measure(args):
         "free": sorted(FREE & {name for name, _, _, _ in models}),
         "checks": checks,
         "cg_prepare": cg_prepare,
+        "cg_compiled": meta_cg_compiled,
     }
     raw.write(json.dumps({"meta": meta}) + "\n")
     for r in range(args.rounds):
@@ -595,8 +603,12 @@ def report(path):
                 "conventions by `PinocchioMap` before summing):", ""]
         out += [f"- {label}: {d:.1e}" for label, d in floating.items()] + [""]
     if meta.get("cg_prepare"):
-        out.append("Pinocchio's code generation, seconds to record, generate and compile each function "
-                   "(once per run, before the timing): "
+        compiled = meta.get("cg_compiled", {})
+        what = ("seconds to record, generate and compile each function"
+                if all(compiled.get(name, True) for name in meta["cg_prepare"])
+                else "seconds to record each function and load its library (the libraries were already "
+                     "in build/cg, as with --no-build: not compiled again)")
+        out.append(f"Pinocchio's code generation, {what} (once per run, before the timing): "
                    + "; ".join(f"{name} " + ", ".join(f"{f} {t:g}" for f, t in times.items())
                                for name, times in meta["cg_prepare"].items())
                    + ".")
