@@ -3,7 +3,7 @@
 // Pinocchio's CodeGenBase as its own generators are, on the same states as
 // pinocchio_bench (bench_common.hpp draws them).
 //
-//   pinocchio_cg_bench URDF [--free] [--name NAME] [--batch B] [--reps R]
+//   pinocchio_cg_bench URDF [--free] [--name NAME] [--weld J1,J2,...] [--batch B] [--reps R]
 //                           [--seed S] [--only aba,rnea,crba_sym,gravity]
 //                           [--cflags "-Ofast -march=native"]
 //
@@ -115,8 +115,8 @@ int main(int argc, char ** argv)
     cflags = value();
     return true;
   });
-  if (!o.weld.empty() || o.check)
-    bench::usage("--weld and --check are pinocchio_bench's");
+  if (o.check)
+    bench::usage("--check is pinocchio_bench's");
   const pinocchio::Model model = bench::load(o);
   const int n = model.nv;
   const std::string build = "CppADCodeGen " + std::string(CPPAD_PACKAGE_STRING)
