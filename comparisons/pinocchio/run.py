@@ -10,7 +10,9 @@ Steps:
 1. `make -j1` (the C++ and C drivers) and `cargo build --release` of rust/,
    once for the default x86-64 target and once with -C target-cpu=native,
    into $CARGO_TARGET_DIR/{generic,native} (default build/target/...),
-   with CARGO_BUILD_JOBS=1 unless it is set.
+   with CARGO_BUILD_JOBS=1 unless it is set; `make cg` (pinocchio_cg_bench,
+   Pinocchio's code-generated functions) unless --no-cg, whose generated
+   libraries are made once per run in build/cg.
 2. URDFs of the chains without one in examples/robots (n = 24, 48, 64; appell
    times 64 too when the Rust driver is built with --features large-models,
    run.py's default) are written into build/urdf/ with make_urdf.py's
@@ -18,8 +20,10 @@ Steps:
    copies (no <visual>/<collision>, the Panda's fingers fixed) go to
    build/mujoco/.
 3. Correctness: both Pinocchio builds evaluate the states of
-   tests/reference/pinocchio/*.json (computed by Pinocchio's Python
-   bindings) and must agree with them to 1e-9 relative.
+   tests/reference/pinocchio/*.json and, on a free flyer, of
+   tests/reference/pinocchio/robots/ for the floating-base robots (computed
+   by Pinocchio's Python bindings) and must agree with them to 1e-9
+   relative.
 4. Timing: ROUNDS rounds; in each, every model is timed by every
    implementation, one process each, TRIES times over (the order of the
    implementations reversed from one round to the next). Each process
@@ -65,6 +69,24 @@ MODELS = [
     (f"spatial_chain_{n}", os.path.join(ROBOTS, "spatial_chain", f"spatial_chain_{n}.urdf"), [], True)
     for n in (2, 4, 8, 16, 32)
 ]
+# Floating-base robots: example-robot-data 6.0.0's URDFs as the repository
+# holds them (tests/robots/, unchanged; tests/robots/MANIFEST.json), loaded
+# on a free joint `root_joint` by every driver (pinocchio_bench --free:
+# JointModelFreeFlyer; appell: `urdf(..., base = free)`, rust/src/floating.rs).
+# The last entry names the reference file in tests/reference/pinocchio/robots
+# (Pinocchio's Python bindings, free flyer) that the Pinocchio builds are
+# checked against. MuJoCo does not time them.
+TEST_ROBOTS = os.path.join(ROOT, "tests", "robots")
+FREE_MODELS = [
+    ("solo12", os.path.join(TEST_ROBOTS, "solo", "solo12.urdf"), [], True),
+    ("anymal_b", os.path.join(TEST_ROBOTS, "anymal_b_simple", "anymal.urdf"), [], True),
+    ("go1", os.path.join(TEST_ROBOTS, "go1", "go1.urdf"), [], True),
+    ("hyq", os.path.join(TEST_ROBOTS, "hyq", "hyq_no_sensors.urdf"), [], True),
+    ("g1", os.path.join(TEST_ROBOTS, "g1", "g1_29dof_rev_1_0.urdf"), [], True),
+]
+FREE_REFERENCE = {"solo12": "solo12", "anymal_b": "anymal", "go1": "go1", "hyq": "hyq", "g1": "g1"}
+FREE = {name for name, _, _, _ in FREE_MODELS}
+
 # Chains without a URDF in examples/robots, written into build/urdf by
 # make_urdf.py's chain_urdf; (n, timed by appell too).
 LARGE_CHAINS = ((24, False), (48, False), (64, True))
@@ -78,6 +100,11 @@ PAIRS = [
     ("mass_matrix", "crba_sym"),
     ("gravity", "gravity"),
 ]
+# appell function -> Pinocchio's code-generated counterpart
+# (pinocchio_cg_bench, impl "pinocchio_cg").
+PAIRS_CG = {"rhs": "aba", "inverse_dynamics": "rnea", "mass_matrix": "crba_sym", "gravity": "gravity"}
+# The Rust driver's conversions between the conventions (free bases only).
+CONVERSIONS = ["map_in", "map_out"]
 # Pinocchio functions shown in the second table, in order.
 PINOCCHIO_FUNCTIONS = ["aba", "rnea", "crba", "crba_sym", "nle", "gravity", "crba_nle"]
 
@@ -121,6 +148,17 @@ def run(cmd, **kw):
 
 def build_cxx():
     run(["make", "-j1", f"PYTHON={VENV_PYTHON}"], cwd=HERE)
+
+
+def build_cg():
+    """pinocchio_cg_bench, or None (with the reason logged) if it cannot be
+    built (no CppAD / CppADCodeGen headers: run ./setup.sh again)."""
+    try:
+        run(["make", "-j1", "cg", f"PYTHON={VENV_PYTHON}"], cwd=HERE)
+    except subprocess.CalledProcessError as e:
+        log(f"  pinocchio_cg_bench not built ({e}); timing without Pinocchio's code generation")
+        return None
+    return os.path.join(BUILD, "pinocchio_cg_bench")
 
 
 def rust_target_dir(variant):
@@ -192,13 +230,16 @@ def check_against_reference(binary):
     """Largest relative difference of `binary --check` from the reference
     files, over every quantity and robot."""
     worst = 0.0
-    for name, urdf, weld, _ in MODELS:
-        with open(os.path.join(REFERENCE, f"{name}.json")) as f:
+    files = [(name, urdf, weld, os.path.join(REFERENCE, f"{name}.json"), []) for name, urdf, weld, _ in MODELS]
+    files += [(name, urdf, weld, os.path.join(REFERENCE, "robots", f"{FREE_REFERENCE[name]}.json"), ["--free"])
+              for name, urdf, weld, _ in FREE_MODELS]
+    for name, urdf, weld, path, free in files:
+        with open(path) as f:
             ref = json.load(f)
         lines = []
         for s in ref["states"]:
             lines.append(" ".join(repr(x) for x in s["q"] + s["v"] + s["tau"] + s["a"]))
-        cmd = [binary, urdf, "--check"] + (["--weld", ",".join(weld)] if weld else [])
+        cmd = [binary, urdf, "--check"] + (["--weld", ",".join(weld)] if weld else []) + free
         out = subprocess.run(cmd, input="\n".join(lines) + "\n", capture_output=True, text=True, check=True)
         got = [json.loads(line) for line in out.stdout.splitlines()]
         assert len(got) == len(ref["states"]), (name, len(got))
@@ -216,8 +257,8 @@ def check_against_reference(binary):
 # ----------------------------------------------------------------- timing
 
 
-def run_driver(cmd):
-    out = subprocess.run(cmd, capture_output=True, text=True)
+def run_driver(cmd, cwd=None):
+    out = subprocess.run(cmd, capture_output=True, text=True, cwd=cwd)
     if out.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{out.stderr}")
     return [json.loads(line) for line in out.stdout.splitlines() if line.strip()]
@@ -254,18 +295,32 @@ def measure(args):
     pin_bin = os.path.join(BUILD, "pinocchio_bench")
     pin_lib_bin = os.path.join(BUILD, "pinocchio_bench_lib")
     mj_bin = os.path.join(BUILD, "mujoco_bench")
+    cg_bin = None if args.no_cg else os.path.join(BUILD, "pinocchio_cg_bench")
+    cg_dir = os.path.join(BUILD, "cg")
     rust_bins = {}
     if args.no_build:
         for v in variants:
             rust_bins[v] = os.path.join(rust_target_dir(v), "release", "appell_bench")
+        if cg_bin and not os.path.exists(cg_bin):
+            cg_bin = None
     else:
         t0 = time.time()
         build_cxx()
         log(f"  C++ drivers built in {time.time() - t0:.0f} s")
+        if cg_bin:
+            t0 = time.time()
+            cg_bin = build_cg()
+            log(f"  code-generation driver built in {time.time() - t0:.0f} s")
+            # The generated libraries are made again (the URDFs or flags may
+            # have changed).
+            if os.path.isdir(cg_dir):
+                for f in os.listdir(cg_dir):
+                    if f.endswith(".so"):
+                        os.remove(os.path.join(cg_dir, f))
         for v in variants:
             rust_bins[v] = build_rust(v, args.features)
 
-    models = MODELS + ([] if args.no_large else write_chain_urdfs())
+    models = MODELS + FREE_MODELS + ([] if args.no_large else write_chain_urdfs())
     # The robots, then the chains by size.
     models.sort(key=lambda m: (m[0].startswith("spatial_chain_"), int(m[0].rsplit("_", 1)[1]) if m[0].startswith("spatial_chain_") else 0))
     if args.models:
@@ -295,9 +350,29 @@ def measure(args):
     joints = {}
     for name, urdf, weld, _ in models:
         wl = ["--weld", ",".join(weld)] if weld else []
-        head = run_driver([pin_bin, urdf, "--name", name, "--batch", "1", "--reps", "1", "--only", "gravity"] + wl)[0]
+        fl = ["--free"] if name in FREE else []
+        head = run_driver([pin_bin, urdf, "--name", name, "--batch", "1", "--reps", "1", "--only", "gravity"] + wl + fl)[0]
         joints[name] = head["joints"]
-    mj_urdf = {} if args.no_mujoco else {name: mujoco_urdf(name, urdf, weld) for name, urdf, weld, _ in models}
+    mj_urdf = {} if args.no_mujoco else {
+        name: mujoco_urdf(name, urdf, weld) for name, urdf, weld, _ in models if name not in FREE
+    }
+
+    # Pinocchio's code generation: record, generate and compile each
+    # function once per model (untimed; the libraries stay in build/cg).
+    cg_prepare = {}
+    meta_cg_compiled = {}
+    if cg_bin:
+        os.makedirs(cg_dir, exist_ok=True)
+        for name, urdf, weld, _ in models:
+            wl = ["--weld", ",".join(weld)] if weld else []
+            fl = ["--free"] if name in FREE else []
+            t0 = time.time()
+            lines = run_driver([cg_bin, urdf, "--name", name, "--batch", "1", "--reps", "1"] + wl + fl, cwd=cg_dir)
+            cg_prepare[name] = {x["prepare"]: x["seconds"] for x in lines if "prepare" in x}
+            cg_prepare[name]["total"] = round(time.time() - t0, 1)
+            compiled = [x["compiled"] for x in lines if "prepare" in x]
+            meta_cg_compiled[name] = all(compiled) if compiled else False
+            log(f"  code generation for {name}: {cg_prepare[name]}")
 
     path = os.path.join(BUILD, "results.jsonl")
     raw = open(path, "w")
@@ -314,28 +389,36 @@ def measure(args):
         "rust": variants,
         "rust_features": args.features,
         "models": [[name, with_appell] for name, _, _, with_appell in models],
+        "free": sorted(FREE & {name for name, _, _, _ in models}),
         "checks": checks,
+        "cg_prepare": cg_prepare,
+        "cg_compiled": meta_cg_compiled,
     }
     raw.write(json.dumps({"meta": meta}) + "\n")
     for r in range(args.rounds):
         log(f"round {r + 1}/{args.rounds}")
         for name, urdf, weld, with_appell in models:
             wl = ["--weld", ",".join(weld)] if weld else []
+            fl = ["--free"] if name in FREE else []
             jl = ["--joints", ",".join(joints[name])]
             jobs = [
-                ("pinocchio", [pin_bin, urdf, "--name", name] + wl + common),
-                ("pinocchio_lib", [pin_lib_bin, urdf, "--name", name] + wl + common),
+                ("pinocchio", [pin_bin, urdf, "--name", name] + wl + fl + common, None),
+                ("pinocchio_lib", [pin_lib_bin, urdf, "--name", name] + wl + fl + common, None),
             ]
+            if cg_bin:
+                jobs.append(("pinocchio_cg", [cg_bin, urdf, "--name", name] + wl + fl + common, cg_dir))
             if with_appell:
                 for v in [v for v in variants if name in rust_models[v]]:
-                    jobs.append((f"appell_{v}", [rust_bins[v], name] + jl + common))
-            if not args.no_mujoco:
-                jobs.append(("mujoco", [mj_bin, mj_urdf[name], "--name", name] + jl + common))
+                    jobs.append((f"appell_{v}", [rust_bins[v], name] + jl + common, None))
+            if not args.no_mujoco and name in mj_urdf:
+                jobs.append(("mujoco", [mj_bin, mj_urdf[name], "--name", name] + jl + common, None))
             if r % 2:
                 jobs.reverse()
             for t in range(args.tries):
-                for key, cmd in jobs:
-                    for line in run_driver(cmd):
+                for key, cmd, cwd in jobs:
+                    for line in run_driver(cmd, cwd):
+                        if "prepare" in line:
+                            continue
                         line["round"], line["try"], line["impl_key"] = r, t, key
                         raw.write(json.dumps(line) + "\n")
             raw.flush()
@@ -364,6 +447,8 @@ def report(path):
     models = meta["models"]
     small = [name for name, with_appell in models if with_appell]
     has_mujoco = any(x["impl_key"] == "mujoco" for x in timed)
+    has_cg = any(x["impl_key"] == "pinocchio_cg" for x in timed)
+    free = set(meta.get("free", []))
 
     # Of each round's tries, the fastest median.
     best = {}
@@ -411,14 +496,20 @@ def report(path):
     # Table 1: forward dynamics.
     cols = ["model", "dof", "appell rhs ops"] + [f"appell rhs ({v}), ns" for v in variants]
     cols += ["Pinocchio ABA, ns"] + [f"ABA / appell ({v})" for v in variants]
+    if has_cg:
+        cols += ["Pinocchio codegen ABA, ns"] + [f"codegen ABA / appell ({v})" for v in variants]
     cols += ["Pinocchio ABA (library), ns"] + (["MuJoCo mj_forward, ns"] if has_mujoco else [])
     rows = []
     for name in small:
         h = head(appell_keys[0], name) if appell_keys else {}
-        row = [name, str(h.get("nv", head("pinocchio", name).get("nv", "?"))), f"{h.get('rhs_ops', 0):,}"]
+        label = name + (" (free base)" if name in free else "")
+        row = [label, str(h.get("nv", head("pinocchio", name).get("nv", "?"))), f"{h.get('rhs_ops', 0):,}"]
         row += [fmt_range(medians(k, name, "rhs")) for k in appell_keys]
         row += [fmt_range(medians("pinocchio", name, "aba"))]
         row += [fmt_range(ratios("pinocchio", "aba", k, "rhs", name), fmt_ratio) for k in appell_keys]
+        if has_cg:
+            row += [fmt_range(medians("pinocchio_cg", name, "aba"))]
+            row += [fmt_range(ratios("pinocchio_cg", "aba", k, "rhs", name), fmt_ratio) for k in appell_keys]
         row += [fmt_range(medians("pinocchio_lib", name, "aba"))]
         if has_mujoco:
             row += [fmt_range(medians("mujoco", name, "mj_forward"))]
@@ -429,14 +520,38 @@ def report(path):
     for fa, fp in PAIRS[1:]:
         if not appell_keys or not any(medians(appell_keys[0], m, fa) for m in small):
             continue  # a function the Rust driver does not time (yet)
+        cg = PAIRS_CG.get(fa) if has_cg else None
         cols = ["model"] + [f"appell {fa} ({v}), ns" for v in variants] + [f"Pinocchio {fp}, ns"]
         cols += [f"{fp} / appell ({v})" for v in variants]
+        if cg:
+            cols += [f"Pinocchio codegen {cg}, ns"] + [f"codegen / appell ({v})" for v in variants]
         rows = []
         for name in small:
             row = [name] + [fmt_range(medians(k, name, fa)) for k in appell_keys]
             row += [fmt_range(medians("pinocchio", name, fp))]
             row += [fmt_range(ratios("pinocchio", fp, k, fa, name), fmt_ratio) for k in appell_keys]
+            if cg:
+                row += [fmt_range(medians("pinocchio_cg", name, cg))]
+                row += [fmt_range(ratios("pinocchio_cg", cg, k, fa, name), fmt_ratio) for k in appell_keys]
             rows.append(row)
+        out += table(cols, rows)
+
+    # The conversions between Pinocchio's conventions and appell's (free
+    # bases), beside the rhs they feed.
+    converted = [name for name in small if name in free and appell_keys and medians(appell_keys[0], name, "map_in")]
+    if converted:
+        cols = ["model"]
+        for v in variants:
+            cols += [f"map_in ({v}), ns", f"map_out ({v}), ns", f"rhs ({v}), ns"]
+        rows = []
+        for name in converted:
+            row = [name]
+            for k in appell_keys:
+                row += [fmt_range(medians(k, name, f)) for f in CONVERSIONS + ["rhs"]]
+            rows.append(row)
+        out += ["Converting a state (untimed in the tables above): `map_in` is Pinocchio's q and v to appell's "
+                "reduced state (`q_from_pinocchio`, `v_from_pinocchio`, the retained coordinates picked), "
+                "`map_out` appell's accelerations to Pinocchio's a (`a_to_pinocchio`).", ""]
         out += table(cols, rows)
 
     # Table 3: every Pinocchio function, every model.
@@ -469,13 +584,35 @@ def report(path):
     worst = {}
     pairs = [(k, fa, fp) for k in appell_keys for fa, fp in PAIRS]
     pairs += [("mujoco", "mj_forward", "aba"), ("pinocchio_lib", "aba", "aba"), ("pinocchio_lib", "crba_nle", "crba_nle")]
+    pairs += [("pinocchio_cg", f, f) for f in PAIRS_CG.values()]
+    where, floating = {}, {}
     for name, _ in models:
         for k, fa, fp in pairs:
             a, b = checksum(k, name, fa), checksum("pinocchio", name, fp)
             if a is not None and b is not None:
                 label = f"{k} {fa} vs {fp}"
-                worst[label] = max(worst.get(label, 0.0), abs(a - b) / max(abs(b), 1.0))
-    out += [f"- {label}: {d:.1e}" for label, d in worst.items()] + [""]
+                d = abs(a - b) / max(abs(b), 1.0)
+                if d >= worst.get(label, 0.0):
+                    worst[label], where[label] = d, name
+                if name in free:
+                    floating[label] = max(floating.get(label, 0.0), d)
+    out += [f"- {label}: {d:.1e} ({where[label]}){'  **above 1e-9**' if d > 1e-9 else ''}"
+            for label, d in worst.items()] + [""]
+    if floating:
+        out += ["The same over the floating-base robots alone (appell's outputs converted to Pinocchio's "
+                "conventions by `PinocchioMap` before summing):", ""]
+        out += [f"- {label}: {d:.1e}" for label, d in floating.items()] + [""]
+    if meta.get("cg_prepare"):
+        compiled = meta.get("cg_compiled", {})
+        what = ("seconds to record, generate and compile each function"
+                if all(compiled.get(name, True) for name in meta["cg_prepare"])
+                else "seconds to record each function and load its library (the libraries were already "
+                     "in build/cg, as with --no-build: not compiled again)")
+        out.append(f"Pinocchio's code generation, {what} (once per run, before the timing): "
+                   + "; ".join(f"{name} " + ", ".join(f"{f} {t:g}" for f, t in times.items())
+                               for name, times in meta["cg_prepare"].items())
+                   + ".")
+        out.append("")
     out.append(
         "pinocchio_bench against tests/reference/pinocchio (Python bindings' values): "
         + ", ".join(f"{k} {v:.1e}" for k, v in meta["checks"].items())
@@ -502,6 +639,7 @@ def main():
                     help="cargo features of the Rust driver (large-models: the 64-link chain; '' for none)")
     ap.add_argument("--no-build", action="store_true", help="use the binaries already built")
     ap.add_argument("--no-mujoco", action="store_true")
+    ap.add_argument("--no-cg", action="store_true", help="leave out Pinocchio's code-generated functions (pinocchio_cg_bench)")
     ap.add_argument("--no-large", action="store_true", help="skip the chains n = 24, 48, 64 (written into build/urdf)")
     ap.add_argument("--models", default=None, help="comma-separated subset of the models")
     ap.add_argument("--report", metavar="RESULTS_JSONL", default=None,

@@ -10,6 +10,8 @@
 #   cmeel-eigen,           headers that Pinocchio's own headers include but
 #   cmeel-urdfdom-headers  that `pin` does not install (its "build" extra
 #                          would, with scipy and more)
+#   cmeel-cppad,           CppAD's and CppADCodeGen's headers, for Pinocchio's
+#   cmeel-cppadcodegen     code-generated functions (pinocchio_cg_bench)
 #   example-robot-data     where the UR5 and Panda URDFs come from
 #   mujoco                 libmujoco.so and its headers
 #   numpy                  for pin's bindings
@@ -21,7 +23,7 @@ cd "$(dirname "$0")"
 python3 -m venv .venv
 .venv/bin/pip install --upgrade --quiet pip
 if [ "${LATEST:-0}" = 1 ]; then
-    .venv/bin/pip install ${PIP_ARGS:-} pin example-robot-data mujoco numpy cmeel-eigen cmeel-urdfdom-headers
+    .venv/bin/pip install ${PIP_ARGS:-} pin example-robot-data mujoco numpy cmeel-eigen cmeel-urdfdom-headers cmeel-cppad cmeel-cppadcodegen
 else
     .venv/bin/pip install ${PIP_ARGS:-} -r requirements.txt
 fi
@@ -31,6 +33,7 @@ prefix = os.path.join(os.path.dirname(cmeel.__path__[0]), "cmeel.prefix")
 print(f"pinocchio {pinocchio.__version__}, mujoco {mujoco.__version__}")
 print(f"cmeel prefix: {prefix}")
 for f in ("include/pinocchio/algorithm/aba.hpp", "include/eigen3/Eigen/Core",
-          "include/urdfdom_headers/urdf_model/model.h", "lib/libpinocchio_default.so"):
+          "include/urdfdom_headers/urdf_model/model.h", "lib/libpinocchio_default.so",
+          "include/cppad/cg.hpp", "include/pinocchio/codegen/cppadcg-algo.hpp"):
     assert os.path.exists(os.path.join(prefix, f)), f"missing {f}"
 PY

@@ -7,26 +7,46 @@
 //! appell_bench list
 //! ```
 //!
-//! MODEL is `ur5`, `panda`, `spatial_chain_2`, `_4`, `_8`, `_16` (and `_32`
-//! with `--features large-models`). `--joints` gives the joint order in
-//! which the random numbers are drawn (Pinocchio's, which `run.py` passes
-//! on); without it the model's speed order is used. For each state: q_i
-//! uniform in [-π, π), then v_i, then τ_i uniform in [-1, 1), per joint in
-//! that order (SplitMix64, the C++ driver's generator). The values are then
-//! placed by joint name: coordinates and speeds are the joints', inputs
-//! `tau_<joint>`, and the reduced state of `rhs` is the retained
-//! coordinates (`info().retained`) followed by the speeds. Functions that
-//! take an acceleration get the τ vector (as Pinocchio's RNEA does here).
+//! MODEL is `ur5`, `panda`, `spatial_chain_2`, `_4`, `_8`, `_16`, `_32` (and
+//! `_64` with `--features large-models`), or a floating-base robot:
+//! `solo12`, `anymal_b`, `go1`, `hyq`, `g1` (`floating.rs`). `--joints` gives the
+//! joint order in which the random numbers are drawn (Pinocchio's, which
+//! `run.py` passes on); without it the model's speed order is used.
+//!
+//! Fixed base: for each state, q_i uniform in [-π, π), then v_i, then τ_i
+//! uniform in [-1, 1), per joint in that order (SplitMix64, the C++
+//! driver's generator). The values are then placed by joint name:
+//! coordinates and speeds are the joints', inputs `tau_<joint>`, and the
+//! reduced state of `rhs` is the retained coordinates (`info().retained`)
+//! followed by the speeds. Functions that take an acceleration get the τ
+//! vector (as Pinocchio's RNEA does here).
+//!
+//! Free base (`root_joint` first in `--joints`): Pinocchio's q, v and w are
+//! drawn as `bench::draw` in `../bench_common.hpp` draws them (the base's
+//! position uniform in [-1, 1)³, its quaternion x, y, z, w from four
+//! uniforms in [-1, 1) divided by their norm, the joints' angles in
+//! [-π, π); v and w uniform in [-1, 1) over all nv entries; Pinocchio's
+//! ABA gets τ = w with the base's six entries zeroed, its RNEA a = w), then
+//! converted to appell's coordinates, speeds and accelerations by
+//! [`PinocchioMap`] (untimed); the inputs `tau_<joint>` are w's joint
+//! entries.
 //!
 //! Output: JSON lines, one describing the model, then one per timed
 //! function with the per-call time (ns) of each repetition (one pass over
 //! the batch) summarised as median, min and max over the repetitions, and a
 //! checksum (the sum of the function's outputs over the batch, from an
 //! untimed pass; for `rhs` only the accelerations) to compare with
-//! Pinocchio's.
+//! Pinocchio's. For a free base the checksum pass first converts each
+//! output to Pinocchio's conventions (accelerations by `a_to_pinocchio`,
+//! forces by `tau_to_pinocchio`, M by `mass_to_pinocchio`), so that it
+//! sums the same numbers as Pinocchio's; the timed loop calls appell's
+//! function alone. Two more timed functions measure the conversion itself:
+//! `map_in` (Pinocchio's q and v to appell's reduced state) and `map_out`
+//! (appell's accelerations to Pinocchio's `a`).
 //!
 //! Adding a function is one `t.run(...)` line in [`bench`].
 
+mod floating;
 #[path = "../../../../examples/models/panda.rs"]
 mod panda;
 #[path = "../../../../examples/models/spatial_chain.rs"]
@@ -38,6 +58,7 @@ use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use appell::pinocchio::PinocchioMap;
 use appell::{Model, ModelError};
 
 /// The models this build has, by the names `run.py` uses.
@@ -51,7 +72,16 @@ const MODELS: &[&str] = &[
     "spatial_chain_32",
     #[cfg(feature = "large-models")]
     "spatial_chain_64",
+    "solo12",
+    "anymal_b",
+    "go1",
+    "hyq",
+    "g1",
 ];
+
+/// The name `urdf(..., base = free)` gives the free joint (Pinocchio's
+/// `JointModelFreeFlyer` in `buildModel` has the same).
+const ROOT: &str = "root_joint";
 
 /// SplitMix64, as in the C++ driver; `uniform` takes the top 53 bits.
 struct SplitMix64(u64);
@@ -98,6 +128,14 @@ struct Batch {
     /// Inputs, in `info().inputs` order.
     inputs: Vec<f64>,
     m: usize,
+    /// A free base: Pinocchio's q (nq per state) and v (nv per state) as
+    /// drawn, and the map between the conventions. Empty and `None` for a
+    /// fixed base.
+    q_pin: Vec<f64>,
+    nq_pin: usize,
+    v_pin: Vec<f64>,
+    nv_pin: usize,
+    map: Option<PinocchioMap>,
 }
 
 /// The arguments of state `k`.
@@ -105,10 +143,11 @@ struct State<'a> {
     state: &'a [f64],
     q: &'a [f64],
     u: &'a [f64],
-    /// For the inverse dynamics the Model trait is gaining.
-    #[allow(dead_code)]
+    /// Accelerations (speed order) for the inverse dynamics.
     a: &'a [f64],
     inputs: &'a [f64],
+    q_pin: &'a [f64],
+    v_pin: &'a [f64],
 }
 
 impl Batch {
@@ -119,8 +158,25 @@ impl Batch {
             u: &self.u[k * self.l..(k + 1) * self.l],
             a: &self.a[k * self.l..(k + 1) * self.l],
             inputs: &self.inputs[k * self.m..(k + 1) * self.m],
+            q_pin: &self.q_pin[k * self.nq_pin..(k + 1) * self.nq_pin],
+            v_pin: &self.v_pin[k * self.nv_pin..(k + 1) * self.nv_pin],
         }
     }
+}
+
+/// A URDF joint name as the URDF reader names the model's coordinate
+/// (every character other than an ASCII letter, digit or `_` becomes `_`),
+/// so that Pinocchio's names from `--joints` can be looked up.
+fn rust_name(urdf: &str) -> String {
+    urdf.chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '_' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect()
 }
 
 /// Where each of `names` is in `joints`, with `prefix` taken off first.
@@ -139,6 +195,9 @@ fn positions(joints: &[String], names: &[&str], prefix: &str) -> Result<Vec<usiz
 
 fn draw<M: Model>(opts: &Options) -> Result<Batch, String> {
     let info = M::info();
+    if info.coordinate_index(&format!("{ROOT}_qw")).is_some() {
+        return draw_free::<M>(opts);
+    }
     let joints: Vec<String> = match &opts.joints {
         Some(j) => j.clone(),
         None => info.speeds.iter().map(|s| s.to_string()).collect(),
@@ -170,6 +229,11 @@ fn draw<M: Model>(opts: &Options) -> Result<Batch, String> {
         l: nj,
         inputs: Vec::with_capacity(count * nj),
         m: nj,
+        q_pin: Vec::new(),
+        nq_pin: 0,
+        v_pin: Vec::new(),
+        nv_pin: 0,
+        map: None,
     };
     let mut rng = SplitMix64(opts.seed);
     let pi = std::f64::consts::PI;
@@ -184,6 +248,73 @@ fn draw<M: Model>(opts: &Options) -> Result<Batch, String> {
         b.a.extend(u_at.iter().map(|&i| tau[i]));
         b.inputs.extend(in_at.iter().map(|&i| tau[i]));
     }
+    Ok(b)
+}
+
+/// The batch of a floating-base model: Pinocchio's states drawn as the C++
+/// driver draws them (`bench::draw`), converted to appell's by
+/// [`PinocchioMap`].
+fn draw_free<M: Model>(opts: &Options) -> Result<Batch, String> {
+    let info = M::info();
+    let joints: Vec<String> = match &opts.joints {
+        Some(j) => j.iter().filter(|j| *j != ROOT).cloned().collect(),
+        None => info.speeds[6..].iter().map(|s| s.to_string()).collect(),
+    };
+    let names: Vec<&str> = joints.iter().map(String::as_str).collect();
+    let map = PinocchioMap::free(ROOT, info.coordinates, info.speeds, &names)
+        .map_err(|e| format!("{}: {e}", info.name))?;
+    let in_at = positions(&joints, info.inputs, "tau_")?;
+    let kept_at: Vec<usize> = info
+        .retained
+        .iter()
+        .map(|c| info.coordinate_index(c).expect("a retained coordinate"))
+        .collect();
+    let (n, l, m) = (info.coordinates.len(), info.speeds.len(), info.inputs.len());
+    let (nq, nv) = (map.nq(), map.nv());
+    let count = opts.batch;
+    let mut b = Batch {
+        count,
+        state: Vec::with_capacity(count * info.state_len()),
+        state_len: info.state_len(),
+        q: vec![0.0; count * n],
+        n,
+        u: vec![0.0; count * l],
+        a: vec![0.0; count * l],
+        l,
+        inputs: Vec::with_capacity(count * m),
+        m,
+        q_pin: Vec::with_capacity(count * nq),
+        nq_pin: nq,
+        v_pin: Vec::with_capacity(count * nv),
+        nv_pin: nv,
+        map: None,
+    };
+    let mut rng = SplitMix64(opts.seed);
+    let pi = std::f64::consts::PI;
+    for k in 0..count {
+        let mut q_pin: Vec<f64> = (0..7).map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let norm =
+            (q_pin[3] * q_pin[3] + q_pin[4] * q_pin[4] + q_pin[5] * q_pin[5] + q_pin[6] * q_pin[6])
+                .sqrt();
+        q_pin[3..7].iter_mut().for_each(|x| *x /= norm);
+        q_pin.extend((7..nq).map(|_| rng.uniform(-pi, pi)));
+        let v_pin: Vec<f64> = (0..nv).map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let w: Vec<f64> = (0..nv).map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let q = &mut b.q[k * n..(k + 1) * n];
+        let u = &mut b.u[k * l..(k + 1) * l];
+        let a = &mut b.a[k * l..(k + 1) * l];
+        let bad = |e: ModelError| format!("converting state {k}: {e}");
+        map.q_from_pinocchio(&q_pin, q).map_err(bad)?;
+        map.v_from_pinocchio(q, &v_pin, u).map_err(bad)?;
+        map.a_from_pinocchio(q, &v_pin, &w, a).map_err(bad)?;
+        b.state.extend(kept_at.iter().map(|&i| q[i]));
+        b.state.extend_from_slice(u);
+        // Pinocchio's w after the base's six entries, joint by joint.
+        b.inputs.extend(in_at.iter().map(|&i| w[6 + i]));
+        b.q_pin.extend(q_pin);
+        b.v_pin.extend(v_pin);
+    }
+    b.map = Some(map);
     Ok(b)
 }
 
@@ -207,8 +338,24 @@ fn build() -> String {
 }
 
 fn json_list(items: &[&str]) -> String {
-    let quoted: Vec<String> = items.iter().map(|s| format!("\"{s}\"")).collect();
+    let quoted: Vec<String> = items.iter().map(|s| json_string(s)).collect();
     format!("[{}]", quoted.join(","))
+}
+
+fn json_string(s: &str) -> String {
+    let mut out = String::from("\"");
+    for c in s.chars() {
+        match c {
+            '"' | '\\' => {
+                out.push('\\');
+                out.push(c);
+            }
+            c if (c as u32) < 0x20 => out.push_str(&format!("\\u{:04x}", c as u32)),
+            c => out.push(c),
+        }
+    }
+    out.push('"');
+    out
 }
 
 /// Times functions over one batch and prints a JSON line for each.
@@ -222,10 +369,11 @@ struct Timer<'a> {
 
 impl Timer<'_> {
     /// Times `f`, which writes `out_len` outputs for a state; the checksum
-    /// sums `out[sum_from..]`.
-    fn run<F>(&self, function: &str, out_len: usize, sum_from: usize, mut f: F)
+    /// adds `sum(state, out)` over the batch (untimed).
+    fn run<F, G>(&self, function: &str, out_len: usize, mut f: F, sum: G)
     where
         F: FnMut(&State, &mut [f64]) -> Result<(), ModelError>,
+        G: Fn(&State, &[f64]) -> Result<f64, ModelError>,
     {
         if let Some(only) = self.only {
             if !only.iter().any(|o| o == function) {
@@ -254,8 +402,9 @@ impl Timer<'_> {
         black_box(acc);
         let mut checksum = 0.0;
         for k in 0..b.count {
-            f(&b.at(k), &mut out).expect("evaluated above");
-            checksum += out[sum_from..].iter().sum::<f64>();
+            let s = b.at(k);
+            f(&s, &mut out).expect("evaluated above");
+            checksum += sum(&s, &out).expect("a conversion to Pinocchio's conventions");
         }
         per_call.sort_by(f64::total_cmp);
         let r = per_call.len();
@@ -277,14 +426,15 @@ fn bench<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
     let info = M::info();
     let b = draw::<M>(opts)?;
     println!(
-        "{{\"impl\":\"appell\",\"build\":\"{}\",\"model\":\"{}\",\"type\":\"{}\",\"nv\":{},\"joints\":{},\"retained\":{},\"rhs_ops\":{}}}",
+        "{{\"impl\":\"appell\",\"build\":\"{}\",\"model\":\"{}\",\"type\":\"{}\",\"nv\":{},\"joints\":{},\"retained\":{},\"rhs_ops\":{},\"form\":{}}}",
         build(),
         opts.model,
         info.name,
         info.speeds.len(),
         json_list(info.speeds),
         json_list(info.retained),
-        info.rhs_ops.total
+        info.rhs_ops.total,
+        json_string(info.form)
     );
     let t = Timer {
         name: &opts.model,
@@ -297,22 +447,120 @@ fn bench<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
     // Parameter-only work is done once, as a simulation does.
     let prepared = model.prepare::<f64>();
 
+    let map = b.map.as_ref();
+    // The checksums: the sum of the outputs, in Pinocchio's conventions
+    // (converted here, untimed, for a free base).
+    let plain = |from: usize| move |_: &State, out: &[f64]| Ok(out[from..].iter().sum::<f64>());
+    let nv = map.map_or(l, PinocchioMap::nv);
+    let accelerations = |s: &State, out: &[f64]| -> Result<f64, ModelError> {
+        let Some(map) = map else {
+            return Ok(out[kept..].iter().sum());
+        };
+        let mut a = vec![0.0; nv];
+        map.a_to_pinocchio(s.q, s.u, &out[kept..], &mut a)?;
+        Ok(a.iter().sum())
+    };
+    let forces = |s: &State, out: &[f64]| -> Result<f64, ModelError> {
+        let Some(map) = map else {
+            return Ok(out.iter().sum());
+        };
+        let mut tau = vec![0.0; nv];
+        map.tau_to_pinocchio(s.q, out, &mut tau)?;
+        Ok(tau.iter().sum())
+    };
+    let mass = |s: &State, out: &[f64]| -> Result<f64, ModelError> {
+        let Some(map) = map else {
+            return Ok(out[..l * l].iter().sum());
+        };
+        let mut m = vec![0.0; nv * nv];
+        map.mass_to_pinocchio(s.q, &out[..l * l], &mut m)?;
+        Ok(m.iter().sum())
+    };
+    // M ü = f in Pinocchio's terms: with u = T v and u̇ = T a + u̇₀ (u̇₀ the
+    // accelerations at a = 0), Tᵀ M T a = Tᵀ (f − M u̇₀).
+    let mass_and_forcing = |s: &State, out: &[f64]| -> Result<f64, ModelError> {
+        let Some(map) = map else {
+            return Ok(out.iter().sum());
+        };
+        let (m, f) = out.split_at(l * l);
+        let mut u_dot0 = vec![0.0; l];
+        map.a_from_pinocchio(s.q, s.v_pin, &vec![0.0; nv], &mut u_dot0)?;
+        let g: Vec<f64> = (0..l)
+            .map(|i| f[i] - (0..l).map(|j| m[i * l + j] * u_dot0[j]).sum::<f64>())
+            .collect();
+        let mut f_pin = vec![0.0; nv];
+        map.tau_to_pinocchio(s.q, &g, &mut f_pin)?;
+        Ok(mass(s, m)? + f_pin.iter().sum::<f64>())
+    };
+
     // Forward dynamics: the reduced state's rates (q̇ = u, then ü).
-    t.run("rhs", info.state_len(), kept, |s, out| {
-        model.rhs(&prepared, 0.0, s.state, s.inputs, out)
-    });
+    t.run(
+        "rhs",
+        info.state_len(),
+        |s, out| model.rhs(&prepared, 0.0, s.state, s.inputs, out),
+        accelerations,
+    );
     // M (l×l, row-major) and f of M ü = f.
-    t.run("mass_matrix_and_forcing", l * l + l, 0, |s, out| {
-        let (m, f) = out.split_at_mut(l * l);
-        model.mass_matrix_and_forcing(0.0, s.q, s.u, s.inputs, m, f)
-    });
+    t.run(
+        "mass_matrix_and_forcing",
+        l * l + l,
+        |s, out| {
+            let (m, f) = out.split_at_mut(l * l);
+            model.mass_matrix_and_forcing(0.0, s.q, s.u, s.inputs, m, f)
+        },
+        mass_and_forcing,
+    );
     // The controller functions: inverse dynamics (RNEA), M alone (CRBA,
     // both triangles) and the gravity term.
-    t.run("inverse_dynamics", l, 0, |s, out| {
-        model.inverse_dynamics(0.0, s.q, s.u, s.a, out)
-    });
-    t.run("mass_matrix", l * l, 0, |s, out| model.mass_matrix(0.0, s.q, out));
-    t.run("gravity", l, 0, |s, out| model.gravity_forces(0.0, s.q, out));
+    t.run(
+        "inverse_dynamics",
+        l,
+        |s, out| model.inverse_dynamics(0.0, s.q, s.u, s.a, out),
+        forces,
+    );
+    t.run(
+        "mass_matrix",
+        l * l,
+        |s, out| model.mass_matrix(0.0, s.q, out),
+        mass,
+    );
+    t.run(
+        "gravity",
+        l,
+        |s, out| model.gravity_forces(0.0, s.q, out),
+        forces,
+    );
+    // What converting costs a Pinocchio user who keeps Pinocchio's state:
+    // its q and v to appell's reduced state, and appell's accelerations to
+    // Pinocchio's a (the checksum of map_out is the sum of the drawn w).
+    if let Some(map) = map {
+        let kept_at: Vec<usize> = info
+            .retained
+            .iter()
+            .map(|c| info.coordinate_index(c).expect("a retained coordinate"))
+            .collect();
+        let n = info.coordinates.len();
+        let mut q = vec![0.0; n];
+        t.run(
+            "map_in",
+            info.state_len(),
+            |s, out| {
+                map.q_from_pinocchio(s.q_pin, &mut q)?;
+                map.v_from_pinocchio(&q, s.v_pin, &mut out[kept..])?;
+                for (x, &i) in out[..kept].iter_mut().zip(&kept_at) {
+                    *x = q[i];
+                }
+                Ok(())
+            },
+            plain(0),
+        );
+        t.run(
+            "map_out",
+            nv,
+            |s, out| map.a_to_pinocchio(s.q, s.u, s.a, out),
+            plain(0),
+        );
+    }
     Ok(())
 }
 
@@ -327,11 +575,18 @@ fn parse(args: &[String]) -> Result<Options, String> {
         seed: 20240917,
         only: None,
     };
-    let list = |s: &str| s.split(',').filter(|x| !x.is_empty()).map(String::from).collect();
+    let list = |s: &str| -> Vec<String> {
+        s.split(',')
+            .filter(|x| !x.is_empty())
+            .map(String::from)
+            .collect()
+    };
     while let Some(arg) = it.next() {
         let mut value = || it.next().ok_or(format!("{arg} needs a value"));
         match arg.as_str() {
-            "--joints" => opts.joints = Some(list(value()?)),
+            "--joints" => {
+                opts.joints = Some(list(value()?).into_iter().map(|j| rust_name(&j)).collect())
+            }
             "--only" => opts.only = Some(list(value()?)),
             "--batch" => opts.batch = value()?.parse().map_err(|e| format!("--batch: {e}"))?,
             "--reps" => opts.reps = value()?.parse().map_err(|e| format!("--reps: {e}"))?,
@@ -368,6 +623,11 @@ fn main() -> ExitCode {
         "spatial_chain_32" => bench(&spatial_chain::SpatialChain32, &opts),
         #[cfg(feature = "large-models")]
         "spatial_chain_64" => bench(&spatial_chain::SpatialChain64, &opts),
+        "solo12" => bench(&floating::Solo12, &opts),
+        "anymal_b" => bench(&floating::AnymalB, &opts),
+        "go1" => bench(&floating::Go1, &opts),
+        "hyq" => bench(&floating::Hyq, &opts),
+        "g1" => bench(&floating::G1, &opts),
         other => Err(format!(
             "unknown model {other}; this build has {}",
             MODELS.join(" ")
