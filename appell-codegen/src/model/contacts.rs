@@ -4,11 +4,14 @@
 //! dependent, as many as it has rows (a leg's joints under a stance foot),
 //! so the base and the free legs keep theirs.
 
+use appell_symbolic::{Graph, Symbol, Tape};
+
 use super::bodies::Side;
 use super::builder::{hint, Builder};
 use super::{Constraint, SpeedSpec, Vec3};
 use crate::ast::*;
 use crate::parse::joints::JointKind;
+use crate::probe::pseudo_value;
 
 /// A resolved contact.
 #[derive(Clone)]
@@ -124,11 +127,16 @@ fn contact_rows(c: &ContactDef, origin: &syn::Ident) -> Vec<ConstraintDef> {
 }
 
 /// The privileged speeds of a scene that holds `held` (contacts) and names
-/// no speeds: `speeds` less, for each contact in turn, the one-axis joints
-/// nearest its link (deepest first) not taken already, as many as its rows.
-/// An error names the contact whose leg has too few joints.
+/// no speeds: `speeds` less, for each contact in turn, joints above its
+/// link (nearest first, not taken already) whose columns in the contact's
+/// rows are independent (numerically, at pseudo-random configurations),
+/// as many as its rows: an ankle whose axis passes through the foot's
+/// origin moves no point contact and is passed over. An error names the
+/// contact whose leg has too few.
 pub(super) fn scene_speeds(
+    g: &mut Graph,
     ast: &ModelAst,
+    rates: &[(String, Symbol)],
     held: &[&Contact],
     speeds: &[SpeedSpec],
 ) -> Result<Vec<SpeedSpec>, String> {
@@ -140,15 +148,17 @@ pub(super) fn scene_speeds(
             .filter(|q| !dependent.contains(q) && speeds.iter().any(|s| s.name == **q))
             .collect();
         let rows = c.rows.len();
-        if free.len() < rows {
+        let chosen = independent_columns(g, c, rates, &free, rows).map_err(|e| e.to_string())?;
+        if chosen.len() < rows {
             let names: Vec<String> = free.iter().map(|q| format!("`{q}`")).collect();
             let above = match names.len() {
                 0 => "no revolute or prismatic joint above it is free to give way".to_string(),
                 k => format!(
-                    "only {k} revolute or prismatic joint{} above it {} free to give way ({})",
+                    "the {k} revolute or prismatic joint{} above it free to give way ({}) move{} it along {} of them",
                     if k == 1 { "" } else { "s" },
-                    if k == 1 { "is" } else { "are" },
-                    names.join(", ")
+                    names.join(", "),
+                    if k == 1 { "s" } else { "" },
+                    chosen.len()
                 ),
             };
             return Err(format!(
@@ -156,13 +166,68 @@ pub(super) fn scene_speeds(
                 c.link
             ));
         }
-        dependent.extend(free.into_iter().take(rows).cloned());
+        dependent.extend(chosen);
     }
     Ok(speeds
         .iter()
         .filter(|s| !dependent.contains(&s.name))
         .cloned()
         .collect())
+}
+
+/// Of `candidates` (joint coordinates, in order), the first ones whose
+/// columns ∂(row)/∂q̇ in `c`'s rows are independent of those chosen before
+/// them, up to `rows`: the most found at any of three pseudo-random
+/// configurations.
+fn independent_columns(
+    g: &mut Graph,
+    c: &Contact,
+    rates: &[(String, Symbol)],
+    candidates: &[&String],
+    rows: usize,
+) -> Result<Vec<String>, appell_symbolic::SymbolicError> {
+    let mut columns = Vec::with_capacity(candidates.len() * rows);
+    for q in candidates {
+        let rate = rates.iter().find(|(name, _)| name == *q).map(|(_, r)| *r);
+        for row in &c.rows {
+            columns.push(match rate {
+                Some(r) => g.diff(row.residual, r)?,
+                None => g.int(0)?,
+            });
+        }
+    }
+    let tape = Tape::new(g, &columns);
+    let mut best: Vec<String> = Vec::new();
+    for trial in 0..3u64 {
+        let value = |s: Symbol| Some(pseudo_value(g, s, trial));
+        let Ok(values) = tape.eval(&value) else {
+            continue;
+        };
+        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut chosen = Vec::new();
+        for (k, q) in candidates.iter().enumerate() {
+            if chosen.len() == rows {
+                break;
+            }
+            let mut v: Vec<f64> = values[k * rows..(k + 1) * rows].to_vec();
+            let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            for b in &basis {
+                let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+                for (x, y) in v.iter_mut().zip(b) {
+                    *x -= p * y;
+                }
+            }
+            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            if norm > 1e-9 * norm0.max(1e-300) && norm0 > 0.0 {
+                basis.push(v.iter().map(|x| x / norm).collect());
+                chosen.push((*q).clone());
+            }
+        }
+        if chosen.len() > best.len() {
+            best = chosen;
+        }
+    }
+    Ok(best)
 }
 
 /// The coordinates of the revolute and prismatic joints from `link` up to
@@ -184,13 +249,15 @@ mod tests {
     use crate::ctxt::Ctxt;
     use crate::{model, parse};
 
-    /// A body on a leg of `joints` revolute joints, a foot at its end.
+    /// A body on a leg of `joints` revolute joints (a hip roll about x,
+    /// then pitches about y), a foot at its end.
     fn leg(joints: usize, scene: &str) -> String {
         let mut src = String::from("#[appell(joint(base, free, parent = N, child = B))]\n");
         src += "#[appell(body(B, frame = B, center = origin(B), mass = 1.0, inertia = principal(0.1, 0.1, 0.1)))]\n";
         let mut parent = "B".to_string();
         for k in 0..joints {
-            src += &format!("#[appell(joint(j{k}, revolute(y), parent = {parent}, child = L{k}, xyz = [0.0, 0.0, -0.2]))]\n");
+            let axis = if k == 0 { "x" } else { "y" };
+            src += &format!("#[appell(joint(j{k}, revolute({axis}), parent = {parent}, child = L{k}, xyz = [0.0, 0.0, -0.2]))]\n");
             src += &format!("#[appell(body(L{k}, frame = L{k}, center = origin(L{k}), mass = 0.1, inertia = principal(0.01, 0.01, 0.01)))]\n");
             parent = format!("L{k}");
         }
@@ -210,7 +277,7 @@ mod tests {
     }
 
     #[test]
-    fn a_held_foot_takes_the_speeds_of_the_joints_nearest_it() {
+    fn a_held_foot_takes_the_speeds_of_the_nearest_joints_that_move_it_apart() {
         let (cx, k) = build(&leg(
             4,
             "#[appell(scene(standing, effects(gravity, down)))]",
@@ -221,11 +288,13 @@ mod tests {
         // itself holds none of them.
         assert_eq!(model.contacts[0].rows.len(), 3);
         assert!(model.nonholonomic.is_empty());
+        // j3, j2 and j1 pitch about parallel axes: the foot's sideways
+        // row needs the roll j0, and j1 keeps its speed.
         let (speeds, _) = model.scenes[0].speeds.clone().expect("speeds");
         let names: Vec<&str> = speeds.iter().map(|s| s.name.as_str()).collect();
         assert_eq!(
             names,
-            ["base_wx", "base_wy", "base_wz", "base_x", "base_y", "base_z", "j0"]
+            ["base_wx", "base_wy", "base_wz", "base_x", "base_y", "base_z", "j1"]
         );
     }
 
@@ -237,7 +306,7 @@ mod tests {
         ));
         let errors = cx.check().expect_err("an error").to_string();
         assert!(
-            errors.contains("holds 3 rows, and only 2 revolute or prismatic joints above it are free to give way (`j1`, `j0`)"),
+            errors.contains("holds 3 rows, and the 2 revolute or prismatic joints above it free to give way (`j1`, `j0`) move it along 2 of them"),
             "{errors}"
         );
     }

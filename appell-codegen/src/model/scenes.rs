@@ -147,7 +147,7 @@ impl Builder<'_> {
     /// The speeds of a scene that names no speeds: the model's, less the
     /// joints its contacts make dependent (None when it holds none).
     fn contact_speeds(
-        &self,
+        &mut self,
         ast: &ModelAst,
         sc: &SceneDef,
         contacts: &[super::Contact],
@@ -161,7 +161,12 @@ impl Builder<'_> {
         if held.is_empty() {
             return None;
         }
-        match super::contacts::scene_speeds(ast, &held, model_speeds) {
+        let rates: Vec<(String, appell_symbolic::Symbol)> = self
+            .coords
+            .iter()
+            .map(|(c, coord)| (c.to_string(), coord.rate))
+            .collect();
+        match super::contacts::scene_speeds(&mut self.g, ast, &rates, &held, model_speeds) {
             Ok(speeds) => {
                 let name = &sc.name;
                 Some((speeds, quote::quote!(#name)))
