@@ -32,7 +32,7 @@ pub struct Link {
     pub inputs: Vec<Id>,
     /// A free joint's rotation of the child from the joint frame: its
     /// columns turn the child's velocity, in which the recursions run, into
-    /// the rates of the joint's slides (see [`super::free`]).
+    /// the rates of the joint's slides (see the `free` module beside this one).
     pub free: Option<M3>,
 }
 
