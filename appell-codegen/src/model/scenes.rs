@@ -147,7 +147,7 @@ impl Builder<'_> {
     /// The speeds of a scene that names no speeds: the model's, less the
     /// joints its contacts make dependent (None when it holds none).
     fn contact_speeds(
-        &mut self,
+        &self,
         ast: &ModelAst,
         sc: &SceneDef,
         contacts: &[super::Contact],
@@ -166,7 +166,10 @@ impl Builder<'_> {
             .iter()
             .map(|(c, coord)| (c.to_string(), coord.rate))
             .collect();
-        match super::contacts::scene_speeds(&mut self.g, ast, &rates, &held, model_speeds) {
+        // The rank probe differentiates in a copy of the graph, so that the
+        // model's node order (and every expansion) is as without it.
+        let mut scratch = self.g.clone();
+        match super::contacts::scene_speeds(&mut scratch, ast, &rates, &held, model_speeds) {
             Ok(speeds) => {
                 let name = &sc.name;
                 Some((speeds, quote::quote!(#name)))
