@@ -312,3 +312,21 @@ fn the_urdfs_joint_limits_are_kept() {
         (-10.0, 10.0, 1000.0, 1000.0)
     );
 }
+
+#[test]
+fn a_stance_leg_stretched_straight_is_a_typed_error_not_a_nan() {
+    // Knee straight: the hip pitch and the knee move the foot the same
+    // way, and the stance leg's rates are not determined.
+    let robot = OneLeg;
+    let standing = OneLegStanding::from_ref(&robot);
+    let info = OneLegStanding::info();
+    let at = |name: &str| info.coordinate_index(name).unwrap();
+    let mut q = vec![0.0; info.coordinates.len()];
+    q[at("root_joint_qw")] = 1.0;
+    q[at("root_joint_z")] = 0.45;
+    let mut x: Vec<f64> = info.retained.iter().map(|c| q[at(c)]).collect();
+    x.extend([0.0; 6]);
+    let mut rates = vec![0.0; x.len()];
+    let result = standing.rhs(&standing.prepare::<f64>(), 0.0, &x, &[0.0; 3], &mut rates);
+    assert!(result.is_err(), "{result:?}: {rates:?}");
+}
