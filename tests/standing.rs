@@ -173,6 +173,20 @@ fn solo12_on_its_feet_agrees_with_pinocchio() {
 #[appell(scene(standing, effects(gravity, actuation, stance)))]
 struct OneLeg;
 
+/// The one-legged robot upright at height `z` with its hip pitched by
+/// `hip` and its knee bent by `knee` (full coordinates; the model and its
+/// scene have the same ones).
+fn upright(z: f64, hip: f64, knee: f64) -> Vec<f64> {
+    let info = OneLeg::info();
+    let at = |name: &str| info.coordinate_index(name).unwrap();
+    let mut q = vec![0.0; info.coordinates.len()];
+    q[at("root_joint_qw")] = 1.0;
+    q[at("root_joint_z")] = z;
+    q[at("hip_pitch")] = hip;
+    q[at("knee")] = knee;
+    q
+}
+
 #[test]
 fn a_falling_robot_lands_on_its_foot_with_the_impulse_that_stops_it() {
     use appell::hybrid::{Guard, Hybrid, Phase};
@@ -186,13 +200,7 @@ fn a_falling_robot_lands_on_its_foot_with_the_impulse_that_stops_it() {
     // Upright, the knee bent, 0.5 m up and at rest: it falls as one body
     // (no torque turns a joint in free fall) until the foot reaches the
     // ground.
-    let info = OneLeg::info();
-    let at = |name: &str| info.coordinate_index(name).unwrap();
-    let mut q = vec![0.0; info.coordinates.len()];
-    q[at("root_joint_qw")] = 1.0;
-    q[at("root_joint_z")] = 0.5;
-    q[at("hip_pitch")] = 0.3;
-    q[at("knee")] = -0.6;
+    let q = upright(0.5, 0.3, -0.6);
     let mut feet = [[0.0; 3]];
     robot.contact_points(0.0, &q, &mut feet).unwrap();
     let height = feet[0][2];
@@ -252,12 +260,7 @@ fn the_lift_off_guard_is_the_grounds_push_along_n_z() {
     let robot = OneLeg;
     let standing = OneLegStanding::from_ref(&robot);
     let info = OneLegStanding::info();
-    let at = |name: &str| info.coordinate_index(name).unwrap();
-    let mut q = vec![0.0; info.coordinates.len()];
-    q[at("root_joint_qw")] = 1.0;
-    q[at("root_joint_z")] = 0.4;
-    q[at("hip_pitch")] = 0.3;
-    q[at("knee")] = -0.6;
+    let q = upright(0.4, 0.3, -0.6);
     let u = [0.1, -0.2, 0.05, 0.3, 0.0, -0.1];
     let inputs = [0.5, -1.0, 2.0];
     let guard = Guard::contact_lift_off(0, standing, 0, &inputs);
@@ -320,10 +323,8 @@ fn a_stance_leg_stretched_straight_is_a_typed_error_not_a_nan() {
     let robot = OneLeg;
     let standing = OneLegStanding::from_ref(&robot);
     let info = OneLegStanding::info();
+    let q = upright(0.45, 0.0, 0.0);
     let at = |name: &str| info.coordinate_index(name).unwrap();
-    let mut q = vec![0.0; info.coordinates.len()];
-    q[at("root_joint_qw")] = 1.0;
-    q[at("root_joint_z")] = 0.45;
     let mut x: Vec<f64> = info.retained.iter().map(|c| q[at(c)]).collect();
     x.extend([0.0; 6]);
     let mut rates = vec![0.0; x.len()];

@@ -84,24 +84,8 @@ pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
         };
         trials += 1;
         // Incremental Gram–Schmidt rank test, row by row.
-        let mut basis: Vec<Vec<f64>> = Vec::new();
-        let mut dep = None;
-        for r in 0..m {
-            let mut v: Vec<f64> = vals[r * n..(r + 1) * n].to_vec();
-            let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            for b in &basis {
-                let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
-                for (x, y) in v.iter_mut().zip(b) {
-                    *x -= p * y;
-                }
-            }
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm <= 1e-9 * norm0.max(1e-300) {
-                dep = Some(r);
-                break;
-            }
-            basis.push(v.iter().map(|x| x / norm).collect());
-        }
+        let mut basis = Basis::default();
+        let dep = (0..m).find(|&r| !basis.extends(&vals[r * n..(r + 1) * n]));
         match dep {
             None => return None,
             Some(r) => first_dependent = Some(first_dependent.map_or(r, |f: usize| f.min(r))),
@@ -111,6 +95,41 @@ pub fn dependent_row(g: &Graph, d: &[Id], n: usize, m: usize) -> Option<usize> {
         }
     }
     first_dependent
+}
+
+/// An orthonormal basis grown vector by vector (Gram–Schmidt): the
+/// numeric rank tests of [`dependent_row`] and of a contact's joints.
+#[derive(Default)]
+pub struct Basis(Vec<Vec<f64>>);
+
+impl Basis {
+    /// Adds `v` when it is independent of the basis (its part outside the
+    /// span above 1e-9 of its length) and says whether it was.
+    ///
+    /// ```
+    /// use appell_codegen::probe::Basis;
+    /// let mut b = Basis::default();
+    /// assert!(b.extends(&[1.0, 0.0]));
+    /// assert!(!b.extends(&[2.0, 0.0]));
+    /// assert!(b.extends(&[1.0, 1.0]));
+    /// assert!(!b.extends(&[0.0, 0.0]));
+    /// ```
+    pub fn extends(&mut self, v: &[f64]) -> bool {
+        let mut v = v.to_vec();
+        let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        for b in &self.0 {
+            let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
+            for (x, y) in v.iter_mut().zip(b) {
+                *x -= p * y;
+            }
+        }
+        let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+        if norm <= 1e-9 * norm0.max(1e-300) {
+            return false;
+        }
+        self.0.push(v.iter().map(|x| x / norm).collect());
+        true
+    }
 }
 
 /// Whether a piecewise function reachable from `roots` switches on `q`:

@@ -11,7 +11,7 @@ use super::builder::{hint, Builder};
 use super::{Constraint, SpeedSpec, Vec3};
 use crate::ast::*;
 use crate::parse::joints::JointKind;
-use crate::probe::pseudo_value;
+use crate::probe::{pseudo_value, Basis};
 
 /// A resolved contact.
 #[derive(Clone)]
@@ -203,23 +203,13 @@ fn independent_columns(
         let Ok(values) = tape.eval(&value) else {
             continue;
         };
-        let mut basis: Vec<Vec<f64>> = Vec::new();
+        let mut basis = Basis::default();
         let mut chosen = Vec::new();
         for (k, q) in candidates.iter().enumerate() {
             if chosen.len() == rows {
                 break;
             }
-            let mut v: Vec<f64> = values[k * rows..(k + 1) * rows].to_vec();
-            let norm0 = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            for b in &basis {
-                let p: f64 = v.iter().zip(b).map(|(x, y)| x * y).sum();
-                for (x, y) in v.iter_mut().zip(b) {
-                    *x -= p * y;
-                }
-            }
-            let norm = v.iter().map(|x| x * x).sum::<f64>().sqrt();
-            if norm > 1e-9 * norm0.max(1e-300) && norm0 > 0.0 {
-                basis.push(v.iter().map(|x| x / norm).collect());
+            if basis.extends(&values[k * rows..(k + 1) * rows]) {
                 chosen.push((*q).clone());
             }
         }
