@@ -19,6 +19,15 @@
 //!
 //! `APPELL_BLESS=1 cargo test -p appell-codegen --test snapshots` writes the
 //! snapshots anew; review the diff before committing it.
+//!
+//! An expansion over [`FULL_TEXT_LIMIT`] bytes (a robot's, a long chain's)
+//! is kept as a [`summary`]: its size, a hash of the whole text, and every
+//! operation count and form it reports, so that a change of any byte fails
+//! the test and a change of cost reads as a diff. When such a model
+//! differs, the test writes its new text under cargo's temporary directory
+//! and names the file; `APPELL_EXPAND=<snapshot name> cargo test -p
+//! appell-codegen --test snapshots print_expansion -- --ignored
+//! --nocapture` prints any model's full text.
 
 use std::path::{Path, PathBuf};
 
@@ -125,8 +134,57 @@ fn behind_a_feature(item: &syn::ItemStruct) -> bool {
     })
 }
 
+/// Expansions longer than this many bytes are kept as a [`summary`].
+const FULL_TEXT_LIMIT: usize = 100_000;
+
+/// What the snapshot file holds for an expansion: the text itself, or its
+/// summary when it is longer than [`FULL_TEXT_LIMIT`].
+fn snapshot_of(text: &str) -> String {
+    if text.len() <= FULL_TEXT_LIMIT {
+        text.to_string()
+    } else {
+        summary(text)
+    }
+}
+
+/// A long expansion's size, its FNV-1a hash, and the lines that report
+/// its cost: each `form` and each operation count (one line a count).
+fn summary(text: &str) -> String {
+    let mut out = format!(
+        "large expansion, kept as a summary (see the header of appell-codegen/tests/snapshots.rs)\nbytes: {}\nlines: {}\nfnv1a-64: {:016x}\n",
+        text.len(),
+        text.lines().count(),
+        fnv1a(text.as_bytes())
+    );
+    let mut lines = text.lines().map(str::trim);
+    while let Some(line) = lines.next() {
+        if line.starts_with("form: ") {
+            out.push_str(line);
+            out.push('\n');
+        } else if line.ends_with("OpCounts {") {
+            let name = line.split(':').next().unwrap_or("").trim();
+            let fields: Vec<&str> = lines.by_ref().take_while(|l| !l.starts_with('}')).collect();
+            out.push_str(&format!("{name}: {}\n", fields.join(" ")));
+        }
+    }
+    out
+}
+
+/// The 64-bit FNV-1a hash: stable across platforms and Rust versions.
+fn fnv1a(bytes: &[u8]) -> u64 {
+    bytes.iter().fold(0xcbf2_9ce4_8422_2325, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0000_0100_0000_01b3)
+    })
+}
+
 /// Every model: (snapshot name, expansion).
 fn expansions() -> Vec<(String, String)> {
+    expansions_named(None)
+}
+
+/// Every model, or only the one whose snapshot is named `only` (with or
+/// without `.txt`): (snapshot name, expansion).
+fn expansions_named(only: Option<&str>) -> Vec<(String, String)> {
     let root = workspace_root();
     let mut files = Vec::new();
     for dir in SOURCES {
@@ -150,8 +208,12 @@ fn expansions() -> Vec<(String, String)> {
             if behind_a_feature(item) && !large {
                 continue;
             }
+            let name = format!("{stem}__{}.txt", item.ident);
+            if only.is_some_and(|o| o != name && format!("{o}.txt") != name) {
+                continue;
+            }
             let text = expansion_text(item, &file_roots(rel));
-            out.push((format!("{stem}__{}.txt", item.ident), text));
+            out.push((name, text));
         }
     }
     out
@@ -164,8 +226,9 @@ fn every_models_expansion_matches_its_snapshot() {
     let all = expansions();
     assert!(all.len() >= 40, "found only {} models", all.len());
     let mut failures = Vec::new();
-    for (name, text) in &all {
+    for (name, full) in &all {
         let path = dir.join(name);
+        let text = &snapshot_of(full);
         if bless {
             std::fs::create_dir_all(&dir).expect("snapshot dir");
             std::fs::write(&path, text).expect("write snapshot");
@@ -179,7 +242,13 @@ fn every_models_expansion_matches_its_snapshot() {
                     .zip(text.lines())
                     .position(|(a, b)| a != b)
                     .unwrap_or(old.lines().count().min(text.lines().count()));
-                failures.push(format!("{name}: differs from line {}", line + 1));
+                let mut failure = format!("{name}: differs from line {}", line + 1);
+                if text != full {
+                    let new = Path::new(env!("CARGO_TARGET_TMPDIR")).join(name);
+                    std::fs::write(&new, full).expect("write the new expansion");
+                    failure.push_str(&format!(" (its new full text: {})", new.display()));
+                }
+                failures.push(failure);
             }
             Err(_) => failures.push(format!("{name}: no snapshot (run with APPELL_BLESS=1)")),
         }
@@ -195,6 +264,36 @@ fn every_models_expansion_matches_its_snapshot() {
         }
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// The full expansion of the model whose snapshot is named by
+/// `APPELL_EXPAND` (e.g. `tests__standing__Solo12`), on standard output.
+#[test]
+#[ignore]
+fn print_expansion() {
+    let name = std::env::var("APPELL_EXPAND").expect("APPELL_EXPAND names a snapshot");
+    let found = expansions_named(Some(&name));
+    assert!(!found.is_empty(), "no model has the snapshot name `{name}`");
+    for (_, text) in found {
+        print!("{text}");
+    }
+}
+
+#[test]
+fn a_long_expansions_summary_keeps_its_size_hash_forms_and_counts() {
+    let mut text = String::from("    form: \"structured: 12 operations\",\n");
+    text.push_str("    rhs_ops: ::appell::__private::OpCounts {\n        add: 5,\n        total: 12,\n    },\n");
+    let s = summary(&text);
+    assert!(
+        s.contains(&format!("bytes: {}\nlines: 5\n", text.len())),
+        "{s}"
+    );
+    assert!(s.contains("form: \"structured: 12 operations\",\n"), "{s}");
+    assert!(s.contains("rhs_ops: add: 5, total: 12,\n"), "{s}");
+    // One byte more changes the hash.
+    assert_ne!(summary(&text), summary(&format!("{text} ")));
+    assert_eq!(fnv1a(b"a"), 0xaf63_dc4c_8601_ec8c);
+    assert_eq!(snapshot_of("short"), "short");
 }
 
 /// Expansion time (median of five), emitted size and rhs operation count of
