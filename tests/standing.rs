@@ -29,6 +29,17 @@ use serde_json::Value;
 #[appell(scene(trotting, effects(gravity, actuation, fl, hr)))]
 struct Solo12;
 
+/// Unitree G1 (29 joints) on a free base with its two feet flat: in double
+/// support or standing on its left foot.
+#[allow(clippy::duplicated_attributes)] // the scenes name effects alike
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/robots/g1/g1_29dof_rev_1_0.urdf", base = free), gravity(-9.81 * N.z))]
+#[appell(contact(left_ankle_roll_link, flat, effect = left))]
+#[appell(contact(right_ankle_roll_link, flat, effect = right))]
+#[appell(scene(double_support, effects(gravity, actuation, left, right)))]
+#[appell(scene(left_support, effects(gravity, actuation, left)))]
+struct G1;
+
 fn numbers(v: &Value) -> Vec<f64> {
     v.as_array()
         .expect("a list")
@@ -49,8 +60,9 @@ fn relative(a: &[f64], b: &[f64]) -> f64 {
 }
 
 /// The worst relative differences of the scene's accelerations and contact
-/// forces to Pinocchio's, over the reference's states.
-fn worst_difference<S: Model>(scene: &S, set: &str) -> (f64, f64) {
+/// forces to Pinocchio's, over the reference's states (`Full` is the robot
+/// in the air, whose coordinates and speeds the scene's are among).
+fn worst_difference<Full: Model, S: Model>(scene: &S, set: &str) -> (f64, f64) {
     let path = format!(
         "{}/tests/reference/pinocchio/contacts/{set}.json",
         env!("CARGO_MANIFEST_DIR")
@@ -61,7 +73,7 @@ fn worst_difference<S: Model>(scene: &S, set: &str) -> (f64, f64) {
         .iter()
         .map(|j| j["name"].as_str().expect("name"))
         .collect();
-    let (full, info) = (Solo12::info(), S::info());
+    let (full, info) = (Full::info(), S::info());
     let map = PinocchioMap::free("root_joint", full.coordinates, full.speeds, &joints).unwrap();
     let (n, l, nv) = (full.coordinates.len(), full.speeds.len(), map.nv());
     let prepared = scene.prepare::<f64>();
@@ -156,9 +168,22 @@ fn a_stance_foot_makes_its_legs_joints_dependent() {
 #[test]
 fn solo12_on_its_feet_agrees_with_pinocchio() {
     let robot = Solo12;
-    let four = worst_difference(Solo12Standing::from_ref(&robot), "solo12_four_feet");
-    let trot = worst_difference(Solo12Trotting::from_ref(&robot), "solo12_trot_fl_hr");
+    let four = worst_difference::<Solo12, _>(Solo12Standing::from_ref(&robot), "solo12_four_feet");
+    let trot = worst_difference::<Solo12, _>(Solo12Trotting::from_ref(&robot), "solo12_trot_fl_hr");
     for (set, (a, f)) in [("four feet", four), ("trot", trot)] {
+        assert!(
+            a < 1e-9 && f < 1e-9,
+            "{set}: accelerations {a:.1e}, forces {f:.1e}"
+        );
+    }
+}
+
+#[test]
+fn g1_on_its_flat_feet_agrees_with_pinocchio() {
+    let robot = G1;
+    let double = worst_difference::<G1, _>(G1DoubleSupport::from_ref(&robot), "g1_double_support");
+    let left = worst_difference::<G1, _>(G1LeftSupport::from_ref(&robot), "g1_left_support");
+    for (set, (a, f)) in [("double support", double), ("left support", left)] {
         assert!(
             a < 1e-9 && f < 1e-9,
             "{set}: accelerations {a:.1e}, forces {f:.1e}"

@@ -263,12 +263,12 @@ impl Graph {
             }
             if block.is_none() {
                 if let Some((r, c)) = scalar {
-                    let inv = self.recip(rows[r][c])?;
-                    for x in rows[r].iter_mut() {
-                        let t = self.mul(*x, inv)?;
-                        *x = self.expand_outside_functions(t, self.limits.max_terms)?;
+                    // An expansion past the term limit leaves this unknown,
+                    // and the rest, to the numeric solve.
+                    match give_up_on_term_limit(self.scalar_pivot(&rows, r, c))? {
+                        Some(next) => rows = next,
+                        None => break,
                     }
-                    self.clear_column(&mut rows, r, &[c])?;
                     open_rows.retain(|&x| x != r);
                     open_cols.retain(|&x| x != c);
                     pivots.push((r, c));
@@ -278,25 +278,10 @@ impl Graph {
             let Some((r1, r2, c1, c2, det)) = block else {
                 break;
             };
-            let (a11, a12, a21, a22) = (rows[r1][c1], rows[r1][c2], rows[r2][c1], rows[r2][c2]);
-            let inv_det = self.recip(det)?;
-            // [row1; row2] ← adj(B)/det · [row1; row2]
-            let width = rows[r1].len();
-            let (old1, old2) = (rows[r1].clone(), rows[r2].clone());
-            for k in 0..width {
-                let x = self.mul(a22, old1[k])?;
-                let y = self.mul(a12, old2[k])?;
-                let n1 = self.sub(x, y)?;
-                let n1 = self.mul(n1, inv_det)?;
-                rows[r1][k] = self.expand_outside_functions(n1, self.limits.max_terms)?;
-                let x = self.mul(a11, old2[k])?;
-                let y = self.mul(a21, old1[k])?;
-                let n2 = self.sub(x, y)?;
-                let n2 = self.mul(n2, inv_det)?;
-                rows[r2][k] = self.expand_outside_functions(n2, self.limits.max_terms)?;
+            match give_up_on_term_limit(self.two_by_two_pivot(&rows, (r1, r2, c1, c2, det)))? {
+                Some(next) => rows = next,
+                None => break,
             }
-            self.clear_column(&mut rows, r1, &[c1])?;
-            self.clear_column(&mut rows, r2, &[c2])?;
             open_rows.retain(|&x| x != r1 && x != r2);
             open_cols.retain(|&x| x != c1 && x != c2);
             pivots.push((r1, c1));
@@ -324,6 +309,50 @@ impl Graph {
             s: SymMatrix::from_rows(k, k, s)?,
             s_rhs: SymMatrix::from_rows(k, m, s_rhs)?,
         })
+    }
+
+    /// The rows after pivoting on entry (`r`, `c`): row `r` divided by it,
+    /// column `c` cleared from the others.
+    fn scalar_pivot(&mut self, rows: &[Vec<Id>], r: usize, c: usize) -> Result<Vec<Vec<Id>>> {
+        let mut rows = rows.to_vec();
+        let inv = self.recip(rows[r][c])?;
+        for x in rows[r].iter_mut() {
+            let t = self.mul(*x, inv)?;
+            *x = self.expand_outside_functions(t, self.limits.max_terms)?;
+        }
+        self.clear_column(&mut rows, r, &[c])?;
+        Ok(rows)
+    }
+
+    /// The rows after pivoting on the 2×2 block (`r1`, `r2`) × (`c1`, `c2`)
+    /// of determinant `det`: the two rows multiplied by the block's inverse,
+    /// its columns cleared from the others.
+    fn two_by_two_pivot(
+        &mut self,
+        rows: &[Vec<Id>],
+        (r1, r2, c1, c2, det): (usize, usize, usize, usize, Id),
+    ) -> Result<Vec<Vec<Id>>> {
+        let mut rows = rows.to_vec();
+        let (a11, a12, a21, a22) = (rows[r1][c1], rows[r1][c2], rows[r2][c1], rows[r2][c2]);
+        let inv_det = self.recip(det)?;
+        // [row1; row2] ← adj(B)/det · [row1; row2]
+        let width = rows[r1].len();
+        let (old1, old2) = (rows[r1].clone(), rows[r2].clone());
+        for k in 0..width {
+            let x = self.mul(a22, old1[k])?;
+            let y = self.mul(a12, old2[k])?;
+            let n1 = self.sub(x, y)?;
+            let n1 = self.mul(n1, inv_det)?;
+            rows[r1][k] = self.expand_outside_functions(n1, self.limits.max_terms)?;
+            let x = self.mul(a11, old2[k])?;
+            let y = self.mul(a21, old1[k])?;
+            let n2 = self.sub(x, y)?;
+            let n2 = self.mul(n2, inv_det)?;
+            rows[r2][k] = self.expand_outside_functions(n2, self.limits.max_terms)?;
+        }
+        self.clear_column(&mut rows, r1, &[c1])?;
+        self.clear_column(&mut rows, r2, &[c2])?;
+        Ok(rows)
     }
 
     /// The smallest provably non-zero entry among the open rows and columns
@@ -375,7 +404,13 @@ impl Graph {
                         let p = self.mul(a11, a22)?;
                         let q = self.mul(a12, a21)?;
                         let d = self.sub(p, q)?;
-                        let det = self.expand_outside_functions(d, self.limits.max_terms)?;
+                        // A determinant too large to expand is no pivot.
+                        let Some(det) = give_up_on_term_limit(
+                            self.expand_outside_functions(d, self.limits.max_terms),
+                        )?
+                        else {
+                            continue;
+                        };
                         let ok = if constant_only {
                             self.as_number(det).is_some_and(|n| !n.is_zero())
                         } else {
@@ -690,6 +725,16 @@ impl Graph {
     }
 }
 
+/// `Ok(None)` for an expansion that exceeded the term limit, so that the
+/// caller can take another way; other errors pass.
+fn give_up_on_term_limit<T>(r: Result<T>) -> Result<Option<T>> {
+    match r {
+        Ok(x) => Ok(Some(x)),
+        Err(SymbolicError::TermLimit { .. }) => Ok(None),
+        Err(e) => Err(e),
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use crate::{Assumptions, Graph, Sign, SymMatrix, SymbolicError};
@@ -704,6 +749,23 @@ mod tests {
             SymbolicError::StructurallySingular { column: 1 }
         );
     }
+    #[test]
+    fn an_elimination_too_large_to_expand_is_left_to_the_numeric_solve() {
+        // Clearing p below the first pivot would expand p·(a + b + c + d)
+        // into 16 terms, over the limit of 10: both unknowns stay free.
+        let mut g = Graph::with_limits(crate::Limits {
+            max_terms: 10,
+            ..crate::Limits::default()
+        });
+        let a = SymMatrix::parse(&mut g, &[&["1", "0"], &["e + f + h + i", "1"]]).unwrap();
+        let b = SymMatrix::parse(&mut g, &[&["a + b + c + d"], &["0"]]).unwrap();
+        let sol = g.eliminate(&a, &b, &Assumptions::new()).unwrap();
+        assert!(sol.pivot_cols.is_empty());
+        assert_eq!(sol.free_cols, vec![0, 1]);
+        assert_eq!(sol.s, a);
+        assert_eq!(sol.s_rhs, b);
+    }
+
     #[test]
     fn refuses_a_pivot_that_may_vanish() {
         let mut g = Graph::new();

@@ -7,7 +7,10 @@ forces of Pinocchio's constrained forward dynamics.
 A point contact holds a foot frame's origin still: its rows are the frame's
 linear velocity in the world's axes (LOCAL_WORLD_ALIGNED), J v = 0, and the
 accelerations keep it, J ddq + gamma = 0 with gamma the frame's classical
-acceleration at ddq = 0. Pinocchio's `forwardDynamics(model, data, q, v,
+acceleration at ddq = 0. A flat contact holds the whole frame: three more
+rows, its angular velocity in the world's axes (the frame Jacobian's six
+rows), and its lambda is the ground's force and then its moment about the
+frame's origin. Pinocchio's `forwardDynamics(model, data, q, v,
 tau, J, gamma)` solves
 
     M ddq + nle = tau + J^T lambda,    J ddq = -gamma,
@@ -49,21 +52,43 @@ N_STATES = 20
 TOL = 1e-9
 MAX_LEG_CONDITION = 1e3
 
-# (file written, URDF under tests/, feet frames held, what it is)
+# (file written, URDF under tests/, feet frames held, their kind, what it is)
 SETS = [
     (
         "solo12_four_feet",
         "tests/robots/solo/solo12.urdf",
         ["FL_FOOT", "FR_FOOT", "HL_FOOT", "HR_FOOT"],
+        "point",
         "Solo12 standing on four point feet",
     ),
     (
         "solo12_trot_fl_hr",
         "tests/robots/solo/solo12.urdf",
         ["FL_FOOT", "HR_FOOT"],
+        "point",
         "Solo12 trotting: front-left and hind-right feet down",
     ),
+    (
+        "g1_double_support",
+        "tests/robots/g1/g1_29dof_rev_1_0.urdf",
+        ["left_ankle_roll_link", "right_ankle_roll_link"],
+        "flat",
+        "G1 (29 joints) in double support: both feet flat on the ground",
+    ),
+    (
+        "g1_left_support",
+        "tests/robots/g1/g1_29dof_rev_1_0.urdf",
+        ["left_ankle_roll_link"],
+        "flat",
+        "G1 (29 joints) in single support: the left foot flat on the ground",
+    ),
 ]
+
+
+def rows_of(kind):
+    """The frame Jacobian's rows a contact holds: the linear three, or all
+    six for a flat foot."""
+    return {"point": 3, "flat": 6}[kind]
 
 
 def random_state(model, rng):
@@ -84,8 +109,8 @@ def random_state(model, rng):
     return q
 
 
-def contact_terms(model, data, frames, q, v):
-    """J (3 rows a foot, world axes) and gamma (the feet's classical
+def contact_terms(model, data, frames, kind, q, v):
+    """J (3 or 6 rows a foot, world axes) and gamma (the feet's classical
     accelerations at ddq = 0)."""
     pin.forwardKinematics(model, data, q, v, np.zeros(model.nv))
     pin.computeJointJacobians(model, data, q)
@@ -94,46 +119,47 @@ def contact_terms(model, data, frames, q, v):
     for f in frames:
         fid = model.getFrameId(f)
         jac = pin.getFrameJacobian(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-        rows.append(jac[:3, :])
+        rows.append(jac[: rows_of(kind), :])
         acc = pin.getFrameClassicalAcceleration(model, data, fid, pin.LOCAL_WORLD_ALIGNED)
-        drift.append(acc.linear)
+        drift.append(acc.vector[: rows_of(kind)])
     return np.vstack(rows), np.concatenate(drift)
 
 
-def feet_accelerations(model, data, frames, q, v, a):
+def feet_accelerations(model, data, frames, kind, q, v, a):
     pin.forwardKinematics(model, data, q, v, a)
     pin.updateFramePlacements(model, data)
     return np.concatenate(
         [
             pin.getFrameClassicalAcceleration(
                 model, data, model.getFrameId(f), pin.LOCAL_WORLD_ALIGNED
-            ).linear
+            ).vector[: rows_of(kind)]
             for f in frames
         ]
     )
 
 
-def leg_condition(model, data, frames, q):
+def leg_condition(model, data, frames, kind, q):
     """The largest condition number of a foot's Jacobian in the joints of
     its leg (the columns after the base's that move it)."""
     pin.computeJointJacobians(model, data, q)
     pin.updateFramePlacements(model, data)
     worst = 0.0
     for f in frames:
-        jac = pin.getFrameJacobian(model, data, model.getFrameId(f), pin.LOCAL_WORLD_ALIGNED)[:3]
+        frame = model.getFrameId(f)
+        jac = pin.getFrameJacobian(model, data, frame, pin.LOCAL_WORLD_ALIGNED)[: rows_of(kind)]
         cols = [c for c in range(6, model.nv) if np.abs(jac[:, c]).max() > 0]
         worst = max(worst, np.linalg.cond(jac[:, cols]))
     return worst
 
 
-def one_state(model, data, frames, rng):
+def one_state(model, data, frames, kind, rng):
     q = random_state(model, rng)
-    while leg_condition(model, data, frames, q) > MAX_LEG_CONDITION:
+    while leg_condition(model, data, frames, kind, q) > MAX_LEG_CONDITION:
         q = random_state(model, rng)
-    jac, _ = contact_terms(model, data, frames, q, np.zeros(model.nv))
+    jac, _ = contact_terms(model, data, frames, kind, q, np.zeros(model.nv))
     v = rng.uniform(-1.0, 1.0, model.nv)
     v = v - np.linalg.pinv(jac) @ (jac @ v)
-    jac, gamma = contact_terms(model, data, frames, q, v)
+    jac, gamma = contact_terms(model, data, frames, kind, q, v)
     assert np.abs(jac @ v).max() < 1e-12
     tau = np.concatenate([np.zeros(6), rng.uniform(-1.0, 1.0, model.nv - 6)])
     ddq = pin.forwardDynamics(model, data, q, v, tau, jac, gamma).copy()
@@ -153,7 +179,7 @@ def one_state(model, data, frames, rng):
     # Sign: M ddq + nle = tau + J^T lambda.
     residual = mass @ ddq + nle - tau - jac.T @ lam
     assert np.abs(residual).max() < TOL * scale, f"lambda's sign: residual {np.abs(residual).max()}"
-    feet = feet_accelerations(model, data, frames, q, v, ddq)
+    feet = feet_accelerations(model, data, frames, kind, q, v, ddq)
     assert np.abs(feet).max() < TOL * scale, f"feet accelerate: {np.abs(feet).max()}"
     return {
         "q": q.tolist(),
@@ -167,7 +193,7 @@ def one_state(model, data, frames, rng):
 def main():
     os.makedirs(OUT, exist_ok=True)
     rng = np.random.default_rng(SEED)
-    for name, urdf, frames, what in SETS:
+    for name, urdf, frames, kind, what in SETS:
         model = pin.buildModelFromUrdf(os.path.join(ROOT, urdf), pin.JointModelFreeFlyer())
         data = model.createData()
         assert np.allclose(model.gravity.linear, [0.0, 0.0, -9.81])
@@ -181,13 +207,13 @@ def main():
             }
             for j in range(1, model.njoints)
         ]
-        states = [one_state(model, data, frames, rng) for _ in range(N_STATES)]
+        states = [one_state(model, data, frames, kind, rng) for _ in range(N_STATES)]
         doc = {
             "robot": name,
             "what": what,
             "urdf": urdf,
             "base": "free",
-            "contacts": [{"frame": f, "kind": "point"} for f in frames],
+            "contacts": [{"frame": f, "kind": kind} for f in frames],
             "pinocchio": pin.__version__,
             "numpy": importlib.metadata.version("numpy"),
             "seed": SEED,
