@@ -4,7 +4,7 @@
 //! dependent-speed block D' (eq. 27) that pivots only on entries it can prove
 //! non-zero.
 
-use std::collections::BTreeSet;
+use std::collections::{BTreeSet, HashMap};
 
 use crate::deps::SymbolSet;
 use crate::error::{Result, SymbolicError};
@@ -243,6 +243,9 @@ impl Graph {
         let mut open_rows: Vec<usize> = (0..n).collect();
         let mut open_cols: Vec<usize> = (0..n).collect();
         let mut pivots: Vec<(usize, usize)> = Vec::new(); // (row, col)
+                                                          // The blocks' determinants, expanded once (rows a pivot leaves
+                                                          // alone keep their entries, so the next search meets them again).
+        let mut dets = HashMap::new();
         loop {
             for &c in &open_cols {
                 if open_rows.iter().all(|&r| self.is_zero(rows[r][c])) {
@@ -256,9 +259,21 @@ impl Graph {
             let constant_scalar = scalar.filter(|&(r, c)| self.as_number(rows[r][c]).is_some());
             let mut block = None;
             if constant_scalar.is_none() {
-                block = self.block_pivot(&rows, &open_rows, &open_cols, assumptions, true)?;
+                block = self.block_pivot(
+                    &rows,
+                    (&open_rows, &open_cols),
+                    assumptions,
+                    true,
+                    &mut dets,
+                )?;
                 if block.is_none() && scalar.is_none() {
-                    block = self.block_pivot(&rows, &open_rows, &open_cols, assumptions, false)?;
+                    block = self.block_pivot(
+                        &rows,
+                        (&open_rows, &open_cols),
+                        assumptions,
+                        false,
+                        &mut dets,
+                    )?;
                 }
             }
             if block.is_none() {
@@ -380,15 +395,17 @@ impl Graph {
     }
 
     /// A 2×2 block of the open rows and columns whose determinant is a
-    /// non-zero constant (`constant_only`) or provably non-zero.
+    /// non-zero constant (`constant_only`) or provably non-zero. `dets`
+    /// holds the expanded determinants of blocks met before (`None`: too
+    /// large to expand).
     #[allow(clippy::type_complexity)] // (r1, r2, c1, c2, determinant)
     fn block_pivot(
         &mut self,
         rows: &[Vec<Id>],
-        open_rows: &[usize],
-        open_cols: &[usize],
+        (open_rows, open_cols): (&[usize], &[usize]),
         assumptions: &Assumptions,
         constant_only: bool,
+        dets: &mut HashMap<[Id; 4], Option<Id>>,
     ) -> Result<Option<(usize, usize, usize, usize, Id)>> {
         for (i, &c1) in open_cols.iter().enumerate() {
             for &c2 in &open_cols[i + 1..] {
@@ -401,14 +418,16 @@ impl Graph {
                         {
                             continue;
                         }
-                        let p = self.mul(a11, a22)?;
-                        let q = self.mul(a12, a21)?;
-                        let d = self.sub(p, q)?;
+                        let det = match dets.get(&[a11, a12, a21, a22]) {
+                            Some(&det) => det,
+                            None => {
+                                let det = self.block_determinant(a11, a12, a21, a22)?;
+                                dets.insert([a11, a12, a21, a22], det);
+                                det
+                            }
+                        };
                         // A determinant too large to expand is no pivot.
-                        let Some(det) = give_up_on_term_limit(
-                            self.expand_outside_functions(d, self.limits.max_terms),
-                        )?
-                        else {
+                        let Some(det) = det else {
                             continue;
                         };
                         let ok = if constant_only {
@@ -424,6 +443,16 @@ impl Graph {
             }
         }
         Ok(None)
+    }
+
+    /// `a11 a22 − a12 a21` expanded, or `None` when that takes more than
+    /// [`BLOCK_DETERMINANT_TERMS`] terms.
+    fn block_determinant(&mut self, a11: Id, a12: Id, a21: Id, a22: Id) -> Result<Option<Id>> {
+        let p = self.mul(a11, a22)?;
+        let q = self.mul(a12, a21)?;
+        let d = self.sub(p, q)?;
+        let budget = self.limits.max_terms.min(BLOCK_DETERMINANT_TERMS);
+        give_up_on_term_limit(self.expand_outside_functions(d, budget))
     }
 
     /// Subtracts multiples of the (normalized) pivot row `p` from every other
@@ -724,6 +753,13 @@ impl Graph {
         })
     }
 }
+
+/// The most terms a 2×2 block's determinant may take while it is expanded
+/// to be proved non-zero. A rotation's expands to a constant through a
+/// handful; one that needs thousands is no pivot worth having, and trying
+/// every block of a long chain's rows at the general term limit costs
+/// minutes.
+const BLOCK_DETERMINANT_TERMS: usize = 1000;
 
 /// `Ok(None)` for an expansion that exceeded the term limit, so that the
 /// caller can take another way; other errors pass.
