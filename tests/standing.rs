@@ -150,6 +150,13 @@ fn a_stance_foot_makes_its_legs_joints_dependent() {
             "root_joint_z"
         ]
     );
+    assert!(
+        four.form
+            .starts_with("structured: M by the composite-rigid-body algorithm")
+            && four.form.contains("projected onto the scene's"),
+        "{}",
+        four.form
+    );
     let trot = Solo12Trotting::info();
     assert_eq!(trot.speeds.len(), 12);
     for leg in ["FR", "HL"] {
