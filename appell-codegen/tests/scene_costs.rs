@@ -1,0 +1,69 @@
+//! A contact scene pays for the contacts it names: its operation count is
+//! that of the same robot declaring those contacts alone.
+
+use appell_codegen::FileRoots;
+
+/// The workspace root, which the models' URDF paths start from.
+fn workspace_root() -> std::path::PathBuf {
+    std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .parent()
+        .expect("workspace root")
+        .to_path_buf()
+}
+
+/// The operation counts (`total`) the expansion of `src` reports, in order:
+/// the model's rhs, then each scene's.
+fn rhs_totals(src: &str) -> Vec<usize> {
+    let input: syn::DeriveInput = syn::parse_str(src).expect("a model");
+    let roots = FileRoots::new(Some(&workspace_root()), None);
+    let text = appell_codegen::expand_with(&input, &roots, &Default::default()).to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    text.match_indices("rhs_ops")
+        .map(|(i, _)| {
+            let rest = &text[i..];
+            let at = rest.find("total :").expect("a total") + "total :".len();
+            rest[at..]
+                .split([',', '}'])
+                .next()
+                .and_then(|n| n.trim().parse().ok())
+                .expect("a count")
+        })
+        .collect()
+}
+
+/// Bolt, a biped on point feet, its left foot down.
+fn bolt(contacts: &str) -> String {
+    format!(
+        r#"#[derive(Appell)]
+        #[appell(urdf("tests/robots/bolt/bolt.urdf", base = free), gravity(-9.81 * N.z))]
+        #[appell({contacts})]
+        #[appell(scene(left, effects(gravity, actuation, fl)))]
+        struct Bolt;"#
+    )
+}
+
+#[test]
+fn a_contact_scene_costs_what_the_robot_with_its_contacts_alone_costs() {
+    let both = rhs_totals(&bolt(
+        "contact(FL_FOOT, point, effect = fl), contact(FR_FOOT, point, effect = fr)",
+    ));
+    let left = rhs_totals(&bolt("contact(FL_FOOT, point, effect = fl)"));
+    assert_eq!(both.len(), 2, "{both:?}");
+    println!("Bolt in the air and on its left foot: {both:?} operations per rhs call");
+    assert_eq!(both, left);
+    // And the scene pays for its foot: more than the robot in the air.
+    assert!(both[1] != both[0], "{both:?}");
+}
+
+#[test]
+fn a_scene_costs_the_same_after_another_scene() {
+    let both = "contact(FL_FOOT, point, effect = fl), contact(FR_FOOT, point, effect = fr)";
+    let alone = rhs_totals(&bolt(both));
+    let src = bolt(both).replace(
+        "#[appell(scene(left",
+        "#[appell(scene(both, effects(gravity, actuation, fl, fr)))]\n#[appell(scene(left",
+    );
+    let after = rhs_totals(&src);
+    assert_eq!(after.len(), 3, "{after:?}");
+    assert_eq!((after[0], after[2]), (alone[0], alone[1]));
+}
