@@ -189,14 +189,16 @@ impl<'a> Guard<'a> {
     /// [`Model::contact_links`](crate::Model::contact_links) is
     /// [`ModelError::Contact`].
     pub fn touchdown(to: usize, model: &'a dyn DynModel, contact: usize) -> Self {
+        // The contacts' points, allocated once: the guard runs every step.
+        let count = model.dyn_contact_links().len();
+        let points = core::cell::RefCell::new(vec![[0.0; 3]; count]);
         Guard::new("touchdown", to, move |t, q: &[f64], _u: &[f64]| {
-            let count = model.dyn_contact_links().len();
             if contact >= count {
                 return Err(ModelError::Contact {
                     what: "the touchdown guard names a contact the model does not declare",
                 });
             }
-            let mut points = vec![[0.0; 3]; count];
+            let mut points = points.borrow_mut();
             model.dyn_contact_points(t, q, &mut points)?;
             Ok(points[contact][2])
         })

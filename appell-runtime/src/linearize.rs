@@ -17,6 +17,9 @@
 //! * [`minimal_linearization`]: the linearization in a minimal state, with
 //!   the retained coordinates fixed by holonomic constraints eliminated and
 //!   the privileged speeds an operating point holds fixed dropped.
+//! * [`fixed_step`] and [`step_jacobian`]: one step of RK4 or semi-implicit
+//!   Euler as a discrete-time map x⁺ = Φ(t, x, u), and its Jacobians
+//!   ∂x⁺/∂x and ∂x⁺/∂u in one call, for discrete-time MPC and DDP.
 //!
 //! # Example
 //!
@@ -128,6 +131,7 @@ use crate::model::Model;
 use num_dual::Dual64;
 
 mod checks;
+mod discrete;
 mod eigen;
 mod error;
 mod holonomic;
@@ -136,6 +140,7 @@ mod minimal;
 #[cfg(feature = "std")]
 pub(crate) mod newton_dyn;
 
+pub use discrete::{fixed_step, step_jacobian, FixedStep, StepLinearization};
 pub use eigen::eigenvalues;
 pub use error::LinearizeError;
 pub use holonomic::{

@@ -30,7 +30,7 @@ pub struct Linearization {
 
 /// The names of the reduced state: the retained coordinates, then the
 /// privileged speeds suffixed `_dot`.
-fn state_names(info: &ModelInfo) -> Vec<String> {
+pub(super) fn state_names(info: &ModelInfo) -> Vec<String> {
     info.retained
         .iter()
         .map(|r| r.to_string())
