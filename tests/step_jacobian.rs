@@ -132,3 +132,102 @@ fn bad_arguments_are_typed_errors() {
         ));
     }
 }
+
+/// The command line's answer to one `jacobian` line.
+fn jacobian_line(args: &[&str], line: &str) -> serde_json::Value {
+    let args: Vec<String> = args.iter().map(|s| s.to_string()).collect();
+    let mut out = Vec::new();
+    appell::cli::run_with(
+        WheelAxle::default(),
+        &args,
+        &mut line.as_bytes(),
+        &mut out,
+        |_| Ok(()),
+    )
+    .unwrap();
+    serde_json::from_slice(&out).unwrap()
+}
+
+/// A JSON matrix as rows.
+fn rows(v: &serde_json::Value) -> Vec<Vec<f64>> {
+    v.as_array()
+        .unwrap()
+        .iter()
+        .map(|r| {
+            r.as_array()
+                .unwrap()
+                .iter()
+                .map(|x| x.as_f64().unwrap())
+                .collect()
+        })
+        .collect()
+}
+
+fn matrix(m: &appell::nalgebra::DMatrix<f64>) -> Vec<Vec<f64>> {
+    (0..m.nrows())
+        .map(|i| (0..m.ncols()).map(|j| m[(i, j)]).collect())
+        .collect()
+}
+
+#[test]
+fn the_command_lines_jacobian_is_the_linearization_and_the_steps() {
+    let line = r#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}, "inputs": {"tau": 0.5}}"#;
+    let model = WheelAxle::default();
+    let info = WheelAxle::info();
+    let x: Vec<f64> = info
+        .retained
+        .iter()
+        .map(|c| if *c == "phi" { 0.2 } else { 0.0 })
+        .chain([0.1, 2.0])
+        .collect();
+    let v = jacobian_line(&["wheel_axle", "jacobian"], line);
+    let lin = appell::linearize::linearize(&model, 0.0, &x, &[0.5]).unwrap();
+    assert_eq!(rows(&v["a"]), matrix(&lin.a));
+    assert_eq!(rows(&v["b"]), matrix(&lin.b));
+    assert_eq!(v["state"], serde_json::json!(lin.state_names));
+    assert_eq!(v["inputs"], serde_json::json!(["tau"]));
+    let mut rates = vec![0.0; x.len()];
+    model
+        .rhs(&model.prepare::<f64>(), 0.0, &x, &[0.5], &mut rates)
+        .unwrap();
+    assert_eq!(v["rates"], serde_json::json!(rates));
+
+    // One RK4 step of 10 ms, as step_jacobian takes it.
+    let line_step = format!(
+        "{}, \"step\": {{\"method\": \"rk4\", \"h\": 0.01}}}}",
+        &line[..line.len() - 1]
+    );
+    let v = jacobian_line(&["wheel_axle", "jacobian"], &line_step);
+    let step = step_jacobian(&model, FixedStep::Rk4, 0.0, 0.01, &x, &[0.5]).unwrap();
+    assert_eq!(rows(&v["a"]), matrix(&step.a));
+    assert_eq!(rows(&v["b"]), matrix(&step.b));
+    assert_eq!(v["next"], serde_json::json!(step.next));
+    assert_eq!(v["step"]["method"], "rk4");
+
+    // A scene answers with its own reduced state.
+    let v = jacobian_line(&["wheel_axle", "jacobian", "--scene", "driven"], line);
+    assert_eq!(rows(&v["a"]).len(), 2);
+    assert_eq!(v["state"], serde_json::json!(["phi_dot", "psi1_dot"]));
+}
+
+#[test]
+fn a_bad_jacobian_line_is_answered_with_an_error() {
+    let base = r#"{"q": {"phi": 0.2}, "u": {"phi": 0.1, "psi1": 2.0}"#;
+    for (extra, expected) in [
+        (
+            r#", "step": {"method": "euler", "h": 0.1}}"#,
+            "`step.method` must be",
+        ),
+        (r#", "step": {"method": "rk4"}}"#, "missing `step.h`"),
+        (
+            r#", "step": {"method": "rk4", "h": 0.1, "k": 2}}"#,
+            "unknown field `k` in `step`",
+        ),
+        (r#", "step": 3}"#, "`step` must be an object"),
+        (r#", "stepp": 3}"#, "unknown field `stepp`"),
+    ] {
+        let v = jacobian_line(&["wheel_axle", "jacobian"], &format!("{base}{extra}"));
+        let message = v["error"].as_str().unwrap_or_default();
+        assert!(message.contains(expected), "{extra}: {v}");
+    }
+}

@@ -7,6 +7,8 @@
 //! <program> eval --scene NAME      the same for a scene, plus its outputs
 //! <program> contacts     the same states -> multipliers and contact forces
 //! <program> contacts --scene NAME  the same for a scene (its loads only)
+//! <program> jacobian     the same states -> A = ∂ẋ/∂x, B = ∂ẋ/∂u (or of one step)
+//! <program> jacobian --scene NAME  the same for a scene
 //! <program> info         the model's metadata as JSON
 //! <program> equations    the derived reduced equations, as text
 //! <program> bench        time the generated rhs against the oracle, as JSON
@@ -98,6 +100,25 @@
 //! Forces are on the body, from the ground, in N components. `"solved"`,
 //! `"residual"` and `"warning"` are added as in `eval`.
 //!
+//! # `jacobian`
+//!
+//! The same input lines, and optionally `"step": {"method": "rk4" |
+//! "semi_implicit_euler", "h": 0.01}`, answered with the Jacobians of the
+//! reduced equations at that state (those of [`crate::linearize::linearize`])
+//! or, with `step`, of one step of that method
+//! ([`crate::linearize::step_jacobian`]):
+//!
+//! ```text
+//! {"state": [names], "inputs": [names], "rates": [ẋ..], "a": [[∂ẋ_i/∂x_j..]..], "b": [[∂ẋ_i/∂u_k..]..]}
+//! {"state": [..], "inputs": [..], "step": {"method": "rk4", "h": 0.01}, "next": [x⁺..], "a": [[∂x⁺_i/∂x_j..]..], "b": [..]}
+//! ```
+//!
+//! A row per state component (the retained coordinates, then the speeds
+//! suffixed `_dot`, as `info`'s `state`), exact to rounding (dual numbers
+//! through the generated code, one pass per state component and input).
+//! `"solved"`, `"residual"` and `"warning"` are added as in `eval`; a
+//! Jacobian that is not finite answers the line with an error.
+//!
 //! # `info`
 //!
 //! One JSON object: `name`, `parameters` (a list of `{"name", "value"}` in
@@ -185,6 +206,7 @@ mod eval;
 mod holonomic;
 mod info;
 mod input;
+mod jacobian;
 mod json;
 mod output;
 mod progress;

@@ -131,7 +131,7 @@ use crate::model::Model;
 use num_dual::Dual64;
 
 mod checks;
-mod discrete;
+pub(crate) mod discrete;
 mod eigen;
 mod error;
 mod holonomic;

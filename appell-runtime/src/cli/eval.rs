@@ -1,9 +1,11 @@
-//! The `eval` and `contacts` subcommands: answering JSON states line by
-//! line with rates, a scene's outputs or the constraint forces.
+//! The `eval`, `contacts` and `jacobian` subcommands: answering JSON
+//! states line by line with rates, a scene's outputs, the constraint
+//! forces or the Jacobians.
 
 use super::error::CliError;
 use super::holonomic::fill_in;
 use super::input::{named, number, Point};
+use super::jacobian::{jacobian_answer, parse_step};
 use super::json::parse_object;
 use super::output::{contact_forces_json, finite_or_null, result_number};
 use crate::dynamic::DynModel;
@@ -81,8 +83,31 @@ impl<M: Model> Evaluator<M> {
 pub(super) struct EvalState {
     defaults: Vec<f64>,
     scene: Option<usize>,
-    /// Answer with the constraint forces instead of the rates (`contacts`).
-    pub(super) contacts: bool,
+    /// What a line is answered with.
+    pub(super) answer: Answer,
+}
+
+/// What a state line is answered with.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Answer {
+    /// The rates (`eval`).
+    Rates,
+    /// The constraint forces (`contacts`).
+    Contacts,
+    /// A = ∂ẋ/∂x and B = ∂ẋ/∂u, or those of one step (`jacobian`).
+    Jacobian,
+}
+
+impl Answer {
+    /// The answer of subcommand `command`, if it answers state lines.
+    pub(super) fn of_command(command: &str) -> Option<Answer> {
+        match command {
+            "eval" => Some(Answer::Rates),
+            "contacts" => Some(Answer::Contacts),
+            "jacobian" => Some(Answer::Jacobian),
+            _ => None,
+        }
+    }
 }
 
 impl EvalState {
@@ -93,7 +118,7 @@ impl EvalState {
         Ok(EvalState {
             defaults,
             scene: None,
-            contacts: false,
+            answer: Answer::Rates,
         })
     }
 
@@ -144,9 +169,20 @@ impl EvalState {
     fn try_eval(&self, model: &mut dyn DynModel, line: &str) -> Result<Value, String> {
         let info = self.info(model);
         let obj = parse_object(line)?;
-        let point = self.parse_point(model, &obj, &[])?;
+        let extra: &[&str] = match self.answer {
+            Answer::Jacobian => &["step"],
+            _ => &[],
+        };
+        let point = self.parse_point(model, &obj, extra)?;
         let model: &dyn DynModel = model;
         let notes = point.filled.notes();
+        if self.answer == Answer::Jacobian {
+            let step = parse_step(&obj)?;
+            let mut answer =
+                self.on_target(model, |target| jacobian_answer(target, info, &point, step))?;
+            answer.extend(notes);
+            return Ok(Value::Object(answer));
+        }
         let (t, q, u, inputs, state) = (point.t, point.q, point.u, point.inputs, point.state);
         let outputs = |energies: bool, contacts: bool| {
             let outputs = Outputs {
@@ -159,7 +195,7 @@ impl EvalState {
             };
             self.on_target(model, |target| outputs.of(target))
         };
-        if self.contacts {
+        if self.answer == Answer::Contacts {
             let mut out = outputs(false, true)?;
             let mut forces = out.remove("contact_forces").unwrap_or(Value::Null);
             if let Value::Object(forces) = &mut forces {

@@ -4,7 +4,7 @@
 use super::animate::animate_dyn;
 use super::bench::bench_dyn;
 use super::error::CliError;
-use super::eval::{eval_stream, EvalState};
+use super::eval::{eval_stream, Answer, EvalState};
 use super::info::info_json_dyn;
 use super::sweep::accuracy_dyn;
 use crate::dynamic::DynModel;
@@ -25,12 +25,12 @@ use std::process::ExitCode;
 /// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
 /// # };
 /// let text = appell_runtime::cli::usage("pendulum", &info);
-/// assert!(text.starts_with("usage: pendulum [eval|contacts|info|equations|bench|accuracy|animate|help]"));
+/// assert!(text.starts_with("usage: pendulum [eval|contacts|jacobian|info|equations|bench|accuracy|animate|help]"));
 /// assert!(text.contains("Pendulum"));
 /// ```
 pub fn usage(program: &str, info: &ModelInfo) -> String {
     format!(
-        "usage: {program} [eval|contacts|info|equations|bench|accuracy|animate|help]\n\
+        "usage: {program} [eval|contacts|jacobian|info|equations|bench|accuracy|animate|help]\n\
          \n\
          Model `{name}`.\n\
          \n\
@@ -43,6 +43,9 @@ pub fn usage(program: &str, info: &ModelInfo) -> String {
          \x20             (`eval --scene NAME`: a scene, plus the outputs it asks for)\n\
          \x20 contacts    the same input -> constraint multipliers, contact forces and\n\
          \x20             the friction rolling needs (`contacts --scene NAME` too)\n\
+         \x20 jacobian    the same input -> A = d(rates)/d(state), B = d(rates)/d(inputs)\n\
+         \x20             as JSON; with \"step\": {{\"method\": \"rk4\" | \"semi_implicit_euler\",\n\
+         \x20             \"h\": ..}} those of one step (`jacobian --scene NAME` too)\n\
          \x20 info        print the model's metadata as JSON\n\
          \x20 equations   print the derived equations\n\
          \x20 bench       time the generated rhs against the oracle, print JSON\n\
@@ -187,15 +190,15 @@ fn dispatch(
     let program = args.first().map(String::as_str).unwrap_or(info.name);
     let rest = args.get(1..).unwrap_or(&[]);
     if let [command, flag, name] = rest {
-        if (command == "eval" || command == "contacts") && flag == "--scene" {
+        if let (Some(answer), "--scene") = (Answer::of_command(command), flag.as_str()) {
             let mut evaluator = EvalState::with_scene(model, name)?;
-            evaluator.contacts = command == "contacts";
+            evaluator.answer = answer;
             eval_stream(&evaluator, model, stdin, stdout)?;
             return Ok(Dispatched::Done);
         }
     }
     if let [command, flag] = rest {
-        if (command == "eval" || command == "contacts") && flag == "--scene" {
+        if Answer::of_command(command).is_some() && flag == "--scene" {
             return Err(EvalState::scene_name_missing(model, command));
         }
     }
@@ -210,13 +213,9 @@ fn dispatch(
         }
     };
     match command {
-        "eval" => {
-            let evaluator = EvalState::new(model)?;
-            eval_stream(&evaluator, model, stdin, stdout)?;
-        }
-        "contacts" => {
+        "eval" | "contacts" | "jacobian" => {
             let mut evaluator = EvalState::new(model)?;
-            evaluator.contacts = true;
+            evaluator.answer = Answer::of_command(command).unwrap_or(Answer::Rates);
             eval_stream(&evaluator, model, stdin, stdout)?;
         }
         "info" => {

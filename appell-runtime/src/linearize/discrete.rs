@@ -96,11 +96,24 @@ pub fn fixed_step<M: Model, T: Scalar>(
     check_len("state", state, info.state_len())?;
     check_len("inputs", inputs, info.inputs.len())?;
     let mut f = |t: T, x: &[T], dx: &mut [T]| model.rhs(prepared, t, x, inputs, dx);
+    step_with(&mut f, info.retained.len(), method, t, h, state)
+}
+
+/// One step of `method` of `dx/dt = f(t, x)` from (`t`, `x`), whose first
+/// `retained` components are coordinates and the rest speeds; x⁺ checked
+/// to be finite. What [`fixed_step`] takes for a model, and the command
+/// line for a `dyn` one.
+pub(crate) fn step_with<T: Scalar>(
+    f: &mut impl FnMut(T, &[T], &mut [T]) -> Result<(), ModelError>,
+    retained: usize,
+    method: FixedStep,
+    t: T,
+    h: T,
+    x: &[T],
+) -> Result<Vec<T>, ModelError> {
     let next = match method {
-        FixedStep::Rk4 => rk4(&mut f, t, h, state)?,
-        FixedStep::SemiImplicitEuler => {
-            semi_implicit_euler(&mut f, info.retained.len(), t, h, state)?
-        }
+        FixedStep::Rk4 => rk4(f, t, h, x)?,
+        FixedStep::SemiImplicitEuler => semi_implicit_euler(f, retained, t, h, x)?,
     };
     if next.iter().all(|v| v.re().is_finite()) {
         Ok(next)
