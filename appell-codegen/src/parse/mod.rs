@@ -15,6 +15,7 @@ mod expr;
 mod files;
 mod items;
 pub mod joints;
+mod keywords;
 mod repeat;
 pub mod urdf;
 
@@ -316,40 +317,15 @@ impl syn::parse::Parse for Item {
     }
 }
 
-const ITEMS: &[&str] = &[
-    "coordinates",
-    "speeds",
-    "inputs",
-    "positive",
-    "frame",
-    "point",
-    "particle",
-    "body",
-    "holonomic",
-    "nonholonomic",
-    "force",
-    "torque",
-    "gravity",
-    "spring",
-    "damper",
-    "friction",
-    "rolls",
-    "contact",
-    "scene",
-    "joint",
-    "repeat",
-    "urdf",
-];
-
 fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
     let name = item.name.to_string();
     let tokens = item.content.clone();
     let result: syn::Result<()> = (|| {
         match name.as_str() {
-            "coordinates" => ast.coordinates.extend(ident_list(tokens)?),
-            "inputs" => ast.inputs.extend(ident_list(tokens)?),
-            "positive" => ast.positive.extend(ident_list(tokens)?),
-            "speeds" => {
+            keywords::COORDINATES => ast.coordinates.extend(ident_list(tokens)?),
+            keywords::INPUTS => ast.inputs.extend(ident_list(tokens)?),
+            keywords::POSITIVE => ast.positive.extend(ident_list(tokens)?),
+            keywords::SPEEDS => {
                 let list =
                     Parser::parse2(Punctuated::<SpeedItem, Token![,]>::parse_terminated, tokens)?;
                 let list: Vec<SpeedDef> = list
@@ -368,68 +344,68 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
                     None => ast.speeds = Some((list, item.all.clone())),
                 }
             }
-            "frame" => ast.frames.extend(Parser::parse2(parse_frame, tokens)?),
-            "point" => ast.points.push(Parser::parse2(parse_point, tokens)?),
-            "particle" => {
+            keywords::FRAME => ast.frames.extend(Parser::parse2(parse_frame, tokens)?),
+            keywords::POINT => ast.points.push(Parser::parse2(parse_point, tokens)?),
+            keywords::PARTICLE => {
                 let span = item.span;
                 ast.bodies.push(Parser::parse2(
                     move |s: ParseStream| parse_particle(s, span),
                     tokens,
                 )?)
             }
-            "body" => {
+            keywords::BODY => {
                 let span = item.span;
                 let (body, center) =
                     Parser::parse2(move |s: ParseStream| parse_body(s, span), tokens)?;
                 ast.points.extend(center);
                 ast.bodies.push(body)
             }
-            "joint" => {
+            keywords::JOINT => {
                 let span = item.span;
                 let joint =
                     Parser::parse2(move |s: ParseStream| joints::parse_joint(s, span), tokens)?;
                 add_joint(ast, &joint)?
             }
-            "urdf" => urdf::add(cx, ast, &item, roots)?,
-            "holonomic" | "nonholonomic" => {
+            keywords::URDF => urdf::add(cx, ast, &item, roots)?,
+            keywords::HOLONOMIC | keywords::NONHOLONOMIC => {
                 let at = item.content.clone();
                 let c = Parser::parse2(move |s: ParseStream| parse_constraint(s, at), tokens)?;
-                if name == "holonomic" {
+                if name == keywords::HOLONOMIC {
                     ast.holonomic.push(c)
                 } else {
                     ast.nonholonomic.push(c)
                 }
             }
-            "force" => ast.forces.push(Parser::parse2(parse_load, tokens)?),
-            "torque" => ast.torques.push(Parser::parse2(parse_load, tokens)?),
-            "spring" | "damper" => {
+            keywords::FORCE => ast.forces.push(Parser::parse2(parse_load, tokens)?),
+            keywords::TORQUE => ast.torques.push(Parser::parse2(parse_load, tokens)?),
+            keywords::SPRING | keywords::DAMPER => {
                 let kind = name.clone();
                 ast.forces.extend(Parser::parse2(
                     move |s: ParseStream| elements::parse_two_point(s, &kind),
                     tokens,
                 )?)
             }
-            "friction" => {
+            keywords::FRICTION => {
                 let (force, torque) = Parser::parse2(elements::parse_friction, tokens)?;
                 ast.forces.push(force);
                 ast.torques.extend(torque);
             }
-            "scene" => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
-            "rolls" => {
+            keywords::SCENE => ast.scenes.push(Parser::parse2(parse_scene, tokens)?),
+            keywords::ROLLS => {
                 let at = item.all.clone();
                 ast.rolls.push(Parser::parse2(
                     move |s: ParseStream| parse_rolls(s, at),
                     tokens,
                 )?)
             }
-            "contact" => {
+            keywords::CONTACT => {
                 let at = item.all.clone();
                 ast.contacts.push(Parser::parse2(
                     move |s: ParseStream| contacts::parse_contact(s, at),
                     tokens,
                 )?)
             }
-            "gravity" => {
+            keywords::GRAVITY => {
                 let e: syn::Expr = syn::parse2(tokens)?;
                 if ast.gravity.is_some() {
                     cx.error_at(item.span, "`gravity` is given twice");
@@ -437,7 +413,7 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
                 ast.gravity = Some(convert(&e)?);
             }
             _ => {
-                let hint = crate::ctxt::did_you_mean(&name, ITEMS.iter().copied())
+                let hint = crate::ctxt::did_you_mean(&name, keywords::ITEMS.iter().copied())
                     .map(|s| format!("; did you mean `{s}`?"))
                     .unwrap_or_default();
                 return Err(syn::Error::new(

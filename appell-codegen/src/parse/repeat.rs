@@ -51,7 +51,7 @@ fn expand_items(
     for item in split_commas(tokens) {
         match item.as_slice() {
             [TokenTree::Ident(id), TokenTree::Group(g)]
-                if id == "repeat" && g.delimiter() == Delimiter::Parenthesis =>
+                if id == super::keywords::REPEAT && g.delimiter() == Delimiter::Parenthesis =>
             {
                 expand_repeat(g, scope, out)?;
             }
