@@ -7,6 +7,7 @@ use syn::{Ident, Token};
 
 use super::items::{expr_ident, key_values};
 use crate::ast::*;
+use crate::parse::keywords as kw;
 
 /// Parses the inside of `contact(...)`; `at` is the whole item's tokens.
 pub(super) fn parse_contact(
@@ -23,8 +24,8 @@ pub(super) fn parse_contact(
     s.parse::<Token![,]>()?;
     let kind: Ident = s.parse()?;
     let flat = match kind.to_string().as_str() {
-        "point" => false,
-        "flat" => true,
+        kw::POINT => false,
+        kw::FLAT => true,
         other => {
             let hint = crate::ctxt::did_you_mean(other, ["point", "flat"])
                 .map(|s| format!("; did you mean `{s}`?"))
@@ -38,7 +39,7 @@ pub(super) fn parse_contact(
     let mut effect = None;
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
-            "effect" => effect = Some(expr_ident(&v)?),
+            kw::EFFECT => effect = Some(expr_ident(&v)?),
             other => {
                 return Err(syn::Error::new(
                     k.span(),

@@ -10,6 +10,7 @@ use super::expr::convert;
 use super::items::{expr_ident, key_values};
 use super::joints::{add, times};
 use crate::ast::*;
+use crate::parse::keywords as kw;
 
 /// The elements a revolute or prismatic joint may carry (`stiffness`,
 /// `rest`, `damping`, `friction`, `friction_smoothing`, `saturation`).
@@ -33,12 +34,12 @@ impl JointElements {
     /// Takes `key = value` when it names an element.
     pub(super) fn set(&mut self, key: &Ident, value: &syn::Expr) -> syn::Result<bool> {
         let slot = match key.to_string().as_str() {
-            "stiffness" => &mut self.stiffness,
-            "rest" => &mut self.rest,
-            "damping" => &mut self.damping,
-            "friction" => &mut self.friction,
-            "friction_smoothing" => &mut self.friction_smoothing,
-            "saturation" => &mut self.saturation,
+            kw::STIFFNESS => &mut self.stiffness,
+            kw::REST => &mut self.rest,
+            kw::DAMPING => &mut self.damping,
+            kw::FRICTION => &mut self.friction,
+            kw::FRICTION_SMOOTHING => &mut self.friction_smoothing,
+            kw::SATURATION => &mut self.saturation,
             _ => return Ok(false),
         };
         *slot = Some(convert(value)?);
@@ -129,7 +130,7 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
     for (k, v) in key_values(s)? {
         let key = k.to_string();
         let allowed: &[&str] = match kind {
-            "spring" => &["stiffness", "length", "tension"],
+            kw::SPRING => &["stiffness", "length", "tension"],
             _ => &["damping"],
         };
         if key == "effect" {
@@ -154,7 +155,7 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
     let d = sub(Expr::Name(q.clone()), Expr::Name(p.clone()));
     let direction = call("unit", vec![d.clone()], span);
     let tension = match kind {
-        "spring" => match (values.remove("tension"), values.remove("stiffness"), values.remove("length")) {
+        kw::SPRING => match (values.remove("tension"), values.remove("stiffness"), values.remove("length")) {
             (Some((t, _)), None, None) => t,
             (None, Some((k, _)), Some((l0, _))) => {
                 times(k, sub(call("norm", vec![d], span), l0))

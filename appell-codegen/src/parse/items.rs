@@ -10,6 +10,7 @@ use syn::{Ident, Token};
 use super::expr::convert;
 use super::{ident_list, Item};
 use crate::ast::*;
+use crate::parse::keywords as kw;
 
 /// `A = P.rotate_z(a)`, or a chain `A = P.rotate_z(a).rotate_x(b)`: each
 /// rotation but the last makes a frame named after the new one, `A_1`,
@@ -171,9 +172,9 @@ pub(super) fn parse_scene(s: ParseStream) -> syn::Result<SceneDef> {
         }
         let item: Item = s.parse()?;
         match item.name.to_string().as_str() {
-            "effects" => effects.extend(ident_list(item.content)?),
-            "speeds" => speeds = Some((ident_list(item.content)?, item.all)),
-            "outputs" => {
+            kw::EFFECTS => effects.extend(ident_list(item.content)?),
+            kw::SPEEDS => speeds = Some((ident_list(item.content)?, item.all)),
+            kw::OUTPUTS => {
                 let list = Parser::parse2(
                     Punctuated::<OutputItem, Token![,]>::parse_terminated,
                     item.content,
@@ -207,16 +208,16 @@ pub(super) fn parse_rolls(s: ParseStream, at: proc_macro2::TokenStream) -> syn::
     let mut first_friction_key = None;
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
-            "contact" => contact = Some(expr_ident(&v)?),
-            "effect" => effect = Some(expr_ident(&v)?),
-            "slides" => slides = Some(expr_ident(&v)?),
-            key @ ("mu" | "normal" | "smoothing" | "viscous" | "plane") => {
+            kw::CONTACT => contact = Some(expr_ident(&v)?),
+            kw::EFFECT => effect = Some(expr_ident(&v)?),
+            kw::SLIDES => slides = Some(expr_ident(&v)?),
+            key @ (kw::MU | kw::NORMAL | kw::SMOOTHING | kw::VISCOUS | kw::PLANE) => {
                 first_friction_key.get_or_insert(k.clone());
                 if friction.insert(key.to_string(), convert(&v)?).is_some() {
                     return Err(syn::Error::new(k.span(), format!("`{key}` is given twice")));
                 }
             }
-            "along" => match &v {
+            kw::ALONG => match &v {
                 syn::Expr::Array(a) => along = Some(a.elems.iter().map(convert).collect::<syn::Result<Vec<_>>>()?),
                 other => return Err(syn::Error::new(other.span(), "`along` takes a list of directions: `along = [A.x, A.y]`")),
             },
@@ -291,7 +292,7 @@ pub(super) fn parse_particle(s: ParseStream, span: Span) -> syn::Result<BodyDef>
     let mut mass = None;
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
-            "mass" => mass = Some(convert(&v)?),
+            kw::MASS => mass = Some(convert(&v)?),
             other => {
                 return Err(syn::Error::new(
                     k.span(),
@@ -320,7 +321,7 @@ pub(super) fn parse_body(s: ParseStream, span: Span) -> syn::Result<(BodyDef, Op
     let mut center_point = None;
     for (k, v) in key_values(s)? {
         match k.to_string().as_str() {
-            "center" => match &v {
+            kw::CENTER => match &v {
                 syn::Expr::Path(_) => center = Some(expr_ident(&v)?),
                 other => {
                     let point = Ident::new(&format!("{name}_center"), other.span());
@@ -331,9 +332,9 @@ pub(super) fn parse_body(s: ParseStream, span: Span) -> syn::Result<(BodyDef, Op
                     center = Some(point);
                 }
             },
-            "frame" => frame = Some(expr_ident(&v)?),
-            "mass" => mass = Some(convert(&v)?),
-            "inertia" => inertia = Some(parse_inertia(&v)?),
+            kw::FRAME => frame = Some(expr_ident(&v)?),
+            kw::MASS => mass = Some(convert(&v)?),
+            kw::INERTIA => inertia = Some(parse_inertia(&v)?),
             other => {
                 return Err(syn::Error::new(
                     k.span(),

@@ -15,6 +15,7 @@ use syn::{Ident, Token};
 
 use super::expr::convert;
 use crate::ast::*;
+use crate::parse::keywords as kw;
 
 /// The direction a joint moves along or about, in the joint frame.
 #[derive(Clone, Debug)]
@@ -124,9 +125,9 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
         let key: Ident = s.parse()?;
         if !s.peek(Token![=]) {
             match key.to_string().as_str() {
-                "actuated" => joint.actuated = true,
-                "dependent" => joint.dependent = true,
-                "lock" => return Err(lock_needs_effect(&key)),
+                kw::ACTUATED => joint.actuated = true,
+                kw::DEPENDENT => joint.dependent = true,
+                kw::LOCK => return Err(lock_needs_effect(&key)),
                 other => return Err(unknown_property(&key, other)),
             }
             continue;
@@ -137,12 +138,12 @@ pub(super) fn parse_joint(s: ParseStream, span: Span) -> syn::Result<JointDef> {
             continue;
         }
         match key.to_string().as_str() {
-            "parent" => parent = Some(super::items::expr_ident(&value)?),
-            "child" => child = Some(super::items::expr_ident(&value)?),
-            "at" => joint.at = Some(super::items::expr_ident(&value)?),
-            "xyz" => joint.xyz = Some(triple(&value, "xyz = [x, y, z]")?),
-            "rpy" => joint.rpy = Some(triple(&value, "rpy = [roll, pitch, yaw]")?),
-            "lock" => set_lock(&mut joint, &key, &value)?,
+            kw::PARENT => parent = Some(super::items::expr_ident(&value)?),
+            kw::CHILD => child = Some(super::items::expr_ident(&value)?),
+            kw::AT => joint.at = Some(super::items::expr_ident(&value)?),
+            kw::XYZ => joint.xyz = Some(triple(&value, "xyz = [x, y, z]")?),
+            kw::RPY => joint.rpy = Some(triple(&value, "rpy = [roll, pitch, yaw]")?),
+            kw::LOCK => set_lock(&mut joint, &key, &value)?,
             other => return Err(unknown_property(&key, other)),
         }
     }
@@ -252,15 +253,17 @@ fn parse_kind(e: &syn::Expr) -> syn::Result<JointKind> {
         syn::Expr::Path(p) => {
             let id = super::items::expr_ident(e)?;
             match id.to_string().as_str() {
-                "weld" | "fixed" => Ok(JointKind::Weld),
-                "spherical" | "ball" => Ok(JointKind::Spherical),
-                "free" | "floating" => Ok(JointKind::Free),
-                k @ ("revolute" | "prismatic" | "cylindrical" | "planar") => Err(syn::Error::new(
-                    p.span(),
-                    format!(
+                kw::WELD | kw::FIXED => Ok(JointKind::Weld),
+                kw::SPHERICAL | kw::BALL => Ok(JointKind::Spherical),
+                kw::FREE | kw::FLOATING => Ok(JointKind::Free),
+                k @ (kw::REVOLUTE | kw::PRISMATIC | kw::CYLINDRICAL | kw::PLANAR) => {
+                    Err(syn::Error::new(
+                        p.span(),
+                        format!(
                         "`{k}` needs its axis: `{k}(z)` or `{k}([ax, ay, az])`, in the joint frame"
                     ),
-                )),
+                    ))
+                }
                 other => Err(unknown(p.span(), other.to_string())),
             }
         }
@@ -274,10 +277,10 @@ fn parse_kind(e: &syn::Expr) -> syn::Result<JointKind> {
             };
             let axis = parse_axis(arg)?;
             match name.as_str() {
-                "revolute" => Ok(JointKind::Revolute(axis)),
-                "prismatic" => Ok(JointKind::Prismatic(axis)),
-                "cylindrical" => Ok(JointKind::Cylindrical(axis)),
-                "planar" => match axis {
+                kw::REVOLUTE => Ok(JointKind::Revolute(axis)),
+                kw::PRISMATIC => Ok(JointKind::Prismatic(axis)),
+                kw::CYLINDRICAL => Ok(JointKind::Cylindrical(axis)),
+                kw::PLANAR => match axis {
                     JointAxis::Unit(k, _) => Ok(JointKind::Planar(k)),
                     JointAxis::Components(_) => Err(syn::Error::new(
                         arg.span(),

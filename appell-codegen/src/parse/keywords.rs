@@ -1,6 +1,7 @@
-//! The model items of `#[appell(...)]`, one constant per keyword: each is
-//! spelled once, for the parser's match and for the names an unknown
-//! item's "did you mean" offers.
+//! The keywords of `#[appell(...)]`, one constant per spelling: the model
+//! items (whose list an unknown item's "did you mean" offers), then the
+//! options and values inside them. Each is spelled once, for the parsers'
+//! matches.
 
 /// `coordinates(...)`.
 pub const COORDINATES: &str = "coordinates";
@@ -46,6 +47,91 @@ pub const JOINT: &str = "joint";
 pub const REPEAT: &str = "repeat";
 /// `urdf(...)`.
 pub const URDF: &str = "urdf";
+
+// Options and values inside the items (a joint's kind and properties, a
+// body's, a scene's, a URDF's, an element's, a contact's kind).
+/// `actuated`.
+pub const ACTUATED: &str = "actuated";
+/// `along`.
+pub const ALONG: &str = "along";
+/// `at`.
+pub const AT: &str = "at";
+/// `ball`.
+pub const BALL: &str = "ball";
+/// `base`.
+pub const BASE: &str = "base";
+/// `center`.
+pub const CENTER: &str = "center";
+/// `child`.
+pub const CHILD: &str = "child";
+/// `cylindrical`.
+pub const CYLINDRICAL: &str = "cylindrical";
+/// `damping`.
+pub const DAMPING: &str = "damping";
+/// `dependent`.
+pub const DEPENDENT: &str = "dependent";
+/// `effect`.
+pub const EFFECT: &str = "effect";
+/// `effects`.
+pub const EFFECTS: &str = "effects";
+/// `fixed`.
+pub const FIXED: &str = "fixed";
+/// `flat`.
+pub const FLAT: &str = "flat";
+/// `floating`.
+pub const FLOATING: &str = "floating";
+/// `free`.
+pub const FREE: &str = "free";
+/// `friction_smoothing`.
+pub const FRICTION_SMOOTHING: &str = "friction_smoothing";
+/// `inertia`.
+pub const INERTIA: &str = "inertia";
+/// `lock`.
+pub const LOCK: &str = "lock";
+/// `mass`.
+pub const MASS: &str = "mass";
+/// `mimic`.
+pub const MIMIC: &str = "mimic";
+/// `mu`.
+pub const MU: &str = "mu";
+/// `normal`.
+pub const NORMAL: &str = "normal";
+/// `outputs`.
+pub const OUTPUTS: &str = "outputs";
+/// `parameters`.
+pub const PARAMETERS: &str = "parameters";
+/// `parent`.
+pub const PARENT: &str = "parent";
+/// `planar`.
+pub const PLANAR: &str = "planar";
+/// `plane`.
+pub const PLANE: &str = "plane";
+/// `prismatic`.
+pub const PRISMATIC: &str = "prismatic";
+/// `rest`.
+pub const REST: &str = "rest";
+/// `revolute`.
+pub const REVOLUTE: &str = "revolute";
+/// `rpy`.
+pub const RPY: &str = "rpy";
+/// `saturation`.
+pub const SATURATION: &str = "saturation";
+/// `slides`.
+pub const SLIDES: &str = "slides";
+/// `smoothing`.
+pub const SMOOTHING: &str = "smoothing";
+/// `spherical`.
+pub const SPHERICAL: &str = "spherical";
+/// `stiffness`.
+pub const STIFFNESS: &str = "stiffness";
+/// `unchecked_inertia`.
+pub const UNCHECKED_INERTIA: &str = "unchecked_inertia";
+/// `viscous`.
+pub const VISCOUS: &str = "viscous";
+/// `weld`.
+pub const WELD: &str = "weld";
+/// `xyz`.
+pub const XYZ: &str = "xyz";
 
 /// Every model item, in the order the model language lists them.
 pub const ITEMS: &[&str] = &[

@@ -10,6 +10,7 @@ use syn::{Ident, LitStr, Token};
 use crate::ast::Expr;
 use crate::ctxt::did_you_mean;
 use crate::parse::convert;
+use crate::parse::keywords as kw;
 
 /// The options of `urdf(...)`.
 const OPTIONS: &[&str] = &[
@@ -104,7 +105,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
         }
         let key: Ident = s.parse()?;
         match key.to_string().as_str() {
-            "weld" | "unchecked_inertia" => {
+            kw::WELD | kw::UNCHECKED_INERTIA => {
                 let content;
                 syn::parenthesized!(content in s);
                 let list = Punctuated::<Ident, Token![,]>::parse_terminated(&content)?;
@@ -114,7 +115,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     spec.unchecked_inertia.extend(list);
                 }
             }
-            "mimic" => {
+            kw::MIMIC => {
                 s.parse::<Token![=]>()?;
                 let value: syn::LitBool = s.parse().map_err(|e| {
                     syn::Error::new(
@@ -124,7 +125,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                 })?;
                 spec.mimic = value.value;
             }
-            "parameters" => {
+            kw::PARAMETERS => {
                 let content;
                 syn::parenthesized!(content in s);
                 let list = Punctuated::<syn::Expr, Token![,]>::parse_terminated(&content)?;
@@ -132,7 +133,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     spec.parameters.push(promotion(e)?);
                 }
             }
-            "parent" | "at" => {
+            kw::PARENT | kw::AT => {
                 s.parse::<Token![=]>()?;
                 let value: Ident = s.parse()?;
                 if key == "parent" {
@@ -141,13 +142,13 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     spec.at = Some(value);
                 }
             }
-            "base" => {
+            kw::BASE => {
                 s.parse::<Token![=]>()?;
                 let value: Ident = s.parse()?;
                 spec.base = match value.to_string().as_str() {
-                    "free" | "floating" => Base::Free,
-                    "planar" => Base::Planar,
-                    "fixed" => Base::Fixed,
+                    kw::FREE | kw::FLOATING => Base::Free,
+                    kw::PLANAR => Base::Planar,
+                    kw::FIXED => Base::Fixed,
                     other => {
                         let hint = did_you_mean(other, BASES.iter().copied())
                             .map(|s| format!(" (did you mean `{s}`?)"))
