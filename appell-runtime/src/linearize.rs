@@ -135,7 +135,7 @@ pub(crate) mod discrete;
 mod eigen;
 mod error;
 mod holonomic;
-mod jacobian;
+pub(crate) mod jacobian;
 mod minimal;
 #[cfg(feature = "std")]
 pub(crate) mod newton_dyn;

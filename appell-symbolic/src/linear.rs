@@ -242,9 +242,10 @@ impl Graph {
             .collect();
         let mut open_rows: Vec<usize> = (0..n).collect();
         let mut open_cols: Vec<usize> = (0..n).collect();
-        let mut pivots: Vec<(usize, usize)> = Vec::new(); // (row, col)
-                                                          // The blocks' determinants, expanded once (rows a pivot leaves
-                                                          // alone keep their entries, so the next search meets them again).
+        // The pivots as (row, col).
+        let mut pivots: Vec<(usize, usize)> = Vec::new();
+        // The blocks' determinants, expanded once (rows a pivot leaves
+        // alone keep their entries, so the next search meets them again).
         let mut dets = HashMap::new();
         loop {
             for &c in &open_cols {

@@ -5,8 +5,10 @@
 use super::input::{number, Point};
 use crate::dynamic::{DynModel, DynRhs};
 use crate::linearize::discrete::step_with;
+use crate::linearize::jacobian::{dual_columns, state_names};
 use crate::linearize::FixedStep;
 use crate::model::ModelInfo;
+use nalgebra::DMatrix;
 use num_dual::Dual64;
 use serde_json::{json, Map, Value};
 
@@ -43,38 +45,24 @@ pub(super) fn jacobian_answer(
     step: Option<(FixedStep, f64)>,
 ) -> Result<Map<String, Value>, String> {
     let rhs = target.dyn_prepare();
-    let (s, ni) = (point.state.len(), point.inputs.len());
-    let dual = |v: &[f64]| -> Vec<Dual64> { v.iter().map(|&x| Dual64::from_re(x)).collect() };
-    let (mut x, mut w) = (dual(&point.state), dual(&point.inputs));
-    let mut values = Vec::new();
-    // One column of (A | B) per pass; a pass without a seed when there is
-    // nothing to differentiate, for the values.
-    let mut columns: Vec<Vec<f64>> = Vec::with_capacity(s + ni);
-    for j in 0..(s + ni).max(1) {
-        set_seed(&mut x, &mut w, j, 1.0);
-        let out = evaluate(rhs.as_ref(), info, point.t, &x, &w, step);
-        set_seed(&mut x, &mut w, j, 0.0);
-        let out = out.map_err(|e| e.to_string())?;
-        values = out.iter().map(|d| d.re).collect();
-        columns.push(out.iter().map(|d| d.eps).collect());
-    }
-    let block = |cols: std::ops::Range<usize>| -> Vec<Vec<f64>> {
-        (0..s)
-            .map(|i| cols.clone().map(|j| columns[j][i]).collect())
-            .collect()
-    };
-    let (a, b) = (block(0..s), block(s..s + ni));
-    let finite = |m: &[Vec<f64>]| m.iter().flatten().all(|v| v.is_finite());
-    if !(finite(&a) && finite(&b) && values.iter().all(|v| v.is_finite())) {
+    let (values, a, b) = dual_columns(&point.state, &point.inputs, |x, w| {
+        evaluate(rhs.as_ref(), info, point.t, x, w, step)
+    })
+    .map_err(|e| e.to_string())?;
+    if !(a
+        .iter()
+        .chain(b.iter())
+        .chain(&values)
+        .all(|v| v.is_finite()))
+    {
         return Err("the Jacobian is not finite at this state".into());
     }
+    let rows = |m: &DMatrix<f64>| -> Vec<Vec<f64>> {
+        m.row_iter().map(|r| r.iter().copied().collect()).collect()
+    };
+    let (a, b) = (rows(&a), rows(&b));
     let mut answer = Map::new();
-    let names: Vec<String> = info
-        .retained
-        .iter()
-        .map(|r| r.to_string())
-        .chain(info.speeds.iter().map(|s| format!("{s}_dot")))
-        .collect();
+    let names = state_names(info);
     answer.insert("state".into(), json!(names));
     answer.insert("inputs".into(), json!(info.inputs));
     match step {
@@ -91,15 +79,6 @@ pub(super) fn jacobian_answer(
     answer.insert("a".into(), json!(a));
     answer.insert("b".into(), json!(b));
     Ok(answer)
-}
-
-/// Seeds component `j` of (state, inputs) with `eps` (past both: nothing).
-fn set_seed(x: &mut [Dual64], w: &mut [Dual64], j: usize, eps: f64) {
-    if let Some(d) = x.get_mut(j) {
-        d.eps = eps;
-    } else if let Some(d) = w.get_mut(j - x.len()) {
-        d.eps = eps;
-    }
 }
 
 /// The rates, or one step, in dual numbers.

@@ -212,12 +212,13 @@ fn dispatch(
             )))
         }
     };
+    if let Some(answer) = Answer::of_command(command) {
+        let mut evaluator = EvalState::new(model)?;
+        evaluator.answer = answer;
+        eval_stream(&evaluator, model, stdin, stdout)?;
+        return Ok(Dispatched::Done);
+    }
     match command {
-        "eval" | "contacts" | "jacobian" => {
-            let mut evaluator = EvalState::new(model)?;
-            evaluator.answer = Answer::of_command(command).unwrap_or(Answer::Rates);
-            eval_stream(&evaluator, model, stdin, stdout)?;
-        }
         "info" => {
             writeln!(stdout, "{}", info_json_dyn(model)?)?;
             stdout.flush()?;

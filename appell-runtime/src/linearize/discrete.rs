@@ -13,7 +13,7 @@ use nalgebra::DMatrix;
 use num_dual::Dual64;
 
 use super::checks::finite;
-use super::jacobian::state_names;
+use super::jacobian::{dual_columns, state_names};
 use crate::model::{check_len, Model, ModelError};
 use crate::scalar::Scalar;
 
@@ -280,24 +280,9 @@ pub fn step_jacobian<M: Model>(
 
     let prepared = model.prepare::<Dual64>();
     let (td, hd) = (Dual64::from_re(t), Dual64::from_re(h));
-    let mut x: Vec<Dual64> = state.iter().map(|&v| Dual64::from_re(v)).collect();
-    let mut w: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
-    let mut a = DMatrix::<f64>::zeros(s, s);
-    let mut b = DMatrix::<f64>::zeros(s, ni);
-    for j in 0..s + ni {
-        let seed = if j < s { &mut x[j] } else { &mut w[j - s] };
-        seed.eps = 1.0;
-        let stepped = fixed_step(model, &prepared, method, td, hd, &x, &w);
-        let seed = if j < s { &mut x[j] } else { &mut w[j - s] };
-        seed.eps = 0.0;
-        for (i, v) in stepped?.iter().enumerate() {
-            if j < s {
-                a[(i, j)] = v.eps;
-            } else {
-                b[(i, j - s)] = v.eps;
-            }
-        }
-    }
+    let (_, a, b) = dual_columns(state, inputs, |x, w| {
+        fixed_step(model, &prepared, method, td, hd, x, w)
+    })?;
     finite(a.as_slice(), "the state Jacobian")?;
     finite(b.as_slice(), "the input Jacobian")?;
     Ok(StepLinearization {

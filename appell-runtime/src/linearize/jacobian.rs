@@ -30,7 +30,7 @@ pub struct Linearization {
 
 /// The names of the reduced state: the retained coordinates, then the
 /// privileged speeds suffixed `_dot`.
-pub(super) fn state_names(info: &ModelInfo) -> Vec<String> {
+pub(crate) fn state_names(info: &ModelInfo) -> Vec<String> {
     info.retained
         .iter()
         .map(|r| r.to_string())
@@ -71,33 +71,10 @@ pub fn linearize<M: Model>(
 
     let prepared = model.prepare::<Dual64>();
     let td = Dual64::from_re(t);
-    let mut x: Vec<Dual64> = state.iter().map(|&v| Dual64::from_re(v)).collect();
-    let mut w: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
-    let mut out = vec![Dual64::from_re(0.0); s];
-    let mut a = DMatrix::<f64>::zeros(s, s);
-    let mut b = DMatrix::<f64>::zeros(s, ni);
-    for j in 0..s {
-        x[j].eps = 1.0;
-        let r = model.rhs(&prepared, td, &x, &w, &mut out);
-        x[j].eps = 0.0;
-        r?;
-        for (i, o) in out.iter().enumerate() {
-            a[(i, j)] = o.eps;
-        }
-    }
-    for j in 0..ni {
-        w[j].eps = 1.0;
-        let r = model.rhs(&prepared, td, &x, &w, &mut out);
-        w[j].eps = 0.0;
-        r?;
-        for (i, o) in out.iter().enumerate() {
-            b[(i, j)] = o.eps;
-        }
-    }
-    if s + ni == 0 {
-        // Nothing to differentiate; still report a failing rhs.
-        model.rhs(&model.prepare::<f64>(), t, state, inputs, &mut [])?;
-    }
+    let (_, a, b) = dual_columns(state, inputs, |x, w| {
+        let mut out = vec![Dual64::from_re(0.0); s];
+        model.rhs(&prepared, td, x, w, &mut out).map(|()| out)
+    })?;
     finite(a.as_slice(), "the state Jacobian")?;
     finite(b.as_slice(), "the input Jacobian")?;
     Ok(Linearization {
@@ -106,4 +83,45 @@ pub fn linearize<M: Model>(
         state_names: state_names(info),
         input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
     })
+}
+
+/// The values of y = f(x, u) (as many components as x) at (`state`,
+/// `inputs`), with A = ∂y/∂x and B = ∂y/∂u: one [`Dual64`] evaluation of
+/// `f` per column, seeded on that component of x or u (one unseeded
+/// evaluation when there is none, so that its error is still reported).
+/// The Jacobians of the rhs, of a step and of the command line's answers.
+#[allow(clippy::type_complexity)] // (values, A, B)
+pub(crate) fn dual_columns<E>(
+    state: &[f64],
+    inputs: &[f64],
+    mut f: impl FnMut(&[Dual64], &[Dual64]) -> Result<Vec<Dual64>, E>,
+) -> Result<(Vec<f64>, DMatrix<f64>, DMatrix<f64>), E> {
+    let (s, ni) = (state.len(), inputs.len());
+    let mut x: Vec<Dual64> = state.iter().map(|&v| Dual64::from_re(v)).collect();
+    let mut w: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
+    let mut a = DMatrix::<f64>::zeros(s, s);
+    let mut b = DMatrix::<f64>::zeros(s, ni);
+    let mut values = Vec::new();
+    for j in 0..(s + ni).max(1) {
+        let seed = |x: &mut [Dual64], w: &mut [Dual64], eps: f64| {
+            if j < s {
+                x[j].eps = eps;
+            } else if j - s < ni {
+                w[j - s].eps = eps;
+            }
+        };
+        seed(&mut x, &mut w, 1.0);
+        let out = f(&x, &w);
+        seed(&mut x, &mut w, 0.0);
+        let out = out?;
+        for (i, o) in out.iter().enumerate().take(s) {
+            if j < s {
+                a[(i, j)] = o.eps;
+            } else if j - s < ni {
+                b[(i, j - s)] = o.eps;
+            }
+        }
+        values = out.iter().map(|o| o.re).collect();
+    }
+    Ok((values, a, b))
 }
