@@ -67,3 +67,40 @@ fn a_scene_costs_the_same_after_another_scene() {
     assert_eq!(after.len(), 3, "{after:?}");
     assert_eq!((after[0], after[2]), (alone[0], alone[1]));
 }
+
+/// The `form` strings the expansion of `src` reports, in order: the
+/// model's, then each scene's.
+fn forms(src: &str) -> Vec<String> {
+    let input: syn::DeriveInput = syn::parse_str(src).expect("a model");
+    let roots = FileRoots::new(Some(&workspace_root()), None);
+    let text = appell_codegen::expand_with(&input, &roots, &Default::default()).to_string();
+    assert!(!text.contains("compile_error"), "{text}");
+    text.match_indices("form : \"")
+        .map(|(i, _)| {
+            let rest = &text[i + "form : \"".len()..];
+            rest[..rest.find('"').expect("a closing quote")].to_string()
+        })
+        .collect()
+}
+
+#[test]
+fn a_large_trees_scene_says_its_m_and_f_come_from_the_recursions() {
+    // A scene that keeps every load (here for its energies) keeps the
+    // model's M and f from the recursions.
+    let forms = forms(
+        r#"#[derive(Appell)]
+        #[appell(urdf("tests/robots/solo/solo12.urdf", base = free), gravity(-9.81 * N.z))]
+        #[appell(scene(watched, effects(gravity, actuation), outputs(energies)))]
+        struct Solo12;"#,
+    );
+    assert_eq!(forms.len(), 2, "{forms:?}");
+    assert!(
+        forms[0].starts_with("structured: the articulated-body algorithm"),
+        "{forms:?}"
+    );
+    assert!(
+        forms[1].starts_with("structured: M by the composite-rigid-body algorithm")
+            && forms[1].contains("solved by LDLᵀ"),
+        "{forms:?}"
+    );
+}
