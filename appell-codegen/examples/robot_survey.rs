@@ -11,8 +11,12 @@
 //! too long or too much memory does not stop the survey.
 //!
 //! ```sh
-//! cargo run --release -p appell-codegen --example robot_survey -- [--timeout S] [--base fixed|free] [DIR_OR_URDF ...] [--only NAME ...]
+//! cargo run --release -p appell-codegen --example robot_survey -- [--timeout S] [--base fixed|free] [--jacobian off] [DIR_OR_URDF ...] [--only NAME ...]
 //! ```
+//!
+//! `--jacobian off` expands each model with `jacobian(off)` (no
+//! `rhs_jacobian`), to compare the expansion's time and size with and
+//! without the derivatives.
 //!
 //! Build it with `--release`: the derive runs optimised in a build
 //! (`[profile.*.build-override] opt-level = 3`), so only a release build
@@ -28,6 +32,7 @@ use proc_macro2::{TokenStream, TokenTree};
 /// What one expansion gave.
 struct Outcome {
     seconds: f64,
+    code_kb: Option<f64>,
     errors: Vec<String>,
     form: Option<String>,
     ops: Option<usize>,
@@ -35,9 +40,17 @@ struct Outcome {
     peak_mb: Option<f64>,
 }
 
+/// Set by `--jacobian off` for the child processes.
+const JACOBIAN_OFF: &str = "APPELL_SURVEY_JACOBIAN_OFF";
+
 fn model_source(path: &Path, base: &str, extra: &str) -> String {
+    let jacobian = if std::env::var_os(JACOBIAN_OFF).is_some() {
+        ", jacobian(off)"
+    } else {
+        ""
+    };
     format!(
-        "#[appell(urdf({:?}, base = {base}{extra}), gravity(-9.81 * N.z))] struct R;",
+        "#[appell(urdf({:?}, base = {base}{extra}), gravity(-9.81 * N.z){jacobian})] struct R;",
         path.display().to_string()
     )
 }
@@ -49,6 +62,7 @@ fn expand_one(path: &Path, base: &str, extra: &str) {
     let t = Instant::now();
     let tokens = expand_with(&input, &FileRoots::default(), &Options::default());
     let seconds = t.elapsed().as_secs_f64();
+    let bytes = tokens.to_string().len();
     let errors = compile_errors(&tokens);
     let form = after(&tokens, "form").and_then(|t| string(&t));
     let ops = after(&tokens, "total").and_then(|t| t.to_string().parse().ok());
@@ -76,7 +90,7 @@ fn expand_one(path: &Path, base: &str, extra: &str) {
             .replace('\t', " ")
     };
     println!(
-        "OUTCOME\t{seconds}\t{}\t{}\t{}\t{}\t{}",
+        "OUTCOME\t{seconds}\t{bytes}\t{}\t{}\t{}\t{}\t{}",
         form.as_deref().map(esc).unwrap_or_default(),
         ops.map(|o: usize| o.to_string()).unwrap_or_default(),
         coordinates.map(|c| c.to_string()).unwrap_or_default(),
@@ -170,11 +184,12 @@ fn survey_one(path: &Path, base: &str, extra: &str, timeout: Duration) -> Result
     let opt = |s: &str| (!s.is_empty()).then(|| s.to_string());
     Ok(Outcome {
         seconds: f[1].parse().unwrap_or(f64::NAN),
-        form: opt(f[2]).map(|s| unesc(&s)),
-        ops: f[3].parse().ok(),
-        coordinates: f[4].parse().ok(),
-        peak_mb: f[5].parse().ok(),
-        errors: f[6..]
+        code_kb: f[2].parse::<f64>().map(|b| b / 1000.0).ok(),
+        form: opt(f[3]).map(|s| unesc(&s)),
+        ops: f[4].parse().ok(),
+        coordinates: f[5].parse().ok(),
+        peak_mb: f[6].parse().ok(),
+        errors: f[7..]
             .iter()
             .filter(|s| !s.is_empty())
             .map(|s| unesc(s))
@@ -278,6 +293,12 @@ fn main() {
                 base = Some(args[k + 1].clone());
                 args.drain(k..k + 2);
             }
+            "--jacobian" => {
+                if args[k + 1] == "off" {
+                    std::env::set_var(JACOBIAN_OFF, "1");
+                }
+                args.drain(k..k + 2);
+            }
             "--only" => {
                 only.push(args[k + 1].clone());
                 args.drain(k..k + 2);
@@ -289,8 +310,8 @@ fn main() {
     if !only.is_empty() {
         list.retain(|(p, _)| only.iter().any(|o| p.display().to_string().contains(o)));
     }
-    println!("| robot | base | coordinates | derives | expansion (s) | peak memory (MB) | rhs ops | form, or the errors |");
-    println!("| --- | --- | --- | --- | --- | --- | --- | --- |");
+    println!("| robot | base | coordinates | derives | expansion (s) | code (kB) | peak memory (MB) | rhs ops | form, or the errors |");
+    println!("| --- | --- | --- | --- | --- | --- | --- | --- | --- |");
     for (path, bases) in list {
         let name = path
             .parent()
@@ -359,15 +380,16 @@ fn main() {
                     };
                     let short: String = what.chars().take(400).collect();
                     println!(
-                        "| {name} | {base} | {} | {derives} | {:.2} | {} | {} | {} |",
+                        "| {name} | {base} | {} | {derives} | {:.2} | {} | {} | {} | {} |",
                         o.coordinates.map(|c| c.to_string()).unwrap_or_default(),
                         o.seconds,
+                        o.code_kb.map(|c| format!("{c:.0}")).unwrap_or_default(),
                         o.peak_mb.map(|p| format!("{p:.0}")).unwrap_or_default(),
                         o.ops.map(|c| c.to_string()).unwrap_or_default(),
                         cell(&short)
                     );
                 }
-                Err(e) => println!("| {name} | {base} | | no | | | | {} |", cell(&e)),
+                Err(e) => println!("| {name} | {base} | | no | | | | | {} |", cell(&e)),
             }
         }
     }

@@ -260,6 +260,9 @@ pub struct ModelAst {
     pub torques: Vec<LoadDef>,
     /// `gravity(vector)`.
     pub gravity: Option<Expr>,
+    /// `jacobian(on | off)`: whether the derive writes `rhs_jacobian`
+    /// always, never, or (`None`) where it costs little.
+    pub jacobian: Option<bool>,
     /// `rolls(body, contact = P)`.
     pub rolls: Vec<RollsDef>,
     /// `contact(link, point | flat)`: constraints held only in the scenes

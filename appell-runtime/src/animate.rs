@@ -26,7 +26,7 @@
 //! #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0,
 //! #     constraints: 0, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
 //! #     torques: 0, form: "closed form", symbolic_elimination: true,
-//! #     rhs_ops: OpCounts { add: 0, mul: 1, div: 0, calls: 1, total: 2 }, equations: "",
+//! #     rhs_ops: OpCounts { add: 0, mul: 1, div: 0, calls: 1, total: 2 }, jacobian: None, equations: "",
 //! # };
 //! # impl Model for Pendulum {
 //! #     type Prepared<T: Scalar> = ();
@@ -139,7 +139,7 @@ pub fn simulate<K: DynModel + ?Sized>(
 /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
 /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
 /// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # impl Model for Free {
 /// #     type Prepared<T: Scalar> = ();

@@ -41,7 +41,7 @@
 //! #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 //! #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
 //! #     torques: 0, form: "closed form", symbolic_elimination: false,
-//! #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+//! #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 //! # };
 //! # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 //! # impl Model for Ring {
@@ -177,7 +177,7 @@ fn cholesky(a: DMatrix<f64>) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, O
 /// #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
 /// #     torques: 0, form: "closed form", symbolic_elimination: false,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 /// # impl Model for Ring {
@@ -268,7 +268,7 @@ pub fn accelerations<M: Model>(
 /// #     effects: &["gravity"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 1,
 /// #     torques: 0, form: "closed form", symbolic_elimination: false,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 /// # impl Model for Ring {

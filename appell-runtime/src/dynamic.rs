@@ -42,6 +42,7 @@ mod sealed {
 /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
 /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
 /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+/// #     jacobian: None,
 /// #     equations: "x'' = -w^2 x",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -106,6 +107,16 @@ pub trait DynRhs {
         dstate: &mut [Dual64],
     ) -> Result<(), ModelError>;
 
+    /// ∂rhs/∂state (row-major n×n into `a`) by the model's generated
+    /// [`Model::rhs_jacobian`]; `Ok(false)` where it has none.
+    fn generated_jacobian(
+        &self,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        a: &mut [f64],
+    ) -> Result<bool, ModelError>;
+
     /// Calls [`DynRhs::rhs`] at `t` on every `(state, inputs)` of `cases`
     /// into `dstate`, every argument and result through
     /// [`black_box`], results dropped: one pass of a timing loop, whose
@@ -156,6 +167,30 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
         self.model.rhs(&self.dual, t, state, inputs, dstate)
     }
 
+    fn generated_jacobian(
+        &self,
+        t: f64,
+        state: &[f64],
+        inputs: &[f64],
+        a: &mut [f64],
+    ) -> Result<bool, ModelError> {
+        if M::info().jacobian.is_none() {
+            return Ok(false);
+        }
+        let (n, ni) = (state.len(), inputs.len());
+        // Small states (the implicit integrators' usual) on the stack.
+        let (mut values, mut b) = ([0.0; 64], [0.0; 256]);
+        if n <= 64 && n * ni <= 256 {
+            let (values, b) = (&mut values[..n], &mut b[..n * ni]);
+            self.model.rhs_jacobian(t, state, inputs, values, a, b)?;
+        } else {
+            let (mut values, mut b) = (vec![0.0; n], vec![0.0; n * ni]);
+            self.model
+                .rhs_jacobian(t, state, inputs, &mut values, a, &mut b)?;
+        }
+        Ok(true)
+    }
+
     fn rhs_pass(&self, t: f64, cases: &[(&[f64], &[f64])], dstate: &mut [f64]) {
         for (state, inputs) in cases {
             let r = self.model.rhs(
@@ -171,9 +206,10 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
 }
 
 /// The Jacobian `∂f/∂x` of `rhs` (row-major n×n into its last argument)
-/// at `(t, x)` with `inputs` held constant, exactly by forward-mode dual
-/// numbers: one [`DynRhs::rhs_dual`] per state component. What the implicit
-/// integrators use for a model.
+/// at `(t, x)` with `inputs` held constant: the model's generated
+/// [`Model::rhs_jacobian`] where it has one, else exactly by forward-mode
+/// dual numbers, one [`DynRhs::rhs_dual`] per state component. What the
+/// implicit integrators use for a model.
 pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
     rhs: &'a R,
     inputs: &[f64],
@@ -182,7 +218,11 @@ pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
     let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
     let mut xd = vec![Dual64::from_re(0.0); n];
     let mut outd = vec![Dual64::from_re(0.0); n];
+    let real_inputs = inputs.to_vec();
     move |t: f64, x: &[f64], j: &mut [f64]| {
+        if rhs.generated_jacobian(t, x, &real_inputs, j)? {
+            return Ok(());
+        }
         let td = Dual64::from_re(t);
         for (d, &v) in xd.iter_mut().zip(x) {
             *d = Dual64::from_re(v);
@@ -221,6 +261,7 @@ pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
 /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
 /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
 /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+/// #     jacobian: None,
 /// #     equations: "x'' = -w^2 x",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

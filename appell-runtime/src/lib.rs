@@ -52,8 +52,8 @@ pub mod sliding;
 pub mod switch;
 
 pub use model::{
-    check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, JointLimit, Model,
-    ModelError, ModelInfo, OpCounts, RowSource, SceneVisitor,
+    check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, JacobianInfo, JointLimit,
+    Model, ModelError, ModelInfo, OpCounts, RowSource, SceneVisitor,
 };
 pub use scalar::Scalar;
 
@@ -95,8 +95,8 @@ pub mod __private {
     pub use crate::model::check_len;
     pub use crate::physical::check_body;
     pub use crate::{
-        BodyInfo, ContactInfo, JointLimit, Model, ModelError, ModelInfo, OpCounts, RowSource,
-        Scalar, SceneVisitor,
+        BodyInfo, ContactInfo, JacobianInfo, JointLimit, Model, ModelError, ModelInfo, OpCounts,
+        RowSource, Scalar, SceneVisitor,
     };
     pub use core::result::Result::{self, Err, Ok};
 }

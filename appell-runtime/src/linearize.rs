@@ -42,6 +42,7 @@
 //! #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
 //! #     force_points: 1, torques: 0, form: "closed form", symbolic_elimination: true,
 //! #     rhs_ops: OpCounts { add: 5, mul: 9, div: 3, calls: 0, total: 18 },
+//! #     jacobian: None,
 //! #     equations: "x'' = f/m + x (g y - x f/m - x'^2 - y'^2) / (x^2 + y^2)",
 //! # };
 //! # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

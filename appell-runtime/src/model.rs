@@ -30,6 +30,18 @@ pub struct OpCounts {
     pub total: usize,
 }
 
+/// How a model's generated Jacobian ([`Model::rhs_jacobian`]) is computed.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct JacobianInfo {
+    /// What is differentiated: `closed form: ...` (∂M and ∂f, and
+    /// ∂ÿ = M⁻¹ (∂f − ∂M ÿ) with M factored once) or `structured: ...`
+    /// (the unrolled articulated-body algorithm differentiated), with the
+    /// operation counts the derive compared.
+    pub form: &'static str,
+    /// Operations per call, the values of the rhs included.
+    pub ops: OpCounts,
+}
+
 /// A rigid body or particle of the model, for the independent solver.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct BodyInfo {
@@ -181,6 +193,11 @@ pub struct ModelInfo {
     pub symbolic_elimination: bool,
     /// Operations per call of the generated reduced rhs.
     pub rhs_ops: OpCounts,
+    /// The generated Jacobian of the reduced rhs
+    /// ([`Model::rhs_jacobian`]): how it is computed and what it costs;
+    /// `None` where the model has none (tools then run the rhs in dual
+    /// numbers, one evaluation per column).
+    pub jacobian: Option<JacobianInfo>,
     /// The derived reduced equations, as text.
     pub equations: &'static str,
 }
@@ -556,6 +573,35 @@ pub trait Model {
         dstate: &mut [T],
     ) -> Result<(), ModelError>;
 
+    /// The reduced rhs and its Jacobians in one call: `dstate` as
+    /// [`Model::rhs`] writes it, `a` = ∂rhs/∂state (s×s row-major, s the
+    /// [state length](ModelInfo::state_len)) and `b` = ∂rhs/∂inputs (s×i
+    /// row-major, i the number of [inputs](ModelInfo::inputs)). Parameters
+    /// and time are held fixed.
+    ///
+    /// The derive generates it where it can differentiate the model's
+    /// equations symbolically ([`ModelInfo::jacobian`] says how, and what
+    /// it costs); it needs no [`Model::prepare`], allocates nothing and
+    /// runs on any [`Scalar`]. Where there is none this returns
+    /// [`ModelError::NotGenerated`], and [`linearize`](crate::linearize)
+    /// falls back to dual numbers. Errors otherwise as [`Model::rhs`]'s, and
+    /// [`ModelError::NonFinite`] naming the Jacobian when a derivative is
+    /// not finite.
+    fn rhs_jacobian<T: Scalar>(
+        &self,
+        t: T,
+        state: &[T],
+        inputs: &[T],
+        dstate: &mut [T],
+        a: &mut [T],
+        b: &mut [T],
+    ) -> Result<(), ModelError> {
+        let _ = (t, state, inputs, dstate, a, b);
+        Err(ModelError::NotGenerated {
+            function: "rhs_jacobian",
+        })
+    }
+
     /// Appell's equations M ÿ = f at full coordinates `q` and privileged
     /// speeds `u`; `m` is l×l row-major.
     fn mass_matrix_and_forcing<T: Scalar>(
@@ -792,7 +838,7 @@ pub trait Model {
     /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
     /// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-    /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+    /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NotGenerated { function: "test" }) }
     /// # impl Model for Free {

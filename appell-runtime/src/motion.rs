@@ -39,7 +39,7 @@ pub struct Rates {
 /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["z"], inputs: &["f"],
 /// #     effects: &["gravity", "push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
 /// #     bodies: &[BodyInfo { name: "P", rigid: false }], force_points: 2, torques: 0,
-/// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 /// # impl Model for Drop {

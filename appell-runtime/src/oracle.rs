@@ -56,6 +56,7 @@
 //! #     constraints: 0, bodies: &[BodyInfo { name: "P", rigid: false }],
 //! #     force_points: 1, torques: 0, form: "closed form", symbolic_elimination: true,
 //! #     rhs_ops: OpCounts { add: 0, mul: 1, div: 1, calls: 1, total: 4 },
+//! #     jacobian: None,
 //! #     equations: "theta'' = -(g/l) sin(theta)",
 //! # };
 //! # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

@@ -37,7 +37,7 @@
 //! #             dependent: &[], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
 //! #             effects: &[], outputs: &[], row_sources: $sources, contacts: &[], holonomic: 0, constraints: $rows,
 //! #             bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-//! #             rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+//! #             rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 //! #         };
 //! #         &INFO
 //! #     }

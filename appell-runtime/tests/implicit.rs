@@ -46,6 +46,8 @@ const fn info(
             calls: 0,
             total: 0,
         },
+        jacobian: None,
+        jacobian: None,
         equations: "",
     }
 }

@@ -212,6 +212,8 @@ const BASE_INFO: ModelInfo = ModelInfo {
     form: "closed form",
     symbolic_elimination: true,
     rhs_ops: NO_OPS,
+    jacobian: None,
+    jacobian: None,
     equations: "",
 };
 

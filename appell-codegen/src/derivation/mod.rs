@@ -16,6 +16,7 @@
 //! | 11. energies | [`energies`] | partials → [`Energies`] |
 //! | 12. reduced state, cyclic coordinates (eq. 42) | [`reduction`] | equations → [`Reduction`] |
 //! | 13. structured form of a tree of joints (ABA, RNEA, CRBA) | [`tree`] | `TreeSpec` → [`tree::Structured`] |
+//! | 14. derivatives of the reduced rhs | [`jacobian`] | equations, structured form → [`jacobian::Jacobians`] |
 //!
 //! A tree of [`tree::STRUCTURED_ONLY_LINKS`] moving links or more skips
 //! stages 6 to 11: its M, f and energies come from the structured form
@@ -38,6 +39,7 @@ pub mod assembly;
 pub mod elimination;
 pub mod energies;
 pub mod folding;
+pub mod jacobian;
 pub mod loads;
 pub mod numeric;
 pub mod partials;
@@ -179,6 +181,9 @@ pub struct Derivation {
     /// A scene's own constraints and speeds, where they differ from the
     /// model's (the emitter puts them in place for its implementation).
     pub own_constraints: Option<ConstraintSet>,
+    /// The derivatives of the reduced rhs (stage 14); `None` until the
+    /// stage ran.
+    pub jacobians: Option<jacobian::Jacobians>,
 }
 
 /// The operations per call of a constrained tree's M and f (lower
@@ -244,7 +249,8 @@ pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
 pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derived> {
     let Kinematics { mut model, twin } = kinematics;
     let scenes_twin = twin.clone();
-    let full = complete(cx, &mut model, twin, options)?;
+    let mut full = complete(cx, &mut model, twin, options)?;
+    full.jacobians = Some(jacobian::differentiate(&mut model, &full));
     let mut scenes = Vec::new();
     for scene in model.scenes.clone() {
         let d = if ConstraintSet::of_scene(&model, &scene).is_some() {
@@ -419,6 +425,7 @@ impl Stages {
             structured: Err(String::new()),
             projection: None,
             own_constraints: None,
+            jacobians: None,
         };
         d.text = text::equations_text(model, &d);
         d

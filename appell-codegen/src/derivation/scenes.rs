@@ -112,8 +112,10 @@ fn scene_derivation(
         unreduced: full.unreduced.clone(),
         folded: full.folded.clone(),
         text: String::new(),
+        jacobians: None,
     };
     d.text = text::equations_text(model, &d);
+    d.jacobians = Some(super::jacobian::differentiate(model, &d));
     Ok(d)
 }
 

@@ -81,7 +81,9 @@ impl Emitter<'_> {
             solve_x_and_w: self.elimination(true),
             solve_x: self.elimination(false),
         };
-        let rhs = self.rhs(&common);
+        let jacobian = self.jacobian(&common);
+        let rhs = self.rhs(&common, &jacobian);
+        let jacobian_fn = &jacobian.function;
         let info = &rhs.info;
         let (info_ident, name) = (&self.info_ident, &self.type_name);
         let (scene_infos, scene_rhs) = (&self.scene_infos, &self.scene_rhs);
@@ -106,6 +108,7 @@ impl Emitter<'_> {
                 #parameters
                 #prepare
                 #rhs_fn
+                #jacobian_fn
                 #equations
                 #kinematics
                 #contacts

@@ -13,7 +13,13 @@ use crate::derivation::{Elimination, RowSource};
 impl Emitter<'_> {
     /// The `ModelInfo` value; `extra_ops` are the rhs's operations outside
     /// the engine's program (the numeric solves and the LDLᵀ).
-    pub(super) fn info(&self, rhs_ops: OpCount, extra_ops: usize, form: &str) -> TokenStream {
+    pub(super) fn info(
+        &self,
+        rhs_ops: OpCount,
+        extra_ops: usize,
+        form: &str,
+        jacobian: &super::jacobian::JacobianParts,
+    ) -> TokenStream {
         let p = p();
         let d = self.d;
         let model = self.model;
@@ -95,7 +101,8 @@ impl Emitter<'_> {
             int(rhs_ops.calls),
         );
         let total = int(rhs_ops.total() + extra_ops);
-        let text = format!("rhs: {form}\n\n{}", d.text);
+        let text = format!("rhs: {form}\njacobian: {}\n\n{}", jacobian.summary, d.text);
+        let jacobian = &jacobian.info;
         quote! {
             #p::ModelInfo {
                 name: #name,
@@ -119,6 +126,7 @@ impl Emitter<'_> {
                 form: #form,
                 symbolic_elimination: #symbolic,
                 rhs_ops: #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
+                jacobian: #jacobian,
                 equations: #text,
             }
         }

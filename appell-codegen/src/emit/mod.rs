@@ -16,6 +16,7 @@ mod contacts;
 mod controller;
 mod functions;
 mod info;
+mod jacobian;
 mod ldlt;
 mod rhs;
 mod scenes;

@@ -66,7 +66,11 @@ impl Emitter<'_> {
     /// `prepare`, `rhs` and the `ModelInfo` (which counts the rhs's
     /// operations and names the form): the structured form where the model
     /// has one and it costs fewer operations per call, else the closed form.
-    pub(super) fn rhs(&self, common: &super::functions::Common) -> RhsParts {
+    pub(super) fn rhs(
+        &self,
+        common: &super::functions::Common,
+        jacobian: &super::jacobian::JacobianParts,
+    ) -> RhsParts {
         if let (false, Ok(s)) = (self.d.closed_form, &self.d.structured) {
             let chosen = self.structured_rhs(common, &s.accelerations);
             let form = format!(
@@ -74,7 +78,7 @@ impl Emitter<'_> {
                 chosen.ops.total(),
                 crate::derivation::tree::STRUCTURED_ONLY_LINKS
             );
-            let info = self.info(chosen.ops, chosen.extra, &form);
+            let info = self.info(chosen.ops, chosen.extra, &form, jacobian);
             return RhsParts { info, ..chosen };
         }
         let flat = self.flat_rhs(common);
@@ -85,7 +89,7 @@ impl Emitter<'_> {
             } else {
                 format!("closed form: {} operations for M and f per call against the projected joint tree's {}", pr.closed_ops, pr.ops)
             };
-            let info = self.info(flat.ops, flat.extra, &form);
+            let info = self.info(flat.ops, flat.extra, &form, jacobian);
             return RhsParts { info, ..flat };
         }
         if !self.d.closed_form {
@@ -97,7 +101,7 @@ impl Emitter<'_> {
             } else {
                 format!("structured: M by the composite-rigid-body algorithm and f by recursive Newton–Euler over the joint tree, solved by LDLᵀ, {flat_total} operations per call")
             };
-            let info = self.info(flat.ops, flat.extra, &form);
+            let info = self.info(flat.ops, flat.extra, &form, jacobian);
             return RhsParts { info, ..flat };
         }
         let (chosen, form) = match &self.d.structured {
@@ -119,7 +123,7 @@ impl Emitter<'_> {
                 format!("closed form ({reason}, so no structured form)"),
             ),
         };
-        let info = self.info(chosen.ops, chosen.extra, &form);
+        let info = self.info(chosen.ops, chosen.extra, &form, jacobian);
         RhsParts { info, ..chosen }
     }
 

@@ -33,7 +33,7 @@ pub fn stub(name: &syn::Ident, scenes: &[syn::Ident], vis: &syn::Visibility) -> 
                 ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], holonomic: 0, constraints: 0,
                 row_sources: &[], contacts: &[],
                 bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-                rhs_ops: #p::OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+                rhs_ops: #p::OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
             };
             #[allow(unused_variables, clippy::all)]
             impl #p::Model for #name {

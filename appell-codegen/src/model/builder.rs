@@ -163,6 +163,7 @@ pub(super) fn build_in(
         effects,
         scenes,
         gravity: loads.gravity,
+        jacobian: ast.jacobian,
         norms: b.norms,
         divisors: b.divisors,
         quaternions: b.quaternions,

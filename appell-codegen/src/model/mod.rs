@@ -352,6 +352,9 @@ pub struct Model {
     pub scenes: Vec<Scene>,
     /// The `gravity(...)` acceleration (N components), if declared.
     pub gravity: Option<Vec3>,
+    /// Whether the derive writes `rhs_jacobian`: always (`jacobian(on)`),
+    /// never (`jacobian(off)`), or (`None`) where it costs little.
+    pub jacobian: Option<bool>,
     /// The squared length of every `norm(...)` and `unit(...)` argument, with
     /// where it occurs, so that the generated code can name a zero-length
     /// one at run time.

@@ -47,6 +47,8 @@ pub const JOINT: &str = "joint";
 pub const REPEAT: &str = "repeat";
 /// `urdf(...)`.
 pub const URDF: &str = "urdf";
+/// `jacobian(...)`.
+pub const JACOBIAN: &str = "jacobian";
 
 // Options and values inside the items (a joint's kind and properties, a
 // body's, a scene's, a URDF's, an element's, a contact's kind).
@@ -74,6 +76,10 @@ pub const DEPENDENT: &str = "dependent";
 pub const EFFECT: &str = "effect";
 /// `effects`.
 pub const EFFECTS: &str = "effects";
+/// `off`.
+pub const OFF: &str = "off";
+/// `on`.
+pub const ON: &str = "on";
 /// `fixed`.
 pub const FIXED: &str = "fixed";
 /// `flat`.
@@ -157,4 +163,5 @@ pub const ITEMS: &[&str] = &[
     JOINT,
     REPEAT,
     URDF,
+    JACOBIAN,
 ];

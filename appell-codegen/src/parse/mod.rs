@@ -48,6 +48,7 @@ pub fn parse_in(cx: &Ctxt, input: &syn::DeriveInput, roots: &FileRoots) -> Model
         forces: Vec::new(),
         torques: Vec::new(),
         gravity: None,
+        jacobian: None,
         rolls: Vec::new(),
         contacts: Vec::new(),
         joint_limits: Vec::new(),
@@ -317,6 +318,21 @@ impl syn::parse::Parse for Item {
     }
 }
 
+/// `on` or `off`, as in `jacobian(off)`.
+fn parse_switch(tokens: proc_macro2::TokenStream) -> syn::Result<bool> {
+    let word: Ident = syn::parse2(tokens.clone()).map_err(|_| {
+        syn::Error::new_spanned(&tokens, "expected `on` or `off`, as in `jacobian(off)`")
+    })?;
+    match word.to_string().as_str() {
+        keywords::ON => Ok(true),
+        keywords::OFF => Ok(false),
+        other => Err(syn::Error::new(
+            word.span(),
+            format!("expected `on` or `off`, found `{other}`, as in `jacobian(off)`"),
+        )),
+    }
+}
+
 fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
     let name = item.name.to_string();
     let tokens = item.content.clone();
@@ -405,6 +421,7 @@ fn add_item(cx: &Ctxt, ast: &mut ModelAst, item: Item, roots: &FileRoots) {
                     tokens,
                 )?)
             }
+            keywords::JACOBIAN => ast.jacobian = Some(parse_switch(tokens)?),
             keywords::GRAVITY => {
                 let e: syn::Expr = syn::parse2(tokens)?;
                 if ast.gravity.is_some() {

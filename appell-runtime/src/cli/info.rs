@@ -17,6 +17,7 @@ use serde_json::{json, Value};
 /// #     bodies: &[BodyInfo { name: "B", rigid: true }], force_points: 0, torques: 1,
 /// #     form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
+/// #     jacobian: None,
 /// #     equations: "phi'' = tau/i",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

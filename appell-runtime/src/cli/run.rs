@@ -22,7 +22,7 @@ use std::process::ExitCode;
 /// #     name: "Pendulum", parameters: &[], coordinates: &[], speeds: &[], dependent: &[],
 /// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[],
 /// #     holonomic: 0, constraints: 0, bodies: &[], force_points: 0, torques: 0,
-/// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts::default(), equations: "",
+/// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts::default(), jacobian: None, equations: "",
 /// # };
 /// let text = appell_runtime::cli::usage("pendulum", &info);
 /// assert!(text.starts_with("usage: pendulum [eval|contacts|jacobian|info|equations|bench|accuracy|animate|help]"));
@@ -109,6 +109,7 @@ pub fn run<M: Model>(
 /// #     effects: &["push"], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
 /// #     torques: 0, form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 1, calls: 0, total: 1 },
+/// #     jacobian: None,
 /// #     equations: "x'' = f/m",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

@@ -49,6 +49,7 @@ pub enum FixedStep {
 /// #     constraints: 0, bodies: &[BodyInfo { name: "bob", rigid: false }],
 /// #     force_points: 1, torques: 1, form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 1, mul: 1, div: 0, calls: 1, total: 3 },
+/// #     jacobian: None,
 /// #     equations: "theta'' = tau - g sin(theta)",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -216,6 +217,7 @@ pub struct StepLinearization {
 /// #     constraints: 0, bodies: &[BodyInfo { name: "bob", rigid: false }],
 /// #     force_points: 1, torques: 1, form: "closed form", symbolic_elimination: true,
 /// #     rhs_ops: OpCounts { add: 1, mul: 1, div: 0, calls: 1, total: 3 },
+/// #     jacobian: None,
 /// #     equations: "theta'' = tau - g sin(theta)",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

@@ -322,7 +322,7 @@ fn unknowns_at<M: Model>(
 /// #     retained: &["x", "y"], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1,
 /// #     constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
 /// #     force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 /// # impl Model for Ring {
@@ -388,7 +388,7 @@ pub fn project_holonomic<M: Model>(
 /// #     row_sources: &[RowSource::Driven { holonomic: true, index: 0, constraint: "holonomic: theta == q_cmd" }],
 /// #     contacts: &[], holonomic: 1, constraints: 1, bodies: &[BodyInfo { name: "P", rigid: false }],
 /// #     force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 /// # impl Model for Servo {
@@ -499,7 +499,7 @@ fn project_at<M: Model>(
 /// #     dependent: &["y"], cyclic: &[], ignorable: &[], retained: &["x", "y"], inputs: &[],
 /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 1, constraints: 1, bodies: &[], force_points: 0,
 /// #     torques: 0, form: "closed form", symbolic_elimination: false,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, equations: "",
+/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
 /// # };
 /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
 /// # impl Model for Ring {

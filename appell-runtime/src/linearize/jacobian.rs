@@ -43,8 +43,10 @@ pub(crate) fn state_names(info: &ModelInfo) -> Vec<String> {
 /// (the [retained](ModelInfo::retained) coordinates, then the privileged
 /// speeds) and `inputs`.
 ///
-/// Each column is one evaluation of the generated code in [`Dual64`], seeded
-/// on that state component or input: the derivatives are exact to rounding.
+/// Where the model has a generated Jacobian ([`ModelInfo::jacobian`]) it is
+/// one call of [`Model::rhs_jacobian`]; else each column is one evaluation
+/// of the generated code in [`Dual64`], seeded on that state component or
+/// input. Either way the derivatives are exact to rounding.
 /// The operating point need not be an equilibrium (A and B are the Jacobians
 /// there; the affine term is `rhs(t, state, inputs)`). The state names are
 /// the retained coordinates, then the speeds' coordinates suffixed `_dot`.
@@ -69,6 +71,16 @@ pub fn linearize<M: Model>(
     finite(inputs, "inputs")?;
     model.validate()?;
 
+    if info.jacobian.is_some() {
+        let (mut values, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
+        model.rhs_jacobian(t, state, inputs, &mut values, &mut a, &mut b)?;
+        return Ok(Linearization {
+            a: DMatrix::from_row_slice(s, s, &a),
+            b: DMatrix::from_row_slice(s, ni, &b),
+            state_names: state_names(info),
+            input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
+        });
+    }
     let prepared = model.prepare::<Dual64>();
     let td = Dual64::from_re(t);
     let (_, a, b) = dual_columns(state, inputs, |x, w| {

@@ -79,6 +79,7 @@ pub static PENDULUM_INFO: ModelInfo = ModelInfo {
         calls: 1,
         total: 3,
     },
+    jacobian: None,
     equations: "theta'' = -(g/l) sin(theta)",
 };
 
@@ -312,6 +313,7 @@ pub static ROD_INFO: ModelInfo = ModelInfo {
         calls: 3,
         total: 15,
     },
+    jacobian: None,
     equations: "theta'' = (-m (L/2)(g sin(theta) + x0''(t) cos(theta)) - k theta') / (m L^2/3)",
 };
 
@@ -573,6 +575,7 @@ pub static KNIFE_INFO: ModelInfo = ModelInfo {
         calls: 3,
         total: 14,
     },
+    jacobian: None,
     equations: "x'' = gx cos(phi)^2 - (c/m) x' - x' phi' tan(phi)\nphi'' = tau / i",
 };
 
@@ -863,6 +866,7 @@ pub static CARTESIAN_INFO: ModelInfo = ModelInfo {
         calls: 2,
         total: 26,
     },
+    jacobian: None,
     equations: "x'' = x (g y - v^2 + L'^2 + L L'') / (x^2 + y^2)",
 };
 
@@ -1229,6 +1233,7 @@ pub static GYRO_INFO: ModelInfo = ModelInfo {
         calls: 12,
         total: 272,
     },
+    jacobian: None,
     equations: "Euler's equations through ZYX angles",
 };
 

@@ -237,6 +237,7 @@ impl TrBdf2 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -307,6 +308,7 @@ impl TrBdf2 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -373,6 +375,7 @@ impl TrBdf2 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

@@ -259,6 +259,7 @@ impl Radau5 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -326,6 +327,7 @@ impl Radau5 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -392,6 +394,7 @@ impl Radau5 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
@@ -458,6 +461,7 @@ impl Radau5 {
     /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
     /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
     /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
+    /// #     jacobian: None,
     /// #     equations: "x'' = -w^2 x",
     /// # };
     /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }

@@ -1,0 +1,226 @@
+//! The generated `rhs_jacobian` (∂rhs/∂state and ∂rhs/∂inputs in one
+//! call) against dual numbers through the generated rhs and against central
+//! differences, at random states: trees (the double pendulum, UR5, and
+//! Panda with `jacobian(on)`: the closed form's and the structured form's
+//! derivatives) and rolling contacts (the wheel-axle and two of its
+//! scenes).
+
+mod common;
+#[path = "../examples/models/double_pendulum.rs"]
+mod double_pendulum;
+#[path = "../examples/models/ur5.rs"]
+mod ur5;
+#[path = "../examples/models/wheel_axle.rs"]
+mod wheel_axle;
+
+use appell::num_dual::Dual64;
+use appell::{Appell, Model, ModelError};
+use common::Rng;
+
+/// Panda as `examples/models/panda.rs` has it, its Jacobian written
+/// although it is larger than the derive writes by default.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf(
+    "examples/robots/panda/panda.urdf",
+    weld(panda_finger_joint1, panda_finger_joint2)
+))]
+#[appell(gravity(-9.81 * N.z), jacobian(on))]
+struct Panda;
+
+/// Two particles on a double pendulum, with a generated Jacobian and
+/// without.
+macro_rules! particles_pendulum {
+    ($name:ident $(, $switch:ident)?) => {
+        #[derive(Appell, Clone, Debug, Default)]
+        #[appell(coordinates(q1, q2), speeds(q1, q2))]
+        #[appell(frame(A = N.rotate_z(q1)), frame(B = N.rotate_z(q2)))]
+        #[appell(point(P = O + A.x), point(Q = P + B.x))]
+        #[appell(particle(P, mass = 1), particle(Q, mass = 1), gravity(-9.81 * N.y))]
+        $(#[appell(jacobian($switch))])?
+        struct $name;
+    };
+}
+particles_pendulum!(WithJacobian);
+particles_pendulum!(NoJacobian, off);
+
+/// The generated Jacobians at (x, u), with the rhs's values.
+struct Generated {
+    values: Vec<f64>,
+    a: Vec<f64>,
+    b: Vec<f64>,
+}
+
+fn generated<M: Model>(model: &M, t: f64, x: &[f64], u: &[f64]) -> Result<Generated, ModelError> {
+    let (s, ni) = (x.len(), u.len());
+    let mut g = Generated {
+        values: vec![0.0; s],
+        a: vec![f64::NAN; s * s],
+        b: vec![f64::NAN; s * ni],
+    };
+    model.rhs_jacobian(t, x, u, &mut g.values, &mut g.a, &mut g.b)?;
+    Ok(g)
+}
+
+/// Column `j` of [A | B] by one dual-number evaluation of the rhs.
+fn dual_column<M: Model>(model: &M, t: f64, x: &[f64], u: &[f64], j: usize) -> Vec<f64> {
+    let prepared = model.prepare::<Dual64>();
+    let mut xd: Vec<Dual64> = x.iter().map(|&v| Dual64::from_re(v)).collect();
+    let mut ud: Vec<Dual64> = u.iter().map(|&v| Dual64::from_re(v)).collect();
+    if j < x.len() {
+        xd[j].eps = 1.0;
+    } else {
+        ud[j - x.len()].eps = 1.0;
+    }
+    let mut out = vec![Dual64::from_re(0.0); x.len()];
+    model
+        .rhs(&prepared, Dual64::from_re(t), &xd, &ud, &mut out)
+        .unwrap();
+    out.iter().map(|d| d.eps).collect()
+}
+
+/// Column `j` of [A | B] by central differences of the rhs in f64, four
+/// points (error h⁴ f⁽⁵⁾/30 and about 1e-16/h).
+fn difference_column<M: Model>(model: &M, t: f64, x: &[f64], u: &[f64], j: usize) -> Vec<f64> {
+    let prepared = model.prepare::<f64>();
+    let eps = 5e-4;
+    let at = |sign: f64| {
+        let (mut x, mut u) = (x.to_vec(), u.to_vec());
+        if j < x.len() {
+            x[j] += sign * eps;
+        } else {
+            u[j - x.len()] += sign * eps;
+        }
+        let mut out = vec![0.0; x.len()];
+        model.rhs(&prepared, t, &x, &u, &mut out).unwrap();
+        out
+    };
+    let (p1, m1, p2, m2) = (at(1.0), at(-1.0), at(2.0), at(-2.0));
+    (0..x.len())
+        .map(|i| (8.0 * (p1[i] - m1[i]) - (p2[i] - m2[i])) / (12.0 * eps))
+        .collect()
+}
+
+/// The worst differences of the generated Jacobian from the dual numbers'
+/// and from central differences, each relative to 1 + |entry|, at
+/// `samples` random states in [−1, 1] (inputs likewise); the generated
+/// values equal the rhs's to rounding.
+fn worst<M: Model>(model: &M, seed: u64, samples: usize) -> (f64, f64) {
+    let info = M::info();
+    assert!(
+        info.jacobian.is_some(),
+        "{} has a generated Jacobian",
+        info.name
+    );
+    let (s, ni) = (info.state_len(), info.inputs.len());
+    let mut rng = Rng(seed);
+    let (mut dual, mut fd) = (0.0f64, 0.0f64);
+    for _ in 0..samples {
+        let x: Vec<f64> = (0..s).map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let u: Vec<f64> = (0..ni).map(|_| rng.uniform(-1.0, 1.0)).collect();
+        let t = rng.uniform(0.0, 1.0);
+        let g = generated(model, t, &x, &u).unwrap();
+        let prepared = model.prepare::<f64>();
+        let mut values = vec![0.0; s];
+        model.rhs(&prepared, t, &x, &u, &mut values).unwrap();
+        for (a, b) in g.values.iter().zip(&values) {
+            assert!(
+                (a - b).abs() <= 1e-12 * (1.0 + b.abs()),
+                "{}: {a} against {b}",
+                info.name
+            );
+        }
+        for j in 0..s + ni {
+            let (d, f) = (
+                dual_column(model, t, &x, &u, j),
+                difference_column(model, t, &x, &u, j),
+            );
+            for i in 0..s {
+                let exact = if j < s {
+                    g.a[i * s + j]
+                } else {
+                    g.b[i * ni + j - s]
+                };
+                dual = dual.max((exact - d[i]).abs() / (1.0 + d[i].abs()));
+                fd = fd.max((exact - f[i]).abs() / (1.0 + f[i].abs()));
+            }
+        }
+    }
+    (dual, fd)
+}
+
+fn assert_agrees<M: Model>(model: &M, seed: u64) {
+    let (dual, fd) = worst(model, seed, 5);
+    let info = M::info();
+    let name = info.name;
+    let form = info.jacobian.map_or("", |j| j.form);
+    println!("{name}: against duals {dual:.1e}, against central differences {fd:.1e}; {form}");
+    assert!(dual < 1e-11, "{name}: {dual:e} from the dual numbers");
+    assert!(fd < 1e-9, "{name}: {fd:e} from central differences");
+}
+
+#[test]
+fn trees_agree_with_dual_numbers_and_differences() {
+    assert_agrees(&double_pendulum::DoublePendulum::default(), 1);
+    assert_agrees(&ur5::Ur5, 2);
+    assert_agrees(&Panda, 4);
+    assert!(Panda::info()
+        .jacobian
+        .unwrap()
+        .form
+        .starts_with("structured"));
+    assert!(ur5::Ur5::info()
+        .jacobian
+        .unwrap()
+        .form
+        .starts_with("closed form"));
+}
+
+#[test]
+fn rolling_contacts_and_their_scenes_agree() {
+    let axle = wheel_axle::WheelAxle::default();
+    assert_agrees(&axle, 6);
+    assert_agrees(&wheel_axle::WheelAxleDriven(axle.clone()), 7);
+    assert_agrees(&wheel_axle::WheelAxleCoasting(axle.clone()), 8);
+}
+
+#[test]
+fn linearize_reads_the_generated_jacobian_and_falls_back_to_dual_numbers() {
+    let x = [0.3, -0.7, 0.2, 0.5];
+    let lin = appell::linearize::linearize(&WithJacobian, 0.0, &x, &[]).unwrap();
+    let g = generated(&WithJacobian, 0.0, &x, &[]).unwrap();
+    assert_eq!(lin.a.transpose().as_slice(), &g.a[..]);
+    // Without a generated Jacobian: the trait's default, and the duals.
+    assert!(NoJacobian::info().jacobian.is_none());
+    assert!(NoJacobian::info()
+        .equations
+        .contains("jacobian: none (turned off by `jacobian(off)`"));
+    let err = generated(&NoJacobian, 0.0, &x, &[]).err();
+    assert!(matches!(
+        err,
+        Some(ModelError::NotGenerated {
+            function: "rhs_jacobian"
+        })
+    ));
+    let off = appell::linearize::linearize(&NoJacobian, 0.0, &x, &[]).unwrap();
+    let worst = off
+        .a
+        .iter()
+        .zip(lin.a.iter())
+        .map(|(a, b)| (a - b).abs())
+        .fold(0.0, f64::max);
+    assert!(worst < 1e-12, "{worst}");
+}
+
+#[test]
+fn wrong_buffers_and_non_finite_states_are_typed_errors() {
+    let model = ur5::Ur5;
+    let (s, ni) = (ur5::Ur5::info().state_len(), ur5::Ur5::info().inputs.len());
+    let (mut v, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
+    let (x, u) = (vec![0.1; s], vec![0.0; ni]);
+    let short = model.rhs_jacobian(0.0, &x, &u, &mut v, &mut a[1..], &mut b);
+    assert!(matches!(short, Err(ModelError::Length { .. })), "{short:?}");
+    let mut bad = x.clone();
+    bad[2] = f64::NAN;
+    let nan = model.rhs_jacobian(0.0, &bad, &u, &mut v, &mut a, &mut b);
+    assert!(matches!(nan, Err(ModelError::NonFinite { .. })), "{nan:?}");
+}
