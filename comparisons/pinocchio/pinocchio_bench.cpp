@@ -5,6 +5,7 @@
 //   pinocchio_bench URDF [--free] [--name NAME] [--weld J1,J2,...] [--batch B]
 //                        [--reps R] [--seed S] [--only aba,rnea,...]
 //   pinocchio_bench URDF [--free] [--weld ...] --check   < states   (see check())
+//   pinocchio_bench URDF [--weld ...] [--batch B] --dump-derivatives   (see dump())
 //
 // The batch of states is drawn from SplitMix64 exactly as the Rust driver
 // (rust/src/main.rs) draws it, in Pinocchio's joint order (bench::draw in
@@ -19,9 +20,20 @@
 // min and max over the repetitions, and a checksum (the sum of every output
 // entry over the batch, from an untimed pass) to compare with the other
 // implementations.
+//
+// aba_derivatives is computeABADerivatives(model, data, q, v, tau): the
+// partial derivatives of the accelerations data.ddq_dq (nv x nq),
+// data.ddq_dv (nv x nv) and data.Minv (= d ddq / d tau). Its documentation
+// (algorithm/aba-derivatives.hpp) says that, as for computeMinverse, only
+// the upper triangle of data.Minv is filled (Pinocchio 4.1's implementation
+// happens to copy it into the lower one before forming ddq_dq and ddq_dv,
+// but that is not promised), so the checksum reads the upper triangle only:
+// sum(ddq_dq) + sum(ddq_dv) + (2 sum(upper triangle of Minv) - trace(Minv)),
+// the sum of every entry of the symmetric M^-1.
 
 #include <iostream>
 
+#include <pinocchio/algorithm/aba-derivatives.hpp>
 #include <pinocchio/algorithm/aba.hpp>
 #include <pinocchio/algorithm/crba.hpp>
 #include <pinocchio/algorithm/joint-configuration.hpp>
@@ -81,16 +93,75 @@ namespace
     return 0;
   }
 
+  // The sum of every entry of data.Minv as a symmetric matrix, from its
+  // upper triangle (the part computeABADerivatives is documented to fill).
+  double minv_sum(const pinocchio::Data & data)
+  {
+    const auto upper = data.Minv.triangularView<Eigen::Upper>().toDenseMatrix();
+    return 2.0 * upper.sum() - data.Minv.diagonal().sum();
+  }
+
+  // --dump-derivatives: for each state of the batch, one JSON line with
+  // computeABADerivatives' ddq, ddq_dq, ddq_dv and ddq_dtau (Minv, its
+  // lower triangle taken from the upper one), rows and columns in
+  // Pinocchio's joint order. run.py compares them entry by entry with
+  // appell_bench --dump-jacobian's.
+  int dump(const pinocchio::Model & model, const bench::Batch & b, const std::string & name)
+  {
+    pinocchio::Data data(model);
+    auto number = [](double x) {
+      char buf[32];
+      std::snprintf(buf, sizeof buf, "%.17g", x);
+      return std::string(buf);
+    };
+    auto list = [&](const Eigen::VectorXd & x) {
+      std::string s = "[";
+      for (Eigen::Index i = 0; i < x.size(); ++i)
+        s += (i ? "," : "") + number(x[i]);
+      return s + "]";
+    };
+    auto matrix = [&](const Eigen::MatrixXd & m) {
+      std::string s = "[";
+      for (Eigen::Index i = 0; i < m.rows(); ++i)
+      {
+        s += i ? ",[" : "[";
+        for (Eigen::Index j = 0; j < m.cols(); ++j)
+          s += (j ? "," : "") + number(m(i, j));
+        s += "]";
+      }
+      return s + "]";
+    };
+    for (int k = 0; k < b.count; ++k)
+    {
+      pinocchio::computeABADerivatives(model, data, b.q[k], b.v[k], b.tau[k]);
+      Eigen::MatrixXd minv = data.Minv.triangularView<Eigen::Upper>();
+      minv.triangularView<Eigen::StrictlyLower>() =
+        minv.transpose().triangularView<Eigen::StrictlyLower>();
+      std::printf(
+        "{\"model\":%s,\"state\":%d,\"ddq\":%s,\"ddq_dq\":%s,\"ddq_dv\":%s,\"ddq_dtau\":%s}\n",
+        bench::json_string(name).c_str(), k, list(data.ddq).c_str(),
+        matrix(data.ddq_dq).c_str(), matrix(data.ddq_dv).c_str(), matrix(minv).c_str());
+    }
+    return 0;
+  }
+
 } // namespace
 
 int main(int argc, char ** argv)
 {
-  const bench::Options o =
-    bench::parse(argc, argv, [](const std::string &, auto &&) { return false; });
+  bool dump_derivatives = false;
+  const bench::Options o = bench::parse(argc, argv, [&](const std::string & arg, auto &&) {
+    if (arg != "--dump-derivatives")
+      return false;
+    dump_derivatives = true;
+    return true;
+  });
   const pinocchio::Model model = bench::load(o);
   const int n = model.nv;
   if (o.check)
     return check(model);
+  if (dump_derivatives)
+    return dump(model, bench::draw(model, o.free, o.count, o.seed), o.name);
 
 #ifdef PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION
   const char * build = "pinocchio's precompiled library (PINOCCHIO_ENABLE_TEMPLATE_INSTANTIATION)";
@@ -108,7 +179,7 @@ int main(int argc, char ** argv)
       data.M.transpose().triangularView<Eigen::StrictlyLower>();
   };
   const std::vector<std::string> names = {"aba",      "rnea", "crba",    "crba_sym",
-                                          "nle",      "gravity", "crba_nle"};
+                                          "nle",      "gravity", "crba_nle", "aba_derivatives"};
   auto run = [&](const char * fn, auto call, auto sum) {
     if (bench::wanted(o.only, names, fn))
       bench::time_function("pinocchio", o.name, fn, call, sum, o.count, o.reps, build);
@@ -163,6 +234,18 @@ int main(int argc, char ** argv)
       symmetrize();
       f.noalias() = b.tau[k] - pinocchio::nonLinearEffects(model, data, b.q[k], b.v[k]);
       return data.M.sum() + f.sum();
+    });
+  // The derivatives of forward dynamics (the counterpart of appell's
+  // rhs_jacobian); the checksum as the header comment says.
+  run(
+    "aba_derivatives",
+    [&](int k) {
+      pinocchio::computeABADerivatives(model, data, b.q[k], b.v[k], b.tau[k]);
+      return data.ddq_dv(n - 1, n - 1);
+    },
+    [&](int k) {
+      pinocchio::computeABADerivatives(model, data, b.q[k], b.v[k], b.tau[k]);
+      return data.ddq_dq.sum() + data.ddq_dv.sum() + minv_sum(data);
     });
   return 0;
 }

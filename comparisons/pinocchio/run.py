@@ -36,6 +36,13 @@ Steps:
    ratios are taken within each round, then the median (range).
    Checksums of paired functions (appell's rhs and Pinocchio's ABA and
    MuJoCo's qacc; M and f against CRBA and NLE) are compared too.
+6. Forward-dynamics derivatives (fixed bases whose appell model has a
+   generated Jacobian, or a jacobian(on) twin in rust/src/jacobian.rs):
+   appell's rhs_jacobian and rhs_jacobian_dual (dual numbers, one rhs per
+   column) against Pinocchio's computeABADerivatives (aba_derivatives),
+   timed as the rest; before the timing, both drivers print the
+   derivatives of DERIVATIVE_STATES states (--dump-jacobian,
+   --dump-derivatives) and they are compared entry by entry.
 
 Raw JSON lines go to build/results.jsonl, the tables to build/results.md.
 """
@@ -99,14 +106,32 @@ PAIRS = [
     ("inverse_dynamics", "rnea"),
     ("mass_matrix", "crba_sym"),
     ("gravity", "gravity"),
+    # The forward-dynamics derivatives: appell's generated Jacobian of the
+    # reduced rhs (A = d rhs/d state, B = d rhs/d inputs) against
+    # computeABADerivatives (ddq_dq, ddq_dv, Minv). The checksums sum the
+    # same numbers: appell the rows of A and B that are the accelerations'
+    # (all columns: the retained coordinates, the speeds, the inputs),
+    # Pinocchio ddq_dq + ddq_dv + Minv (the symmetric matrix's sum from its
+    # upper triangle, the part it is documented to fill). Pinocchio's
+    # ddq_dq has a column for the coordinate appell's reduced state leaves
+    # out (the first joint, about the vertical), zero up to rounding.
+    ("rhs_jacobian", "aba_derivatives"),
+    # The same derivatives by dual numbers (the baseline appell's
+    # linearize used before rhs_jacobian), checked against the same sum.
+    ("rhs_jacobian_dual", "aba_derivatives"),
 ]
+# Functions of PAIRS shown in their own table (the derivatives), not in
+# the per-pair tables.
+DERIVATIVES = ("rhs_jacobian", "rhs_jacobian_dual")
+# States whose derivatives are compared entry by entry before the timing.
+DERIVATIVE_STATES = 20
 # appell function -> Pinocchio's code-generated counterpart
 # (pinocchio_cg_bench, impl "pinocchio_cg").
 PAIRS_CG = {"rhs": "aba", "inverse_dynamics": "rnea", "mass_matrix": "crba_sym", "gravity": "gravity"}
 # The Rust driver's conversions between the conventions (free bases only).
 CONVERSIONS = ["map_in", "map_out"]
 # Pinocchio functions shown in the second table, in order.
-PINOCCHIO_FUNCTIONS = ["aba", "rnea", "crba", "crba_sym", "nle", "gravity", "crba_nle"]
+PINOCCHIO_FUNCTIONS = ["aba", "rnea", "crba", "crba_sym", "nle", "gravity", "crba_nle", "aba_derivatives"]
 
 
 def appell_revision():
@@ -254,6 +279,43 @@ def check_against_reference(binary):
     return worst
 
 
+def check_derivatives(pin_bin, rust_bin, name, urdf, weld, joints, seed):
+    """Entry-by-entry comparison of appell's generated Jacobian
+    (`appell_bench --dump-jacobian`, in Pinocchio's joint order) with
+    computeABADerivatives (`pinocchio_bench --dump-derivatives`) on the
+    first DERIVATIVE_STATES states of the batch; None if the appell model
+    has no generated Jacobian. Per block, the largest absolute difference
+    and the largest relative to 1 + the block's largest entry."""
+    batch = ["--batch", str(DERIVATIVE_STATES), "--seed", str(seed)]
+    wl = ["--weld", ",".join(weld)] if weld else []
+    pin = [x for x in run_driver([pin_bin, urdf, "--name", name, "--dump-derivatives"] + wl + batch) if "ddq_dq" in x]
+    app = [x for x in run_driver([rust_bin, name, "--joints", ",".join(joints), "--dump-jacobian"] + batch)
+           if "ddq_dq" in x]
+    if not app:
+        return None
+    assert len(app) == len(pin), (name, len(app), len(pin))
+    out = {"states": len(app), "type": app[0]["type"]}
+    for key in ("ddq", "ddq_dq", "ddq_dv", "ddq_dtau"):
+        worst_abs = worst_rel = 0.0
+        left_out = 0.0  # Pinocchio's entries where appell has none (the cyclic coordinate)
+        for a, p in zip(app, pin):
+            av = [x for row in a[key] for x in row] if key != "ddq" else a[key]
+            pv = [x for row in p[key] for x in row] if key != "ddq" else p[key]
+            assert len(av) == len(pv), (name, key, len(av), len(pv))
+            scale = 1.0 + max(abs(x) for x in pv)
+            for x, y in zip(av, pv):
+                if x is None:
+                    left_out = max(left_out, abs(y))
+                    continue
+                worst_abs = max(worst_abs, abs(x - y))
+                worst_rel = max(worst_rel, abs(x - y) / scale)
+        out[key] = {"max_abs": worst_abs, "max_rel": worst_rel}
+        if key == "ddq_dq":
+            out[key]["left_out_max_abs"] = left_out
+    out["dual_max_diff"] = max(a["dual_max_diff"] for a in app)
+    return out
+
+
 # ----------------------------------------------------------------- timing
 
 
@@ -353,6 +415,18 @@ def measure(args):
         fl = ["--free"] if name in FREE else []
         head = run_driver([pin_bin, urdf, "--name", name, "--batch", "1", "--reps", "1", "--only", "gravity"] + wl + fl)[0]
         joints[name] = head["joints"]
+    # The derivatives, entry by entry (fixed bases with a Jacobian in the
+    # first Rust build).
+    derivative_checks = {}
+    if variants:
+        for name, urdf, weld, with_appell in models:
+            if with_appell and name not in FREE and name in rust_models[variants[0]]:
+                c = check_derivatives(pin_bin, rust_bins[variants[0]], name, urdf, weld, joints[name], args.seed)
+                if c:
+                    derivative_checks[name] = c
+                    log(f"  derivatives of {name} ({c['type']}) against computeABADerivatives: "
+                        + ", ".join(f"{k} {c[k]['max_abs']:.1e}" for k in ("ddq", "ddq_dq", "ddq_dv", "ddq_dtau"))
+                        + f"; dual numbers {c['dual_max_diff']:.1e}")
     mj_urdf = {} if args.no_mujoco else {
         name: mujoco_urdf(name, urdf, weld) for name, urdf, weld, _ in models if name not in FREE
     }
@@ -393,6 +467,7 @@ def measure(args):
         "checks": checks,
         "cg_prepare": cg_prepare,
         "cg_compiled": meta_cg_compiled,
+        "derivative_checks": derivative_checks,
     }
     raw.write(json.dumps({"meta": meta}) + "\n")
     for r in range(args.rounds):
@@ -518,6 +593,8 @@ def report(path):
 
     # Table 2: the other appell functions against their counterparts.
     for fa, fp in PAIRS[1:]:
+        if fa in DERIVATIVES:
+            continue  # their own table below
         if not appell_keys or not any(medians(appell_keys[0], m, fa) for m in small):
             continue  # a function the Rust driver does not time (yet)
         cg = PAIRS_CG.get(fa) if has_cg else None
@@ -535,6 +612,54 @@ def report(path):
                 row += [fmt_range(ratios("pinocchio_cg", cg, k, fa, name), fmt_ratio) for k in appell_keys]
             rows.append(row)
         out += table(cols, rows)
+
+    # The forward-dynamics derivatives: appell's generated Jacobian and the
+    # dual-number one against computeABADerivatives (and ABA itself).
+    derived = [name for name in small if appell_keys and medians(appell_keys[0], name, "rhs_jacobian")]
+    if derived:
+        def jacobian_ops(name):
+            for x in heads:
+                if x.get("model") == name and x.get("jacobian_ops"):
+                    return f"{x['jacobian_ops']:,}" + (" (twin)" if "jacobian_type" in x else "")
+            return "?"
+        cols = ["model", "dof", "appell rhs_jacobian ops"]
+        for v in variants:
+            cols += [f"appell rhs_jacobian ({v}), ns", f"appell dual ({v}), ns"]
+        cols += ["Pinocchio aba_derivatives, ns", "Pinocchio ABA, ns"]
+        cols += [f"aba_derivatives / rhs_jacobian ({v})" for v in variants]
+        cols += [f"dual / rhs_jacobian ({v})" for v in variants]
+        cols += [f"rhs_jacobian / rhs ({v})" for v in variants] + ["aba_derivatives / ABA"]
+        rows = []
+        for name in derived:
+            h = head(appell_keys[0], name)
+            row = [name, str(h.get("nv", "?")), jacobian_ops(name)]
+            for k in appell_keys:
+                row += [fmt_range(medians(k, name, "rhs_jacobian")), fmt_range(medians(k, name, "rhs_jacobian_dual"))]
+            row += [fmt_range(medians("pinocchio", name, "aba_derivatives")), fmt_range(medians("pinocchio", name, "aba"))]
+            row += [fmt_range(ratios("pinocchio", "aba_derivatives", k, "rhs_jacobian", name), fmt_ratio) for k in appell_keys]
+            row += [fmt_range(ratios(k, "rhs_jacobian_dual", k, "rhs_jacobian", name), fmt_ratio) for k in appell_keys]
+            row += [fmt_range(ratios(k, "rhs_jacobian", k, "rhs", name), fmt_ratio) for k in appell_keys]
+            row += [fmt_range(ratios("pinocchio", "aba_derivatives", "pinocchio", "aba", name), fmt_ratio)]
+            rows.append(row)
+        out += ["Forward-dynamics derivatives: appell's `rhs_jacobian` (the generated rhs, A = ∂rhs/∂state and "
+                "B = ∂rhs/∂inputs in one call; \"(twin)\": from the same robot derived with `jacobian(on)`, "
+                "rust/src/jacobian.rs), the same three outputs by dual numbers (one `Dual64` rhs per column of A "
+                "and B), Pinocchio's `computeABADerivatives` (ddq_dq, ddq_dv, Minv) and its `aba`.", ""]
+        out += table(cols, rows)
+        checks = meta.get("derivative_checks", {})
+        if checks:
+            out += [f"Derivatives entry by entry, appell's generated Jacobian (rows and columns placed by joint "
+                    f"name) against computeABADerivatives on the first {DERIVATIVE_STATES} states, largest "
+                    f"absolute difference (relative to 1 + the block's largest entry):", ""]
+            for name, c in checks.items():
+                parts = [f"{label} {c[k]['max_abs']:.1e} ({c[k]['max_rel']:.1e})"
+                         for k, label in (("ddq", "q̈"), ("ddq_dq", "∂q̈/∂q"), ("ddq_dv", "∂q̈/∂v"),
+                                          ("ddq_dtau", "∂q̈/∂τ"))]
+                out.append(f"- {name} ({c['type']}): " + ", ".join(parts)
+                           + f"; Pinocchio's ∂q̈/∂q in the column appell leaves out (cyclic): at most "
+                           f"{c['ddq_dq']['left_out_max_abs']:.1e}; generated against dual numbers: "
+                           f"{c['dual_max_diff']:.1e}")
+            out.append("")
 
     # The conversions between Pinocchio's conventions and appell's (free
     # bases), beside the rhs they feed.

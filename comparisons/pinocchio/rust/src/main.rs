@@ -4,6 +4,7 @@
 //!
 //! ```text
 //! appell_bench MODEL [--joints J1,J2,...] [--batch B] [--reps R] [--seed S] [--only F1,F2]
+//!              [--dump-jacobian]
 //! appell_bench list
 //! ```
 //!
@@ -44,9 +45,21 @@
 //! `map_in` (Pinocchio's q and v to appell's reduced state) and `map_out`
 //! (appell's accelerations to Pinocchio's `a`).
 //!
+//! Forward-dynamics derivatives (fixed bases): where the model has a
+//! generated Jacobian (`info().jacobian`), or a twin with `jacobian(on)` in
+//! `jacobian.rs` (the Panda, the 8-link chain), [`jacobians`] times
+//! `rhs_jacobian` (the generated rhs, A = ∂rhs/∂state and B = ∂rhs/∂inputs
+//! in one call) and `rhs_jacobian_dual` (the same three outputs by one
+//! `Dual64` evaluation of the rhs per state and input column, what
+//! `linearize` did before `rhs_jacobian`). `--dump-jacobian` times nothing
+//! and prints, per state of the batch, ∂q̈/∂q, ∂q̈/∂v and ∂q̈/∂τ in
+//! Pinocchio's joint order, for `run.py`'s entry-by-entry check against
+//! `pinocchio_bench --dump-derivatives`.
+//!
 //! Adding a function is one `t.run(...)` line in [`bench`].
 
 mod floating;
+mod jacobian;
 #[path = "../../../../examples/models/panda.rs"]
 mod panda;
 #[path = "../../../../examples/models/spatial_chain.rs"]
@@ -58,6 +71,7 @@ use std::hint::black_box;
 use std::process::ExitCode;
 use std::time::Instant;
 
+use appell::num_dual::Dual64;
 use appell::pinocchio::PinocchioMap;
 use appell::{Model, ModelError};
 
@@ -109,6 +123,8 @@ struct Options {
     reps: usize,
     seed: u64,
     only: Option<Vec<String>>,
+    /// `--dump-jacobian`: print the Jacobians instead of timing.
+    dump_jacobian: bool,
 }
 
 /// The batch, one flat array per argument kind, `count` states each.
@@ -368,6 +384,11 @@ struct Timer<'a> {
 }
 
 impl Timer<'_> {
+    fn wants(&self, function: &str) -> bool {
+        self.only
+            .is_none_or(|only| only.iter().any(|o| o == function))
+    }
+
     /// Times `f`, which writes `out_len` outputs for a state; the checksum
     /// adds `sum(state, out)` over the batch (untimed).
     fn run<F, G>(&self, function: &str, out_len: usize, mut f: F, sum: G)
@@ -375,10 +396,8 @@ impl Timer<'_> {
         F: FnMut(&State, &mut [f64]) -> Result<(), ModelError>,
         G: Fn(&State, &[f64]) -> Result<f64, ModelError>,
     {
-        if let Some(only) = self.only {
-            if !only.iter().any(|o| o == function) {
-                return;
-            }
+        if !self.wants(function) {
+            return;
         }
         let b = self.batch;
         let mut out = vec![0.0; out_len];
@@ -426,7 +445,7 @@ fn bench<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
     let info = M::info();
     let b = draw::<M>(opts)?;
     println!(
-        "{{\"impl\":\"appell\",\"build\":\"{}\",\"model\":\"{}\",\"type\":\"{}\",\"nv\":{},\"joints\":{},\"retained\":{},\"rhs_ops\":{},\"form\":{}}}",
+        "{{\"impl\":\"appell\",\"build\":\"{}\",\"model\":\"{}\",\"type\":\"{}\",\"nv\":{},\"joints\":{},\"retained\":{},\"rhs_ops\":{},\"form\":{}{}}}",
         build(),
         opts.model,
         info.name,
@@ -434,7 +453,8 @@ fn bench<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
         json_list(info.speeds),
         json_list(info.retained),
         info.rhs_ops.total,
-        json_string(info.form)
+        json_string(info.form),
+        jacobian_fields::<M>()
     );
     let t = Timer {
         name: &opts.model,
@@ -561,6 +581,256 @@ fn bench<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
             plain(0),
         );
     }
+    if map.is_none() && info.jacobian.is_some() {
+        jacobians(model, &t, opts)?;
+    }
+    Ok(())
+}
+
+/// The `"jacobian_ops"` and `"jacobian_form"` fields of a head line.
+fn jacobian_fields<M: Model>() -> String {
+    match &M::info().jacobian {
+        Some(j) => format!(
+            ",\"jacobian_ops\":{},\"jacobian_form\":{}",
+            j.ops.total,
+            json_string(j.form)
+        ),
+        None => ",\"jacobian_ops\":null,\"jacobian_form\":null".to_string(),
+    }
+}
+
+/// [`bench`] of `model`, then, if it has no generated Jacobian, the
+/// Jacobians of its twin `with` ([`twin`]).
+fn with_twin<P: Model, M: Model>(model: &P, with: &M, opts: &Options) -> Result<(), String> {
+    bench(model, opts)?;
+    if P::info().jacobian.is_none() {
+        twin(with, opts)?;
+    }
+    Ok(())
+}
+
+/// The Jacobians of a twin of the model (`jacobian.rs`: the same robot
+/// with `jacobian(on)`), on the same batch (same joints, same draws), under
+/// the model's name: a head line naming the twin, then [`jacobians`].
+fn twin<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
+    let info = M::info();
+    if info.jacobian.is_none() {
+        return Err(format!("{} has no generated Jacobian", info.name));
+    }
+    let b = draw::<M>(opts)?;
+    if !opts.dump_jacobian {
+        println!(
+            "{{\"impl\":\"appell\",\"build\":\"{}\",\"model\":\"{}\",\"jacobian_type\":\"{}\"{}}}",
+            build(),
+            opts.model,
+            info.name,
+            jacobian_fields::<M>()
+        );
+    }
+    let t = Timer {
+        name: &opts.model,
+        batch: &b,
+        reps: opts.reps,
+        only: opts.only.as_deref(),
+        build: build(),
+    };
+    jacobians(model, &t, opts)
+}
+
+/// `dstate`, A (s×s) and B (s×i), row-major, one after the other in `out`
+/// (the layout of both Jacobian functions' outputs), by one [`Dual64`]
+/// evaluation of the rhs per column of A and of B, seeded on that state
+/// component or input, as `appell::linearize` computed them before the
+/// generated `rhs_jacobian` (`dual_columns` in
+/// `appell-runtime/src/linearize/jacobian.rs`); the buffers `x`, `w`, `y`
+/// are allocated by the caller and `prepared` made once.
+#[allow(clippy::too_many_arguments)]
+fn dual_jacobian<M: Model>(
+    model: &M,
+    prepared: &M::Prepared<Dual64>,
+    state: &[f64],
+    inputs: &[f64],
+    x: &mut [Dual64],
+    w: &mut [Dual64],
+    y: &mut [Dual64],
+    out: &mut [f64],
+) -> Result<(), ModelError> {
+    let (s, ni) = (state.len(), inputs.len());
+    for (xi, &v) in x.iter_mut().zip(state) {
+        *xi = Dual64::from_re(v);
+    }
+    for (wi, &v) in w.iter_mut().zip(inputs) {
+        *wi = Dual64::from_re(v);
+    }
+    let (dstate, rest) = out.split_at_mut(s);
+    let (a, b) = rest.split_at_mut(s * s);
+    for j in 0..s + ni {
+        if j < s {
+            x[j].eps = 1.0;
+        } else {
+            w[j - s].eps = 1.0;
+        }
+        let r = model.rhs(prepared, Dual64::from_re(0.0), x, w, y);
+        if j < s {
+            x[j].eps = 0.0;
+        } else {
+            w[j - s].eps = 0.0;
+        }
+        r?;
+        if j < s {
+            for (i, yi) in y.iter().enumerate() {
+                a[i * s + j] = yi.eps;
+            }
+        } else {
+            for (i, yi) in y.iter().enumerate() {
+                b[i * ni + j - s] = yi.eps;
+            }
+        }
+    }
+    for (d, yi) in dstate.iter_mut().zip(y.iter()) {
+        *d = yi.re;
+    }
+    Ok(())
+}
+
+/// Times the forward-dynamics derivatives of a fixed-base model with a
+/// generated Jacobian: `rhs_jacobian` (generated) and `rhs_jacobian_dual`
+/// (dual numbers, [`dual_jacobian`]), both writing `dstate`, A and B. Their
+/// checksum is the sum over the batch of the rows of A and B that are ü's
+/// (the rows after the retained coordinates' q̇ = u): ∂ü/∂q (retained
+/// coordinates), ∂ü/∂u and ∂ü/∂τ, the same numbers as the sum of
+/// Pinocchio's `ddq_dq`, `ddq_dv` and `Minv` (whose column of the left-out
+/// cyclic coordinate is zero). With `--dump-jacobian`, prints them instead
+/// ([`dump_jacobian`]).
+fn jacobians<M: Model>(model: &M, t: &Timer, opts: &Options) -> Result<(), String> {
+    let info = M::info();
+    let (s, ni, kept) = (info.state_len(), info.inputs.len(), info.retained.len());
+    let len = s + s * s + s * ni;
+    let prepared = model.prepare::<Dual64>();
+    let zero = Dual64::from_re(0.0);
+    let (mut x, mut w, mut y) = (vec![zero; s], vec![zero; ni], vec![zero; s]);
+    if opts.dump_jacobian {
+        return dump_jacobian(model, t.batch, opts, |st, out| {
+            dual_jacobian(
+                model, &prepared, st.state, st.inputs, &mut x, &mut w, &mut y, out,
+            )
+        });
+    }
+    let derivatives = move |_: &State, out: &[f64]| -> Result<f64, ModelError> {
+        let (a, b) = out[s..].split_at(s * s);
+        Ok(a[kept * s..].iter().sum::<f64>() + b[kept * ni..].iter().sum::<f64>())
+    };
+    t.run(
+        "rhs_jacobian",
+        len,
+        |st, out| {
+            let (dstate, rest) = out.split_at_mut(s);
+            let (a, b) = rest.split_at_mut(s * s);
+            model.rhs_jacobian(0.0, st.state, st.inputs, dstate, a, b)
+        },
+        derivatives,
+    );
+    t.run(
+        "rhs_jacobian_dual",
+        len,
+        |st, out| {
+            dual_jacobian(
+                model, &prepared, st.state, st.inputs, &mut x, &mut w, &mut y, out,
+            )
+        },
+        derivatives,
+    );
+    Ok(())
+}
+
+/// `--dump-jacobian`: for each state of the batch, one JSON line with the
+/// generated ∂q̈/∂q (nv×nq, `null` at a coordinate the reduced state leaves
+/// out), ∂q̈/∂v, ∂q̈/∂τ and q̈ in Pinocchio's joint order (`--joints`),
+/// and the largest difference of the generated [A | B] from the dual
+/// numbers' (`dual`).
+fn dump_jacobian<M: Model>(
+    model: &M,
+    b: &Batch,
+    opts: &Options,
+    mut dual: impl FnMut(&State, &mut [f64]) -> Result<(), ModelError>,
+) -> Result<(), String> {
+    let info = M::info();
+    let (s, ni, kept) = (info.state_len(), info.inputs.len(), info.retained.len());
+    let joints: Vec<String> = match &opts.joints {
+        Some(j) => j.clone(),
+        None => info.speeds.iter().map(|s| s.to_string()).collect(),
+    };
+    let find = |names: &[&str], name: &str| names.iter().position(|n| *n == name);
+    let speed: Vec<usize> = joints
+        .iter()
+        .map(|j| find(info.speeds, j).ok_or(format!("no speed {j}")))
+        .collect::<Result<_, _>>()?;
+    let input: Vec<usize> = joints
+        .iter()
+        .map(|j| find(info.inputs, &format!("tau_{j}")).ok_or(format!("no input tau_{j}")))
+        .collect::<Result<_, _>>()?;
+    let retained: Vec<Option<usize>> = joints.iter().map(|j| find(info.retained, j)).collect();
+    let (mut generated, mut dual_out) =
+        (vec![0.0; s + s * s + s * ni], vec![0.0; s + s * s + s * ni]);
+    let number = |x: f64| format!("{x:e}");
+    let matrix = |rows: Vec<Vec<String>>| {
+        let rows: Vec<String> = rows.iter().map(|r| format!("[{}]", r.join(","))).collect();
+        format!("[{}]", rows.join(","))
+    };
+    for k in 0..b.count {
+        let st = b.at(k);
+        {
+            let (dstate, rest) = generated.split_at_mut(s);
+            let (a, bm) = rest.split_at_mut(s * s);
+            model
+                .rhs_jacobian(0.0, st.state, st.inputs, dstate, a, bm)
+                .map_err(|e| format!("rhs_jacobian at state {k}: {e}"))?;
+        }
+        dual(&st, &mut dual_out).map_err(|e| format!("dual Jacobian at state {k}: {e}"))?;
+        let dual_diff = generated[s..]
+            .iter()
+            .zip(&dual_out[s..])
+            .map(|(g, d)| (g - d).abs())
+            .fold(0.0, f64::max);
+        let (a, bm) = generated[s..].split_at(s * s);
+        let row = |p: usize| kept + speed[p];
+        let nj = joints.len();
+        let dq = (0..nj)
+            .map(|p| {
+                (0..nj)
+                    .map(|r| match retained[r] {
+                        Some(c) => number(a[row(p) * s + c]),
+                        None => "null".to_string(),
+                    })
+                    .collect()
+            })
+            .collect();
+        let dv = (0..nj)
+            .map(|p| {
+                (0..nj)
+                    .map(|r| number(a[row(p) * s + kept + speed[r]]))
+                    .collect()
+            })
+            .collect();
+        let dtau = (0..nj)
+            .map(|p| {
+                (0..nj)
+                    .map(|r| number(bm[row(p) * ni + input[r]]))
+                    .collect()
+            })
+            .collect();
+        let ddq: Vec<String> = (0..nj).map(|p| number(generated[row(p)])).collect();
+        println!(
+            "{{\"model\":\"{}\",\"type\":\"{}\",\"state\":{k},\"ddq\":[{}],\"ddq_dq\":{},\"ddq_dv\":{},\"ddq_dtau\":{},\"dual_max_diff\":{:e}}}",
+            opts.model,
+            info.name,
+            ddq.join(","),
+            matrix(dq),
+            matrix(dv),
+            matrix(dtau),
+            dual_diff
+        );
+    }
     Ok(())
 }
 
@@ -574,6 +844,7 @@ fn parse(args: &[String]) -> Result<Options, String> {
         reps: 31,
         seed: 20240917,
         only: None,
+        dump_jacobian: false,
     };
     let list = |s: &str| -> Vec<String> {
         s.split(',')
@@ -588,11 +859,16 @@ fn parse(args: &[String]) -> Result<Options, String> {
                 opts.joints = Some(list(value()?).into_iter().map(|j| rust_name(&j)).collect())
             }
             "--only" => opts.only = Some(list(value()?)),
+            "--dump-jacobian" => opts.dump_jacobian = true,
             "--batch" => opts.batch = value()?.parse().map_err(|e| format!("--batch: {e}"))?,
             "--reps" => opts.reps = value()?.parse().map_err(|e| format!("--reps: {e}"))?,
             "--seed" => opts.seed = value()?.parse().map_err(|e| format!("--seed: {e}"))?,
             other => return Err(format!("unknown argument {other}")),
         }
+    }
+    if opts.dump_jacobian {
+        // Nothing is timed.
+        opts.only = Some(Vec::new());
     }
     if opts.batch == 0 || opts.reps == 0 {
         return Err("--batch and --reps must be positive".into());
@@ -609,16 +885,20 @@ fn main() -> ExitCode {
     let opts = match parse(&args) {
         Ok(o) => o,
         Err(e) => {
-            eprintln!("appell_bench: {e}\nusage: appell_bench MODEL [--joints J1,J2] [--batch B] [--reps R] [--seed S] [--only F1,F2]; models: {}", MODELS.join(" "));
+            eprintln!("appell_bench: {e}\nusage: appell_bench MODEL [--joints J1,J2] [--batch B] [--reps R] [--seed S] [--only F1,F2] [--dump-jacobian]; models: {}", MODELS.join(" "));
             return ExitCode::from(2);
         }
     };
     let result = match opts.model.as_str() {
         "ur5" => bench(&ur5::Ur5, &opts),
-        "panda" => bench(&panda::Panda, &opts),
+        "panda" => with_twin(&panda::Panda, &jacobian::PandaJacobian, &opts),
         "spatial_chain_2" => bench(&spatial_chain::SpatialChain2, &opts),
         "spatial_chain_4" => bench(&spatial_chain::SpatialChain4, &opts),
-        "spatial_chain_8" => bench(&spatial_chain::SpatialChain8, &opts),
+        "spatial_chain_8" => with_twin(
+            &spatial_chain::SpatialChain8,
+            &jacobian::SpatialChain8Jacobian,
+            &opts,
+        ),
         "spatial_chain_16" => bench(&spatial_chain::SpatialChain16, &opts),
         "spatial_chain_32" => bench(&spatial_chain::SpatialChain32, &opts),
         #[cfg(feature = "large-models")]
