@@ -2,16 +2,24 @@
 //! call) against dual numbers through the generated rhs and against central
 //! differences, at random states: trees (the double pendulum, UR5, and
 //! Panda with `jacobian(on)`: the closed form's and the structured form's
-//! derivatives) and rolling contacts (the wheel-axle and two of its
-//! scenes).
+//! derivatives), rolling contacts (the wheel-axle and two of its scenes)
+//! and numeric eliminations of the dependent speeds (the four-bar, the
+//! Chaplygin sleigh, the Whipple bicycle).
 
+#[path = "../examples/models/chaplygin_sleigh.rs"]
+mod chaplygin_sleigh;
 mod common;
 #[path = "../examples/models/double_pendulum.rs"]
 mod double_pendulum;
+#[path = "../examples/models/four_bar.rs"]
+mod four_bar;
 #[path = "../examples/models/ur5.rs"]
 mod ur5;
 #[path = "../examples/models/wheel_axle.rs"]
 mod wheel_axle;
+#[path = "../examples/models/whipple_bicycle.rs"]
+#[allow(dead_code)] // the model alone
+mod whipple_bicycle;
 
 use appell::num_dual::Dual64;
 use appell::{Appell, Model, ModelError};
@@ -184,6 +192,18 @@ fn rolling_contacts_and_their_scenes_agree() {
 }
 
 #[test]
+fn numeric_eliminations_agree() {
+    let four_bar = four_bar::FourBar2 {
+        a: 0.7,
+        m: 1.3,
+        g: 9.81,
+    };
+    assert_agrees(&four_bar, 11);
+    assert_agrees(&chaplygin_sleigh::ChaplyginSleigh::default(), 12);
+    assert_agrees(&whipple_bicycle::WhippleBicycle::default(), 13);
+}
+
+#[test]
 fn linearize_reads_the_generated_jacobian_and_falls_back_to_dual_numbers() {
     let x = [0.3, -0.7, 0.2, 0.5];
     let lin = appell::linearize::linearize(&WithJacobian, 0.0, &x, &[]).unwrap();
@@ -209,6 +229,24 @@ fn linearize_reads_the_generated_jacobian_and_falls_back_to_dual_numbers() {
         .map(|(a, b)| (a - b).abs())
         .fold(0.0, f64::max);
     assert!(worst < 1e-12, "{worst}");
+}
+
+#[test]
+fn a_steps_jacobian_chained_through_the_generated_one_equals_the_dual_numbers() {
+    use appell::linearize::{step_jacobian, FixedStep};
+    let x = [0.3, -0.7, 0.2, 0.5];
+    for method in [FixedStep::Rk4, FixedStep::SemiImplicitEuler] {
+        let chained = step_jacobian(&WithJacobian, method, 0.1, 0.01, &x, &[]).unwrap();
+        let dual = step_jacobian(&NoJacobian, method, 0.1, 0.01, &x, &[]).unwrap();
+        assert_eq!(chained.next, dual.next);
+        let worst = chained
+            .a
+            .iter()
+            .zip(dual.a.iter())
+            .map(|(a, b)| (a - b).abs())
+            .fold(0.0, f64::max);
+        assert!(worst < 1e-13, "{method:?}: {worst}");
+    }
 }
 
 #[test]

@@ -148,5 +148,5 @@ pub use holonomic::{
     check_holonomic, driven_check_holonomic, driven_holonomic_unknowns, driven_project_holonomic,
     driven_solve_holonomic, holonomic_unknowns, project_holonomic, solve_holonomic,
 };
-pub use jacobian::{linearize, Linearization};
+pub use jacobian::{dual_linearize, linearize, Linearization};
 pub use minimal::minimal_linearization;

@@ -357,6 +357,22 @@ impl Graph {
         self.limits
     }
 
+    /// Replaces the limits (a stage that may grow the graph past what it
+    /// can use lowers `max_nodes` while it runs, and stops at the typed
+    /// error). Nodes already built stay.
+    ///
+    /// ```
+    /// use appell_symbolic::{Graph, Limits, SymbolicError};
+    /// let mut g = Graph::new();
+    /// let x = g.parse("x").unwrap();
+    /// g.set_limits(Limits { max_nodes: g.len(), ..g.limits() });
+    /// assert!(matches!(g.parse("x^2 + 1"), Err(SymbolicError::NodeLimit { .. })));
+    /// assert_eq!(g.parse("x").unwrap(), x);
+    /// ```
+    pub fn set_limits(&mut self, limits: Limits) {
+        self.limits = limits;
+    }
+
     /// Counters of the work done so far.
     pub fn stats(&self) -> Stats {
         self.stats

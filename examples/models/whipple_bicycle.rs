@@ -40,6 +40,9 @@ use appell::Appell;
 #[allow(clippy::duplicated_attributes)]
 #[appell(scene(coasting, effects(gravity)))]
 #[appell(scene(ridden, effects(gravity, rider)))]
+// Its Jacobian (for the lean and steer eigenvalues) is larger than the
+// derive writes by default.
+#[appell(jacobian(on))]
 pub struct WhippleBicycle {
     /// Front wheel radius [m].
     pub rf: f64,
@@ -142,7 +145,7 @@ pub fn operating_point(p: &WhippleBicycle) -> Result<[f64; 8], appell::linearize
 
 /// The lean and steer dynamics at forward speed `v` (the benchmark's
 /// state [φ, δ, φ̇, δ̇] is our [q4, q7, q4', q7']): the reduced equations
-/// linearized by dual numbers, the pitch eliminated through the holonomic
+/// linearized by their generated Jacobian, the pitch eliminated through the holonomic
 /// constraint, the rear-wheel rate held at −v/rr.
 pub fn lean_steer(
     p: &WhippleBicycle,

@@ -7,9 +7,11 @@
 //!
 //! - **closed**: ∂f/∂x, ∂f/∂w, ∂M/∂x (lower triangle) and ∂q̇_r/∂x. At run
 //!   time ÿ = M⁻¹ f, then ∂ÿ/∂x_j = M⁻¹ (∂f/∂x_j − (∂M/∂x_j) ÿ), with M
-//!   factored once for the values and every column. Only with the symbolic
-//!   elimination: a numeric one leaves the dependent rates X and their
-//!   remainder w to run time, where no expression differentiates them.
+//!   factored once for the values and every column. With a numeric
+//!   elimination (S X = R and S w = r solved at run time, stage 5) the
+//!   partials treat X and w as symbols, and the emitted code adds their
+//!   total derivatives: ∂X/∂c = S⁻¹ (∂R/∂c − (∂S/∂c) X) and
+//!   ∂w/∂c = S⁻¹ (∂r/∂c + (∂r/∂X) ∂X/∂c − (∂S/∂c) w), by S's factors.
 //! - **structured**: ∂ÿ/∂x and ∂ÿ/∂w of the unrolled articulated-body
 //!   algorithm's accelerations (a plain tree of joints), whose
 //!   constants are folded where they are built.
@@ -27,8 +29,17 @@ use super::Derivation;
 use crate::model::Model;
 
 /// The most nodes a candidate's derivatives may add, as a multiple of the
-/// graph's nodes before them.
+/// graph's nodes before them, for a model that asks for its Jacobian
+/// (`jacobian(on)`).
 pub const GROWTH_LIMIT: usize = 2;
+
+/// The most expressions a Jacobian written by default may have, as a
+/// multiple of the values it differentiates (q̇ and ÿ, or M, f and q̇, and
+/// a numeric elimination's S, R and right side): beyond it the generated
+/// code would grow past about twice the model's. The emitter writes none
+/// larger, and stage 14 stops a candidate whose derivatives add three
+/// times as many nodes.
+pub const SIZE_LIMIT: usize = 4;
 
 /// The symbols the Jacobian's columns differentiate by: the reduced state
 /// (retained coordinates, then the privileged speeds), then the model's
@@ -68,6 +79,29 @@ pub struct ClosedJacobian {
     pub mass: Vec<Vec<Id>>,
     /// ∂q̇_r/∂c for each retained coordinate r, row-major over the columns.
     pub rates: Vec<Id>,
+    /// With a numeric elimination, the partials its total derivatives
+    /// need.
+    pub numeric: Option<NumericPartials>,
+}
+
+/// The partial derivatives of a numeric elimination's expressions, X and w
+/// held as symbols. X's symbols are those of R's non-zero columns, row by
+/// row (x_i,j for j in `columns`), nx of them.
+#[derive(Clone, Debug)]
+pub struct NumericPartials {
+    /// ∂S/∂c per column (k×k).
+    pub s: Vec<Vec<Id>>,
+    /// ∂R/∂c per column, k × the non-zero columns.
+    pub r: Vec<Vec<Id>>,
+    /// ∂r/∂c per column (k), r the right side of S w = r.
+    pub rate: Vec<Vec<Id>>,
+    /// ∂r/∂X, k × nx.
+    pub rate_x: Vec<Id>,
+    /// ∂e/∂X (nx each) for each of the closed form's values e: M's lower
+    /// triangle, f, the retained rates, in that order.
+    pub values_x: Vec<Id>,
+    /// ∂e/∂w (k each) for the same values.
+    pub values_w: Vec<Id>,
 }
 
 /// The derivatives of the reduced rhs (stage 14), and why a candidate is
@@ -115,12 +149,9 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
     if model.jacobian == Some(false) {
         return Jacobians::none(columns, "turned off by `jacobian(off)`");
     }
+    let forced = model.jacobian == Some(true);
     let g = &mut model.g;
-    let closed = if matches!(d.elimination, super::Elimination::Symbolic) {
-        closed(g, d, &columns)
-    } else {
-        Err("the elimination is numeric".to_string())
-    };
+    let closed = closed(g, d, &columns, forced);
     let structured = match &d.structured {
         Ok(s) => {
             let mut roots: Vec<Id> = d
@@ -130,7 +161,8 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
                 .map(|&r| d.map.qdot[r])
                 .collect();
             roots.extend(&s.accelerations);
-            within_budget(g, |g| derivatives(g, &roots, &columns))
+            let allowed = budget(g, &roots, forced);
+            within_budget(g, allowed, |g| derivatives(g, &roots, &columns))
         }
         Err(_) => Err("no structured form".to_string()),
     };
@@ -142,7 +174,12 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
 }
 
 /// The closed form's derivatives.
-fn closed(g: &mut Graph, d: &Derivation, columns: &Columns) -> Result<ClosedJacobian, String> {
+fn closed(
+    g: &mut Graph,
+    d: &Derivation,
+    columns: &Columns,
+    forced: bool,
+) -> Result<ClosedJacobian, String> {
     let l = d.l;
     let lower: Vec<Id> = (0..l)
         .flat_map(|i| (0..=i).map(move |j| (i, j)))
@@ -154,19 +191,83 @@ fn closed(g: &mut Graph, d: &Derivation, columns: &Columns) -> Result<ClosedJaco
         .iter()
         .map(|&r| d.map.qdot[r])
         .collect();
-    within_budget(g, |g| {
+    let mut values: Vec<Id> = lower
+        .iter()
+        .chain(&d.equations.forcing)
+        .chain(&rates)
+        .copied()
+        .collect();
+    if let super::Elimination::Numeric(ne) = &d.elimination {
+        values.extend(ne.expressions());
+    }
+    let allowed = budget(g, &values, forced);
+    within_budget(g, allowed, |g| {
         let forcing = derivatives(g, &d.equations.forcing, columns)?;
-        let rates = derivatives(g, &rates, columns)?;
+        let rate_partials = derivatives(g, &rates, columns)?;
         let per_column = derivatives(g, &lower, columns)?;
         let n = columns.len();
         let mass = (0..n)
             .map(|c| (0..lower.len()).map(|e| per_column[e * n + c]).collect())
             .collect();
+        let numeric = match &d.elimination {
+            super::Elimination::Numeric(ne) => {
+                let values: Vec<Id> = lower
+                    .iter()
+                    .chain(&d.equations.forcing)
+                    .chain(&rates)
+                    .copied()
+                    .collect();
+                Some(numeric_partials(g, ne, d.l, &values, columns)?)
+            }
+            super::Elimination::Symbolic => None,
+        };
         Ok(ClosedJacobian {
             forcing,
             mass,
-            rates,
+            rates: rate_partials,
+            numeric,
         })
+    })
+}
+
+/// The partials of a numeric elimination's S, R and r, and of `values`
+/// with respect to X and w.
+fn numeric_partials(
+    g: &mut Graph,
+    ne: &super::NumericElimination,
+    l: usize,
+    values: &[Id],
+    columns: &Columns,
+) -> Result<NumericPartials, SymbolicError> {
+    let k = ne.k;
+    let used: Vec<usize> = (0..k)
+        .flat_map(|i| ne.columns.iter().map(move |&j| i * (l + 1) + j))
+        .collect();
+    let r_used: Vec<Id> = used.iter().map(|&e| ne.r[e]).collect();
+    let x: Vec<Symbol> = used.iter().map(|&e| ne.x[e]).collect();
+    let per_column = |g: &mut Graph, roots: &[Id]| -> Result<Vec<Vec<Id>>, SymbolicError> {
+        let all = derivatives(g, roots, columns)?;
+        let n = columns.len();
+        Ok((0..n)
+            .map(|c| (0..roots.len()).map(|e| all[e * n + c]).collect())
+            .collect())
+    };
+    let by = |g: &mut Graph, roots: &[Id], symbols: &[Symbol]| -> Result<Vec<Id>, SymbolicError> {
+        let mut out = Vec::with_capacity(roots.len() * symbols.len());
+        for &e in roots {
+            for &s in symbols {
+                out.push(g.diff(e, s)?);
+            }
+        }
+        Ok(out)
+    };
+    Ok(NumericPartials {
+        s: per_column(g, &ne.s)?,
+        r: per_column(g, &r_used)?,
+        rate: per_column(g, &ne.rhs_rate)?,
+        rate_x: by(g, &ne.rhs_rate, &x)?,
+        values_x: by(g, values, &x)?,
+        values_w: by(g, values, &ne.w)?,
     })
 }
 
@@ -182,22 +283,45 @@ fn derivatives(g: &mut Graph, roots: &[Id], columns: &Columns) -> Result<Vec<Id>
 }
 
 /// `build`'s result, or why it is left out: an error, or more new nodes
-/// than [`GROWTH_LIMIT`] allows (checked after it ran: the graph keeps
-/// what it built, which nothing then reaches).
+/// than [`GROWTH_LIMIT`] allows, which stops it there (the graph's node
+/// limit is lowered while it runs; what it built stays, and nothing
+/// reaches it).
 fn within_budget<T>(
     g: &mut Graph,
+    allowed: usize,
     build: impl FnOnce(&mut Graph) -> Result<T, SymbolicError>,
 ) -> Result<T, String> {
-    let before = g.len();
-    let limit = GROWTH_LIMIT * before.max(10_000);
-    let built = build(g).map_err(|e| format!("differentiating failed: {e}"))?;
-    let added = g.len() - before;
-    if added > limit {
-        return Err(format!(
-            "its derivatives added {added} expressions, more than {GROWTH_LIMIT} times the model's {before}"
-        ));
+    let (before, limits) = (g.len(), g.limits());
+    let cap = limits.max_nodes.min(before + allowed);
+    g.set_limits(appell_symbolic::Limits {
+        max_nodes: cap,
+        ..limits
+    });
+    let built = build(g);
+    g.set_limits(limits);
+    match built {
+        Ok(b) => Ok(b),
+        Err(SymbolicError::NodeLimit { limit }) if limit == cap && cap < limits.max_nodes => {
+            Err(format!(
+                "its derivatives would add more than {allowed} expressions (`jacobian(on)` allows {GROWTH_LIMIT} times the model's {before})"
+            ))
+        }
+        Err(e) => Err(format!("differentiating failed: {e}")),
     }
-    Ok(built)
+}
+
+/// The new nodes a candidate differentiating `values` may add: three
+/// times [`SIZE_LIMIT`] times their expressions, or with `jacobian(on)`
+/// [`GROWTH_LIMIT`] times the graph.
+fn budget(g: &Graph, values: &[Id], forced: bool) -> usize {
+    if forced {
+        GROWTH_LIMIT * g.len().max(10_000)
+    } else {
+        // New nodes include intermediates the canonical forms then drop:
+        // the emitter's count of the derivatives decides; this only stops
+        // a candidate far past it.
+        3 * SIZE_LIMIT * g.dag_size(values).max(100)
+    }
 }
 
 #[cfg(test)]
@@ -250,22 +374,52 @@ mod tests {
         // ∂θ̇/∂θ' = 1, ∂θ̇/∂x' = 0.
         assert!((value(closed.rates[2]) - 1.0).abs() < 1e-15);
         assert!(g.is_zero(closed.rates[1]));
+        assert!(closed.numeric.is_none());
+    }
+
+    #[test]
+    fn a_numeric_elimination_gets_the_partials_of_s_r_and_its_right_side() {
+        let mut derived = derive_source(testing::SLEIGH);
+        let crate::derivation::Elimination::Numeric(ne) = derived.full.elimination.clone() else {
+            panic!("the sleigh's elimination is numeric");
+        };
+        let j = differentiate(&mut derived.model, &derived.full);
+        let closed = j.closed.expect("a closed candidate");
+        let numeric = closed.numeric.expect("the elimination's partials");
+        let n = j.columns.len();
+        let nx = ne.k * ne.columns.len();
+        assert_eq!(numeric.s.len(), n);
+        assert_eq!(numeric.s[0].len(), ne.k * ne.k);
+        assert_eq!(numeric.rate_x.len(), ne.k * nx);
+        let l = derived.full.l;
+        let values = l * (l + 3) / 2 + derived.full.reduction.retained.len();
+        assert_eq!(numeric.values_x.len(), values * nx);
+        assert_eq!(numeric.values_w.len(), values * ne.k);
+        // f depends on w (the dependent accelerations' remainder).
+        let g = &derived.model.g;
+        assert!(numeric.values_w.iter().any(|&e| !g.is_zero(e)));
     }
 
     #[test]
     fn a_candidate_that_grows_the_graph_past_its_budget_is_left_out() {
         let mut g = Graph::new();
         let before = g.len();
-        let kept = within_budget(&mut g, |g| g.parse("x + 1"));
+        let allowed = 1000;
+        let kept = within_budget(&mut g, allowed, |g| g.parse("x + 1"));
         assert!(kept.is_ok());
-        let grown = within_budget(&mut g, |g| {
+        let grown = within_budget(&mut g, allowed, |g| {
             let mut last = g.int(0)?;
-            for k in 0..(GROWTH_LIMIT * before.max(10_000) + 10) {
+            for k in 0..(allowed + before + 10) {
                 last = g.parse(&format!("x^{}", k + 2))?;
             }
             Ok(last)
         });
         let reason = grown.expect_err("past the budget");
-        assert!(reason.contains("more than"), "{reason}");
+        assert!(reason.contains("would add more than"), "{reason}");
+        // The graph's own limit is back.
+        assert_eq!(
+            g.limits().max_nodes,
+            appell_symbolic::Limits::default().max_nodes
+        );
     }
 }

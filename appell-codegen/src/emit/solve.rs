@@ -145,6 +145,7 @@ impl Emitter<'_> {
         }
         let mut c = code_with(&self.model.g, &all, &o);
         let eo: Vec<TokenStream> = c.outputs.drain(..head).collect();
+        c.zero.drain(..head);
         let width = cols.len();
         let entry = |i: usize, j: usize| !self.model.g.is_zero(ne.s[i * m + j]);
         let solver = Solver {
@@ -189,10 +190,10 @@ impl Emitter<'_> {
 
 /// Solves with S: its singleton rows one by one, then its remaining block
 /// by LU.
-struct Solver<'a> {
-    order: SingletonOrder,
+pub(super) struct Solver<'a> {
+    pub(super) order: SingletonOrder,
     /// Whether S's entry (i, j) can be non-zero.
-    entry: &'a dyn Fn(usize, usize) -> bool,
+    pub(super) entry: &'a dyn Fn(usize, usize) -> bool,
 }
 
 impl Solver<'_> {
@@ -203,7 +204,7 @@ impl Solver<'_> {
     /// multiplies by it). `factor` factors the block (the first solve);
     /// later solves reuse `__sb` and `__swaps`. Returns the statements and
     /// their operation count.
-    fn solve(
+    pub(super) fn solve(
         &self,
         rhs: &str,
         w: usize,

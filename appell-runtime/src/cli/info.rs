@@ -47,6 +47,7 @@ use serde_json::{json, Value};
 /// assert_eq!(info["state"], serde_json::json!(["phi", "phi_dot"]));
 /// assert_eq!(info["rhs_ops"]["total"], 1);
 /// assert_eq!(info["rhs_ops"]["other"], 0);
+/// assert_eq!(info["jacobian"], serde_json::Value::Null);
 /// ```
 pub fn info_json<M: Model>(model: &M) -> Result<Value, ModelError> {
     info_json_dyn(model)
@@ -126,5 +127,6 @@ pub(super) fn info_json_dyn(model: &dyn DynModel) -> Result<Value, ModelError> {
             "other": ops.total.saturating_sub(ops.add + ops.mul + ops.div + ops.calls),
             "total": ops.total,
         },
+        "jacobian": info.jacobian.map(|j| json!({ "form": j.form, "ops": j.ops.total })),
     }))
 }

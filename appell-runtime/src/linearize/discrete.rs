@@ -3,11 +3,13 @@
 //! Jacobians ∂x⁺/∂x and ∂x⁺/∂u in one call: what a discrete-time MPC or
 //! DDP solver linearizes at every knot.
 //!
-//! The step is written once over any [`Scalar`], so [`step_jacobian`] runs
-//! the very step [`fixed_step`] takes in [`Dual64`], one pass per state
-//! component and input: the Jacobians are those of the map the controller
-//! integrates, exact to rounding (no finite differences, and no
-//! continuous-time Jacobian turned discrete by an approximation).
+//! The Jacobians are those of the map the controller integrates, exact to
+//! rounding (no finite differences, and no continuous-time Jacobian turned
+//! discrete by an approximation): where the model has a generated
+//! [`Model::rhs_jacobian`], [`step_jacobian`] carries each stage's A and B
+//! through the step by the chain rule; elsewhere it runs the very step
+//! [`fixed_step`] takes (written once over any [`Scalar`]) in [`Dual64`],
+//! one pass per state component and input.
 
 use nalgebra::DMatrix;
 use num_dual::Dual64;
@@ -280,6 +282,18 @@ pub fn step_jacobian<M: Model>(
     model.validate()?;
     let next = fixed_step(model, &model.prepare::<f64>(), method, t, h, state, inputs)?;
 
+    if info.jacobian.is_some() {
+        let (a, b) = chained(model, method, t, h, state, inputs)?;
+        finite(a.as_slice(), "the state Jacobian")?;
+        finite(b.as_slice(), "the input Jacobian")?;
+        return Ok(StepLinearization {
+            next,
+            a,
+            b,
+            state_names: state_names(info),
+            input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
+        });
+    }
     let prepared = model.prepare::<Dual64>();
     let (td, hd) = (Dual64::from_re(t), Dual64::from_re(h));
     let (_, a, b) = dual_columns(state, inputs, |x, w| {
@@ -294,4 +308,85 @@ pub fn step_jacobian<M: Model>(
         state_names: state_names(info),
         input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
     })
+}
+
+/// ∂x⁺/∂x and ∂x⁺/∂u of one step by the chain rule through its stages,
+/// each stage's A and B from the model's generated
+/// [`Model::rhs_jacobian`] (the inputs held over the step).
+fn chained<M: Model>(
+    model: &M,
+    method: FixedStep,
+    t: f64,
+    h: f64,
+    x: &[f64],
+    w: &[f64],
+) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
+    let (s, ni) = (x.len(), w.len());
+    let eval = |t: f64, y: &[f64]| -> Result<Stage, ModelError> {
+        let (mut v, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
+        model.rhs_jacobian(t, y, w, &mut v, &mut a, &mut b)?;
+        Ok(Stage {
+            rates: v,
+            a: DMatrix::from_row_slice(s, s, &a),
+            b: DMatrix::from_row_slice(s, ni, &b),
+        })
+    };
+    let id = DMatrix::<f64>::identity(s, s);
+    let along = |y: &[f64], k: &[f64], c: f64| -> Vec<f64> {
+        y.iter().zip(k).map(|(y, k)| y + c * k).collect()
+    };
+    match method {
+        FixedStep::Rk4 => {
+            let half = 0.5 * h;
+            // Stage i: k_i = f(y_i), ∂k_i = A_i ∂y_i (+ B_i for the inputs).
+            let k1 = eval(t, x)?;
+            let k2 = eval(t + half, &along(x, &k1.rates, half))?;
+            let (k2x, k2u) = (&k2.a * (&id + &k1.a * half), &k2.a * (&k1.b * half) + &k2.b);
+            let k3 = eval(t + half, &along(x, &k2.rates, half))?;
+            let (k3x, k3u) = (&k3.a * (&id + &k2x * half), &k3.a * (&k2u * half) + &k3.b);
+            let k4 = eval(t + h, &along(x, &k3.rates, h))?;
+            let (k4x, k4u) = (&k4.a * (&id + &k3x * h), &k4.a * (&k3u * h) + &k4.b);
+            let sixth = h / 6.0;
+            Ok((
+                &id + (&k1.a + (k2x + k3x) * 2.0 + k4x) * sixth,
+                (&k1.b + (k2u + k3u) * 2.0 + k4u) * sixth,
+            ))
+        }
+        FixedStep::SemiImplicitEuler => {
+            let r = M::info().retained.len();
+            // The speeds first: u⁺ = u + h u̇(x); y = (q, u⁺).
+            let first = eval(t, x)?;
+            let mut y = x.to_vec();
+            let (mut dy_x, mut dy_u) = (id.clone(), DMatrix::<f64>::zeros(s, ni));
+            for i in r..s {
+                y[i] = x[i] + h * first.rates[i];
+                for j in 0..s {
+                    dy_x[(i, j)] += h * first.a[(i, j)];
+                }
+                for j in 0..ni {
+                    dy_u[(i, j)] = h * first.b[(i, j)];
+                }
+            }
+            // Then the coordinates at the new speeds: q⁺ = q + h q̇(y).
+            let second = eval(t, &y)?;
+            let (through_x, through_u) = (&second.a * &dy_x, &second.a * &dy_u + &second.b);
+            let (mut ax, mut bu) = (dy_x, dy_u);
+            for i in 0..r {
+                for j in 0..s {
+                    ax[(i, j)] = id[(i, j)] + h * through_x[(i, j)];
+                }
+                for j in 0..ni {
+                    bu[(i, j)] = h * through_u[(i, j)];
+                }
+            }
+            Ok((ax, bu))
+        }
+    }
+}
+
+/// One stage's rates and their Jacobians.
+struct Stage {
+    rates: Vec<f64>,
+    a: DMatrix<f64>,
+    b: DMatrix<f64>,
 }
