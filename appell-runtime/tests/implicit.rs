@@ -47,7 +47,6 @@ const fn info(
             total: 0,
         },
         jacobian: None,
-        jacobian: None,
         equations: "",
     }
 }

@@ -213,7 +213,6 @@ const BASE_INFO: ModelInfo = ModelInfo {
     symbolic_elimination: true,
     rhs_ops: NO_OPS,
     jacobian: None,
-    jacobian: None,
     equations: "",
 };
 
