@@ -177,7 +177,9 @@ fn worst(a: &[Vec<f64>], b: &[Vec<f64>]) -> f64 {
         .zip(b)
         .flat_map(|(x, y)| {
             assert_eq!(x.len(), y.len());
-            x.iter().zip(y).map(|(p, q)| (p - q).abs() / (1.0 + q.abs()))
+            x.iter()
+                .zip(y)
+                .map(|(p, q)| (p - q).abs() / (1.0 + q.abs()))
         })
         .fold(0.0, f64::max)
 }
