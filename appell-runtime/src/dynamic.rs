@@ -108,13 +108,16 @@ pub trait DynRhs {
     ) -> Result<(), ModelError>;
 
     /// ∂rhs/∂state (row-major n×n into `a`) by the model's generated
-    /// [`Model::rhs_jacobian`]; `Ok(false)` where it has none.
+    /// [`Model::rhs_jacobian`], `values` (n) and `b` (n × inputs) its
+    /// other outputs; `Ok(false)` where it has none.
     fn generated_jacobian(
         &self,
         t: f64,
         state: &[f64],
         inputs: &[f64],
+        values: &mut [f64],
         a: &mut [f64],
+        b: &mut [f64],
     ) -> Result<bool, ModelError>;
 
     /// Calls [`DynRhs::rhs`] at `t` on every `(state, inputs)` of `cases`
@@ -172,22 +175,14 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
         t: f64,
         state: &[f64],
         inputs: &[f64],
+        values: &mut [f64],
         a: &mut [f64],
+        b: &mut [f64],
     ) -> Result<bool, ModelError> {
         if M::info().jacobian.is_none() {
             return Ok(false);
         }
-        let (n, ni) = (state.len(), inputs.len());
-        // Small states (the implicit integrators' usual) on the stack.
-        let (mut values, mut b) = ([0.0; 64], [0.0; 256]);
-        if n <= 64 && n * ni <= 256 {
-            let (values, b) = (&mut values[..n], &mut b[..n * ni]);
-            self.model.rhs_jacobian(t, state, inputs, values, a, b)?;
-        } else {
-            let (mut values, mut b) = (vec![0.0; n], vec![0.0; n * ni]);
-            self.model
-                .rhs_jacobian(t, state, inputs, &mut values, a, &mut b)?;
-        }
+        self.model.rhs_jacobian(t, state, inputs, values, a, b)?;
         Ok(true)
     }
 
@@ -218,9 +213,11 @@ pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
     let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
     let mut xd = vec![Dual64::from_re(0.0); n];
     let mut outd = vec![Dual64::from_re(0.0); n];
+    // The generated Jacobian's other outputs, allocated once.
     let real_inputs = inputs.to_vec();
+    let (mut values, mut b) = (vec![0.0; n], vec![0.0; n * inputs.len()]);
     move |t: f64, x: &[f64], j: &mut [f64]| {
-        if rhs.generated_jacobian(t, x, &real_inputs, j)? {
+        if rhs.generated_jacobian(t, x, &real_inputs, &mut values, j, &mut b)? {
             return Ok(());
         }
         let td = Dual64::from_re(t);

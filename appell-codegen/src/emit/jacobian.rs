@@ -579,19 +579,6 @@ impl Emitter<'_> {
         body: TokenStream,
     ) -> TokenStream {
         let p = p();
-        let retained = &self.d.reduction.retained;
-        let g = &self.model.g;
-        let state_q = retained.iter().enumerate().map(|(k, &r)| {
-            let (q, k) = (self.coord(r), int(k));
-            quote!(let #q = __state[#k];)
-        });
-        let state_u = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
-            let (u, k) = (
-                self.ident(g.symbol_name(spec.symbol)),
-                int(retained.len() + k),
-            );
-            quote!(let #u = __state[#k];)
-        });
         let (s, ni) = (layout.states, layout.inputs);
         let checks = [
             self.check("__state", s),
@@ -603,10 +590,11 @@ impl Emitter<'_> {
         let (params_t, pos, bind_inputs) =
             (&common.params_t, &common.positivity, &common.bind_inputs);
         let quaternions = self.quaternion_length_checks();
+        let bind_state = self.bind_state();
         let diagnose = self.non_finite_diagnosis();
         let closure_body = braced([
             quote! {
-                #params_t #(#state_q)* #(#state_u)* #bind_inputs #quaternions
+                #params_t #bind_state #bind_inputs #quaternions
                 for __v in __a.iter_mut().chain(__b.iter_mut()) {
                     *__v = <__T as #p::Scalar>::zero();
                 }

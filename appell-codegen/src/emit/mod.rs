@@ -193,6 +193,25 @@ impl Emitter<'_> {
         quote!(#(#binds)*)
     }
 
+    /// `let q = __state[k];` for every retained coordinate, then `let u =
+    /// __state[k];` for every privileged speed: the reduced state bound.
+    fn bind_state(&self) -> TokenStream {
+        let retained = &self.d.reduction.retained;
+        let g = &self.model.g;
+        let state_q = retained.iter().enumerate().map(|(k, &r)| {
+            let (q, k) = (self.coord(r), int(k));
+            quote!(let #q = __state[#k];)
+        });
+        let state_u = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
+            let (u, k) = (
+                self.ident(g.symbol_name(spec.symbol)),
+                int(retained.len() + k),
+            );
+            quote!(let #u = __state[#k];)
+        });
+        quote!(#(#state_q)* #(#state_u)*)
+    }
+
     /// `let input_k = slice[k];` for every input.
     fn bind_inputs(&self, slice: &str) -> TokenStream {
         let slice = self.ident(slice);

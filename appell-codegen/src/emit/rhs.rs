@@ -222,18 +222,6 @@ impl Emitter<'_> {
     ) -> (TokenStream, TokenStream) {
         let p = p();
         let retained = &self.d.reduction.retained;
-        let g = &self.model.g;
-        let state_q = retained.iter().enumerate().map(|(k, &r)| {
-            let (q, k) = (self.coord(r), int(k));
-            quote!(let #q = __state[#k];)
-        });
-        let state_u = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
-            let (u, k) = (
-                self.ident(g.symbol_name(spec.symbol)),
-                int(retained.len() + k),
-            );
-            quote!(let #u = __state[#k];)
-        });
         let ns = retained.len() + self.d.l;
         let finite = if ns == 0 {
             quote!(true)
@@ -256,6 +244,7 @@ impl Emitter<'_> {
         ];
         let diagnose = self.non_finite_diagnosis();
         let quaternions = self.quaternion_length_checks();
+        let bind_state = self.bind_state();
         let prepare = quote! {
             fn prepare<__T: #p::Scalar>(&self) -> [__T; #hi] {
                 #params_t #prepare_statements
@@ -265,7 +254,7 @@ impl Emitter<'_> {
         let closure_body = braced([
             quote! {
                 let [#(#names),*] = *__prepared;
-                #params_t #(#state_q)* #(#state_u)* #bind_inputs #quaternions
+                #params_t #bind_state #bind_inputs #quaternions
             },
             pieces.body,
             quote! {

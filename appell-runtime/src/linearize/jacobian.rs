@@ -62,26 +62,17 @@ pub fn linearize<M: Model>(
     inputs: &[f64],
 ) -> Result<Linearization, ModelError> {
     let info = M::info();
-    let s = info.state_len();
-    let ni = info.inputs.len();
-    check_len("state", state, s)?;
-    check_len("inputs", inputs, ni)?;
-    finite(&[t], "t")?;
-    finite(state, "state")?;
-    finite(inputs, "inputs")?;
-    model.validate()?;
-
-    if info.jacobian.is_some() {
-        let (mut values, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
-        model.rhs_jacobian(t, state, inputs, &mut values, &mut a, &mut b)?;
-        return Ok(Linearization {
-            a: DMatrix::from_row_slice(s, s, &a),
-            b: DMatrix::from_row_slice(s, ni, &b),
-            state_names: state_names(info),
-            input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
-        });
+    let (s, ni) = checked_point(model, t, state, inputs)?;
+    if info.jacobian.is_none() {
+        return dual_columns_of(model, t, state, inputs);
     }
-    dual_linearize(model, t, state, inputs)
+    let (mut values, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
+    model.rhs_jacobian(t, state, inputs, &mut values, &mut a, &mut b)?;
+    Ok(linearization(
+        info,
+        DMatrix::from_row_slice(s, s, &a),
+        DMatrix::from_row_slice(s, ni, &b),
+    ))
 }
 
 /// [`linearize`] by dual numbers through the generated rhs whether or not
@@ -137,15 +128,38 @@ pub fn dual_linearize<M: Model>(
     state: &[f64],
     inputs: &[f64],
 ) -> Result<Linearization, ModelError> {
+    checked_point(model, t, state, inputs)?;
+    dual_columns_of(model, t, state, inputs)
+}
+
+/// Checks the lengths and finiteness of a point and the model's
+/// parameters; returns the state's and the inputs' lengths.
+fn checked_point<M: Model>(
+    model: &M,
+    t: f64,
+    state: &[f64],
+    inputs: &[f64],
+) -> Result<(usize, usize), ModelError> {
     let info = M::info();
-    let s = info.state_len();
-    let ni = info.inputs.len();
+    let (s, ni) = (info.state_len(), info.inputs.len());
     check_len("state", state, s)?;
     check_len("inputs", inputs, ni)?;
     finite(&[t], "t")?;
     finite(state, "state")?;
     finite(inputs, "inputs")?;
     model.validate()?;
+    Ok((s, ni))
+}
+
+/// A and B by one [`Dual64`] evaluation of the rhs per column, at a
+/// checked point.
+fn dual_columns_of<M: Model>(
+    model: &M,
+    t: f64,
+    state: &[f64],
+    inputs: &[f64],
+) -> Result<Linearization, ModelError> {
+    let s = state.len();
     let prepared = model.prepare::<Dual64>();
     let td = Dual64::from_re(t);
     let (_, a, b) = dual_columns(state, inputs, |x, w| {
@@ -154,12 +168,17 @@ pub fn dual_linearize<M: Model>(
     })?;
     finite(a.as_slice(), "the state Jacobian")?;
     finite(b.as_slice(), "the input Jacobian")?;
-    Ok(Linearization {
+    Ok(linearization(M::info(), a, b))
+}
+
+/// A and B with the model's state and input names.
+fn linearization(info: &ModelInfo, a: DMatrix<f64>, b: DMatrix<f64>) -> Linearization {
+    Linearization {
         a,
         b,
         state_names: state_names(info),
         input_names: info.inputs.iter().map(|s| s.to_string()).collect(),
-    })
+    }
 }
 
 /// The values of y = f(x, u) (as many components as x) at (`state`,
