@@ -4,7 +4,9 @@
 //! Panda with `jacobian(on)`: the closed form's and the structured form's
 //! derivatives), rolling contacts (the wheel-axle and two of its scenes)
 //! and numeric eliminations of the dependent speeds (the four-bar, the
-//! Chaplygin sleigh, the Whipple bicycle).
+//! Chaplygin sleigh, the Whipple bicycle); and the rhs in dual numbers
+//! where the derive writes no symbolic derivatives (the mobile manipulator,
+//! an 8-link chain).
 
 #[path = "../examples/models/chaplygin_sleigh.rs"]
 mod chaplygin_sleigh;
@@ -13,6 +15,8 @@ mod common;
 mod double_pendulum;
 #[path = "../examples/models/four_bar.rs"]
 mod four_bar;
+#[path = "../examples/models/mobile_manipulator.rs"]
+mod mobile_manipulator;
 #[path = "../examples/models/ur5.rs"]
 mod ur5;
 #[path = "../examples/models/wheel_axle.rs"]
@@ -34,6 +38,19 @@ use common::Rng;
 ))]
 #[appell(gravity(-9.81 * N.z), jacobian(on))]
 struct Panda;
+
+/// `SpatialChain8` of `examples/models/spatial_chain.rs` (that file's
+/// 32- and 64-link chains would take minutes to build here).
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(joint(j[1], revolute(z), parent = N, child = link[1], actuated))]
+#[appell(repeat(k in 2..=8,
+    repeat(even in 0..1 - k % 2, joint(j[k], revolute(y), parent = link[k - 1], child = link[k], xyz = [0, 0, 0.5], actuated)),
+    repeat(odd in 0..k % 2, joint(j[k], revolute(z), parent = link[k - 1], child = link[k], xyz = [0, 0, 0.5], actuated))))]
+#[appell(repeat(k in 1..=8, body(link[k], frame = link[k], mass = 1 + 0.1 * k,
+    center = origin(link[k]) + 0.05 * link[k].x + 0.02 * link[k].y + 0.25 * link[k].z,
+    inertia = matrix(0.02 + 0.001 * k, 0.03 + 0.001 * k, 0.01 + 0.001 * k, 0.001, 0.0015, -0.002))))]
+#[appell(gravity(-9.81 * N.z))]
+struct SpatialChain8;
 
 /// Two particles on a double pendulum, with a generated Jacobian and
 /// without.
@@ -201,6 +218,30 @@ fn numeric_eliminations_agree() {
     assert_agrees(&four_bar, 11);
     assert_agrees(&chaplygin_sleigh::ChaplyginSleigh::default(), 12);
     assert_agrees(&whipple_bicycle::WhippleBicycle::default(), 13);
+}
+
+/// Models whose symbolic derivatives the derive does not write by default
+/// get the rhs in dual numbers, and `info` says so with its cost.
+#[test]
+fn dual_number_jacobians_agree() {
+    let manipulator = mobile_manipulator::MobileManipulator::default();
+    assert_agrees(&manipulator, 14);
+    assert_agrees(&SpatialChain8, 15);
+    for info in [
+        mobile_manipulator::MobileManipulator::info(),
+        SpatialChain8::info(),
+    ] {
+        let j = info.jacobian.unwrap();
+        assert!(j.form.starts_with("dual numbers: "), "{}", j.form);
+        // More than one dual pass costs more than the rhs.
+        assert!(j.ops.total > 2 * info.rhs_ops.total, "{:?}", j.ops);
+    }
+    // The 8-link chain: 15 states (the first joint's angle is cyclic) and
+    // 8 torques in 3 passes of 8.
+    let chain = SpatialChain8::info();
+    assert_eq!((chain.state_len(), chain.inputs.len()), (15, 8));
+    let form = chain.jacobian.unwrap().form;
+    assert!(form.contains("3 passes of 8 directions over the 23 columns"), "{form}");
 }
 
 #[test]

@@ -26,6 +26,10 @@ pub mod conditioning;
 pub mod constraint_forces;
 #[cfg(feature = "std")]
 pub mod contact_watch;
+#[doc(hidden)]
+#[path = "doc_model.rs"]
+pub mod __doc_model;
+pub mod dual;
 #[cfg(feature = "std")]
 pub mod dynamic;
 #[cfg(feature = "std")]
@@ -92,6 +96,7 @@ pub mod __private {
         check_pivot, constraint_scale, ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs,
         pivot_margin,
     };
+    pub use crate::dual::{pass_costs, rhs_jacobian_by_duals};
     pub use crate::model::check_len;
     pub use crate::physical::check_body;
     pub use crate::{

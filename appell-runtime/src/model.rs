@@ -34,9 +34,11 @@ pub struct OpCounts {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct JacobianInfo {
     /// What is differentiated: `closed form: ...` (∂M and ∂f, and
-    /// ∂ÿ = M⁻¹ (∂f − ∂M ÿ) with M factored once) or `structured: ...`
+    /// ∂ÿ = M⁻¹ (∂f − ∂M ÿ) with M factored once), `structured: ...`
     /// (the unrolled articulated-body algorithm differentiated), with the
-    /// operation counts the derive compared.
+    /// operation counts the derive compared, or `dual numbers: ...` (the
+    /// rhs evaluated in dual numbers, so many directions a pass, and why
+    /// not symbolically).
     pub form: &'static str,
     /// Operations per call, the values of the rhs included.
     pub ops: OpCounts,
@@ -195,8 +197,9 @@ pub struct ModelInfo {
     pub rhs_ops: OpCounts,
     /// The generated Jacobian of the reduced rhs
     /// ([`Model::rhs_jacobian`]): how it is computed and what it costs;
-    /// `None` where the model has none (tools then run the rhs in dual
-    /// numbers, one evaluation per column).
+    /// `None` where the model has none (`jacobian(off)`, or written by
+    /// hand: tools then run the rhs in dual numbers, one evaluation per
+    /// column).
     pub jacobian: Option<JacobianInfo>,
     /// The derived reduced equations, as text.
     pub equations: &'static str,
@@ -579,12 +582,15 @@ pub trait Model {
     /// row-major, i the number of [inputs](ModelInfo::inputs)). Parameters
     /// and time are held fixed.
     ///
-    /// The derive generates it where it can differentiate the model's
-    /// equations symbolically ([`ModelInfo::jacobian`] says how, and what
-    /// it costs); it needs no [`Model::prepare`], allocates nothing and
-    /// runs on any [`Scalar`]. Where there is none this returns
-    /// [`ModelError::NotGenerated`], and [`linearize`](crate::linearize)
-    /// falls back to dual numbers. Errors otherwise as [`Model::rhs`]'s, and
+    /// The derive generates it for every model, choosing by cost between
+    /// the model's equations differentiated symbolically and the rhs run
+    /// in dual numbers ([`dual::rhs_jacobian_by_duals`](crate::dual::rhs_jacobian_by_duals));
+    /// [`ModelInfo::jacobian`] says which, and what it costs. It needs no
+    /// [`Model::prepare`], allocates nothing and runs on any [`Scalar`].
+    /// A model with `jacobian(off)`, and one written by hand that does not
+    /// implement it, return [`ModelError::NotGenerated`] (this default),
+    /// and [`linearize`](crate::linearize) then runs the rhs in dual
+    /// numbers itself. Errors otherwise as [`Model::rhs`]'s, and
     /// [`ModelError::NonFinite`] naming the Jacobian when a derivative is
     /// not finite.
     fn rhs_jacobian<T: Scalar>(

@@ -102,7 +102,22 @@ impl Emitter<'_> {
         );
         let total = int(rhs_ops.total() + extra_ops);
         let text = format!("rhs: {form}\njacobian: {}\n\n{}", jacobian.summary, d.text);
-        let jacobian = &jacobian.info;
+        let jacobian = match jacobian.dual {
+            Some((width, passes)) => {
+                let (form, w, n) = (&jacobian.summary, int(width), int(passes));
+                quote! {
+                    ::core::option::Option::Some(#p::JacobianInfo {
+                        form: #form,
+                        ops: #p::pass_costs(
+                            #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
+                            #w,
+                            #n,
+                        ),
+                    })
+                }
+            }
+            None => jacobian.info.clone(),
+        };
         quote! {
             #p::ModelInfo {
                 name: #name,

@@ -1,13 +1,16 @@
 //! `rhs_jacobian`: the reduced rhs and its Jacobians A = ∂rhs/∂state and
 //! B = ∂rhs/∂inputs in one call, from stage 14's derivatives.
 //!
-//! Of the two candidates the one with fewer operations per call is
-//! written: the closed form (one program for M, f, q̇ and their
-//! derivatives; M factored once by LDLᵀ; ÿ, then each column
-//! ∂ÿ/∂c = M⁻¹ (∂f/∂c − (∂M/∂c) ÿ) by the same factors), or the
-//! structured form (one program for the articulated-body algorithm's ÿ and
-//! its derivatives). Parameter-only work is not hoisted: the function
-//! needs no `Prepared`.
+//! Of three candidates the cheapest is written: the closed form (one
+//! program for M, f, q̇ and their derivatives; M factored once by LDLᵀ; ÿ,
+//! then each column ∂ÿ/∂c = M⁻¹ (∂f/∂c − (∂M/∂c) ÿ) by the same factors),
+//! the structured form (one program for the articulated-body algorithm's ÿ
+//! and its derivatives), or dual numbers (the model's own rhs evaluated in
+//! W-wide dual numbers, ⌈columns / W⌉ times, by the runtime's
+//! `rhs_jacobian_by_duals`: no code of its own). The symbolic ones are
+//! compared by their distinct expressions against the rhs's; dual numbers
+//! cost about 1 + 2W expressions per rhs expression and pass. Parameter-only
+//! work is not hoisted: the function needs no `Prepared`.
 
 use appell_symbolic::{Id, OpCount};
 use proc_macro2::TokenStream;
@@ -24,8 +27,12 @@ use crate::derivation::{singleton_rows, Elimination, NumericElimination};
 pub(super) struct JacobianParts {
     /// `fn rhs_jacobian`, or nothing (the trait's default).
     pub function: TokenStream,
-    /// `Some(JacobianInfo { .. })` or `None`.
+    /// `Some(JacobianInfo { .. })` or `None`; for dual numbers the info
+    /// is written with the rhs's operation counts (see `dual`).
     pub info: TokenStream,
+    /// Dual numbers: (width W, passes), whose cost `ModelInfo` states from
+    /// the rhs's counts.
+    pub dual: Option<(usize, usize)>,
     /// How it is computed, or why there is none, for the equations text.
     pub summary: String,
 }
@@ -86,17 +93,21 @@ impl Emitter<'_> {
     /// says `jacobian(on)`) where the chosen one has more than
     /// [`SIZE_LIMIT`] times the expressions of the values it differentiates.
     pub(super) fn jacobian(&self, common: &super::functions::Common) -> JacobianParts {
-        let none = |why: String| JacobianParts {
-            function: TokenStream::new(),
-            info: quote!(::core::option::Option::None),
-            summary: format!("none ({why}; tools use dual numbers through the rhs)"),
-        };
-        let Some(j) = &self.d.jacobians else {
-            return none("not derived".to_string());
-        };
         if self.model.jacobian == Some(false) {
-            return none("turned off by `jacobian(off)`".to_string());
+            return JacobianParts {
+                function: TokenStream::new(),
+                info: quote!(::core::option::Option::None),
+                dual: None,
+                summary: "none (turned off by `jacobian(off)`; tools use dual numbers through the rhs)"
+                    .to_string(),
+            };
         }
+        let (width, passes) = self.dual_shape();
+        // Expressions per rhs expression, over all passes (see the module).
+        let dual_ratio = passes * (1 + 2 * width);
+        let Some(j) = &self.d.jacobians else {
+            return self.dual_parts("not derived".to_string());
+        };
         let layout = self.layout(j);
         let g = &self.model.g;
         // Each candidate's roots (values first) and its size against its
@@ -135,15 +146,22 @@ impl Emitter<'_> {
             (None, None) => {
                 let c = j.closed.as_ref().err().cloned().unwrap_or_default();
                 let s = j.structured.as_ref().err().cloned().unwrap_or_default();
-                return none(format!("closed form: {c}; structured: {s}"));
+                return self.dual_parts(format!("closed form: {c}; structured: {s}"));
             }
         };
         let (total, values) = if use_closed { sizes.0 } else { sizes.1 }.expect("a candidate");
         let other = if use_closed { sizes.1 } else { sizes.0 };
-        if self.model.jacobian != Some(true) && total > SIZE_LIMIT * values.max(1) {
-            return none(format!(
-                "its {total} expressions are more than {SIZE_LIMIT} times the rhs's {values}; `jacobian(on)` writes it"
-            ));
+        if self.model.jacobian != Some(true) {
+            if total > SIZE_LIMIT * values.max(1) {
+                return self.dual_parts(format!(
+                    "symbolic: its {total} expressions are more than {SIZE_LIMIT} times the rhs's {values}; `jacobian(on)` writes it"
+                ));
+            }
+            if total > dual_ratio * values.max(1) {
+                return self.dual_parts(format!(
+                    "symbolic: its {total} expressions are more than the dual passes' {dual_ratio} times the rhs's {values}"
+                ));
+            }
         }
         let chosen = if use_closed {
             let (roots, c) = closed.expect("closed roots");
@@ -179,7 +197,41 @@ impl Emitter<'_> {
         JacobianParts {
             function: self.jacobian_function(common, &layout, chosen.body),
             info,
+            dual: None,
             summary: form,
+        }
+    }
+
+    /// The dual numbers' width W (at most 8 directions a pass, so that a
+    /// large rhs's temporaries stay small) and passes over the columns.
+    fn dual_shape(&self) -> (usize, usize) {
+        let columns = self.d.reduction.retained.len() + self.d.l + self.inputs().len();
+        let width = columns.clamp(1, 8);
+        (width, columns.div_ceil(width).max(1))
+    }
+
+    /// `rhs_jacobian` as the runtime's `rhs_jacobian_by_duals` over this
+    /// implementation's state and inputs; `why` says why not symbolic.
+    fn dual_parts(&self, why: String) -> JacobianParts {
+        let p = p();
+        let (width, passes) = self.dual_shape();
+        let (s, i) = (self.d.reduction.retained.len() + self.d.l, self.inputs().len());
+        let (su, iu, wu) = (int(s), int(i), int(width));
+        let function = quote! {
+            fn rhs_jacobian<__T: #p::Scalar>(&self, t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T], __a: &mut [__T], __b: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #p::rhs_jacobian_by_duals::<Self, __T, #su, #iu, #wu>(self, t, __state, __inputs, __dstate, __a, __b)
+            }
+        };
+        let plural = if passes == 1 { "" } else { "es" };
+        let summary = format!(
+            "dual numbers: the rhs in {passes} pass{plural} of {width} directions over the {} columns ({why})",
+            s + i
+        );
+        JacobianParts {
+            function,
+            info: TokenStream::new(),
+            dual: Some((width, passes)),
+            summary,
         }
     }
 

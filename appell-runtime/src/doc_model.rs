@@ -1,0 +1,205 @@
+//! A model written by hand, for the runtime's documentation examples: the
+//! runtime cannot use the derive, and one model shared by the examples is
+//! easier to trust than one hidden in each. Not part of the API.
+
+use crate::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+
+/// A driven pendulum, θ̈ = −(g/l) sin θ + τ: coordinate θ, speed θ̇, input
+/// τ (a torque per unit inertia), parameter `g_over_l`.
+#[derive(Clone, Copy, Debug)]
+pub struct Pendulum {
+    /// g / l.
+    pub g_over_l: f64,
+}
+
+static INFO: ModelInfo = ModelInfo {
+    name: "Pendulum",
+    parameters: &["g_over_l"],
+    coordinates: &["theta"],
+    speeds: &["theta"],
+    dependent: &[],
+    cyclic: &[],
+    ignorable: &[],
+    retained: &["theta"],
+    inputs: &["tau"],
+    effects: &[],
+    outputs: &[],
+    holonomic: 0,
+    constraints: 0,
+    row_sources: &[],
+    contacts: &[],
+    bodies: &[],
+    force_points: 0,
+    torques: 0,
+    form: "closed form, written by hand",
+    symbolic_elimination: true,
+    rhs_ops: OpCounts {
+        add: 1,
+        mul: 1,
+        div: 0,
+        calls: 1,
+        total: 4,
+    },
+    jacobian: None,
+    equations: "theta'' = -g_over_l sin(theta) + tau",
+};
+
+/// M = 1 and f = −(g/l) sin θ + τ at (q, u, inputs).
+fn forcing<T: Scalar>(g_over_l: T, q: &[T], inputs: &[T]) -> T {
+    -g_over_l * q[0].sin() + inputs[0]
+}
+
+impl Model for Pendulum {
+    type Prepared<T: Scalar> = T;
+
+    fn info() -> &'static ModelInfo {
+        &INFO
+    }
+
+    fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
+        crate::check_len("out", out, 1)?;
+        out[0] = self.g_over_l;
+        Ok(())
+    }
+
+    fn set_parameter(&mut self, name: &str, value: f64) -> bool {
+        let known = name == "g_over_l";
+        if known {
+            self.g_over_l = value;
+        }
+        known
+    }
+
+    fn prepare<T: Scalar>(&self) -> T {
+        T::from_f64(self.g_over_l)
+    }
+
+    fn rhs<T: Scalar>(
+        &self,
+        g_over_l: &T,
+        _t: T,
+        state: &[T],
+        inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("state", state, 2)?;
+        crate::check_len("inputs", inputs, 1)?;
+        crate::check_len("dstate", dstate, 2)?;
+        dstate[0] = state[1];
+        dstate[1] = forcing(*g_over_l, state, inputs);
+        Ok(())
+    }
+
+    fn mass_matrix_and_forcing<T: Scalar>(
+        &self,
+        _t: T,
+        q: &[T],
+        _u: &[T],
+        inputs: &[T],
+        m: &mut [T],
+        f: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("q", q, 1)?;
+        crate::check_len("inputs", inputs, 1)?;
+        crate::check_len("m", m, 1)?;
+        crate::check_len("f", f, 1)?;
+        m[0] = T::one();
+        f[0] = forcing(T::from_f64(self.g_over_l), q, inputs);
+        Ok(())
+    }
+
+    fn speed_transform<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        c: &mut [T],
+        c0: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("c", c, 1)?;
+        crate::check_len("c0", c0, 1)?;
+        c[0] = T::one();
+        c0[0] = T::zero();
+        Ok(())
+    }
+
+    fn coordinate_rates<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        u: &[T],
+        qdot: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("u", u, 1)?;
+        crate::check_len("qdot", qdot, 1)?;
+        qdot[0] = u[0];
+        Ok(())
+    }
+
+    fn constraint_residuals<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _qdot: &[T],
+        _position: &mut [T],
+        _velocity: &mut [T],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    fn kinetic_energy<T: Scalar>(&self, _t: T, _q: &[T], u: &[T]) -> Result<T, ModelError> {
+        crate::check_len("u", u, 1)?;
+        Ok(T::from_f64(0.5) * u[0] * u[0])
+    }
+
+    fn mass_properties(
+        &self,
+        _masses: &mut [f64],
+        _inertias: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    fn body_poses<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _positions: &mut [[T; 3]],
+        _rotations: &mut [[T; 9]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    fn constraint_rows<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _d: &mut [T],
+        _d0: &mut [T],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// No forces or torques are declared: nothing to write.
+    fn load_geometry<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _points: &mut [[T; 3]],
+        _frames: &mut [[T; 9]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// No forces or torques are declared: nothing to write.
+    fn load_values<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _qdot: &[T],
+        _inputs: &[T],
+        _forces: &mut [[T; 3]],
+        _torques: &mut [[T; 3]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+}

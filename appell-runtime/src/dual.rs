@@ -1,0 +1,411 @@
+//! Forward-mode derivatives without `std`: [`DualVec`], a number that
+//! carries `W` directional derivatives beside its value over any
+//! [`Scalar`], and [`rhs_jacobian_by_duals`], the rhs's Jacobians from
+//! ⌈(s + i) / W⌉ passes of the model's own rhs in it.
+//!
+//! The derive writes `rhs_jacobian` this way for a model whose symbolic
+//! derivatives would cost more than the passes (or grow its code past the
+//! derive's bound): the generated code is one call here, so the model's
+//! code does not grow, and the Jacobian keeps everything the rhs has (no
+//! allocation, any scalar, `no_std`).
+
+use core::fmt::Debug;
+use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
+
+use crate::{Model, ModelError, OpCounts, Scalar};
+
+/// A value and `W` derivatives of it: `re + Σ eps[k] ε_k` with
+/// ε_j ε_k = 0. Arithmetic on it carries the derivatives along by the chain
+/// rule, so one evaluation of a function gives the function and `W` of its
+/// directional derivatives.
+///
+/// ```
+/// use appell_runtime::{dual::DualVec, Scalar};
+/// // x = 0.5 along the first direction, y = 2 along the second.
+/// let x = DualVec::<f64, 2>::variable(0.5, 0);
+/// let y = DualVec::<f64, 2>::variable(2.0, 1);
+/// let f = x.sin() * y;
+/// assert_eq!(f.re, 0.5_f64.sin() * 2.0);
+/// assert_eq!(f.eps, [0.5_f64.cos() * 2.0, 0.5_f64.sin()]);
+/// ```
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct DualVec<T, const W: usize> {
+    /// The value.
+    pub re: T,
+    /// The derivatives along each of the `W` directions.
+    pub eps: [T; W],
+}
+
+impl<T: Scalar, const W: usize> DualVec<T, W> {
+    /// A constant: `x` with zero derivatives.
+    #[inline(always)]
+    pub fn constant(x: T) -> Self {
+        DualVec {
+            re: x,
+            eps: [T::zero(); W],
+        }
+    }
+
+    /// `x` as the variable of direction `k` (derivative one there, zero
+    /// elsewhere); a constant when `k >= W`.
+    #[inline(always)]
+    pub fn variable(x: T, k: usize) -> Self {
+        let mut d = Self::constant(x);
+        if k < W {
+            d.eps[k] = T::one();
+        }
+        d
+    }
+
+    /// The value `f(re)` with derivatives `f'(re) · eps`.
+    #[inline(always)]
+    fn chain(self, value: T, slope: T) -> Self {
+        DualVec {
+            re: value,
+            eps: self.eps.map(|e| e * slope),
+        }
+    }
+}
+
+impl<T: Scalar, const W: usize> Add for DualVec<T, W> {
+    type Output = Self;
+    #[inline(always)]
+    fn add(mut self, o: Self) -> Self {
+        self += o;
+        self
+    }
+}
+
+impl<T: Scalar, const W: usize> Sub for DualVec<T, W> {
+    type Output = Self;
+    #[inline(always)]
+    fn sub(mut self, o: Self) -> Self {
+        self -= o;
+        self
+    }
+}
+
+impl<T: Scalar, const W: usize> Mul for DualVec<T, W> {
+    type Output = Self;
+    #[inline(always)]
+    fn mul(mut self, o: Self) -> Self {
+        self *= o;
+        self
+    }
+}
+
+impl<T: Scalar, const W: usize> Div for DualVec<T, W> {
+    type Output = Self;
+    #[inline(always)]
+    fn div(mut self, o: Self) -> Self {
+        self /= o;
+        self
+    }
+}
+
+impl<T: Scalar, const W: usize> Neg for DualVec<T, W> {
+    type Output = Self;
+    #[inline(always)]
+    fn neg(self) -> Self {
+        DualVec {
+            re: -self.re,
+            eps: self.eps.map(|e| -e),
+        }
+    }
+}
+
+impl<T: Scalar, const W: usize> AddAssign for DualVec<T, W> {
+    #[inline(always)]
+    fn add_assign(&mut self, o: Self) {
+        self.re += o.re;
+        for (e, f) in self.eps.iter_mut().zip(o.eps) {
+            *e += f;
+        }
+    }
+}
+
+impl<T: Scalar, const W: usize> SubAssign for DualVec<T, W> {
+    #[inline(always)]
+    fn sub_assign(&mut self, o: Self) {
+        self.re -= o.re;
+        for (e, f) in self.eps.iter_mut().zip(o.eps) {
+            *e -= f;
+        }
+    }
+}
+
+impl<T: Scalar, const W: usize> MulAssign for DualVec<T, W> {
+    #[inline(always)]
+    fn mul_assign(&mut self, o: Self) {
+        for (e, f) in self.eps.iter_mut().zip(o.eps) {
+            *e = f.fma(self.re, *e * o.re);
+        }
+        self.re *= o.re;
+    }
+}
+
+impl<T: Scalar, const W: usize> DivAssign for DualVec<T, W> {
+    #[inline(always)]
+    fn div_assign(&mut self, o: Self) {
+        // (a / b)' = (a' − (a / b) b') / b.
+        let inv = T::one() / o.re;
+        let q = self.re * inv;
+        for (e, f) in self.eps.iter_mut().zip(o.eps) {
+            *e = (*e - q * f) * inv;
+        }
+        self.re = q;
+    }
+}
+
+impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
+    #[inline(always)]
+    fn from_f64(x: f64) -> Self {
+        Self::constant(T::from_f64(x))
+    }
+    #[inline(always)]
+    fn re(self) -> f64 {
+        self.re.re()
+    }
+    #[inline(always)]
+    fn sin(self) -> Self {
+        self.chain(self.re.sin(), self.re.cos())
+    }
+    #[inline(always)]
+    fn cos(self) -> Self {
+        self.chain(self.re.cos(), -self.re.sin())
+    }
+    #[inline(always)]
+    fn tan(self) -> Self {
+        let t = self.re.tan();
+        self.chain(t, t.fma(t, T::one()))
+    }
+    #[inline(always)]
+    fn exp(self) -> Self {
+        let e = self.re.exp();
+        self.chain(e, e)
+    }
+    #[inline(always)]
+    fn ln(self) -> Self {
+        self.chain(self.re.ln(), T::one() / self.re)
+    }
+    #[inline(always)]
+    fn abs(self) -> Self {
+        if self.re.re() < 0.0 {
+            -self
+        } else {
+            self
+        }
+    }
+    #[inline(always)]
+    fn sqrt(self) -> Self {
+        let s = self.re.sqrt();
+        self.chain(s, T::from_f64(0.5) / s)
+    }
+    #[inline(always)]
+    fn powi(self, n: i32) -> Self {
+        if n == 0 {
+            return Self::one();
+        }
+        let below = self.re.powi(n - 1);
+        self.chain(below * self.re, T::from_f64(f64::from(n)) * below)
+    }
+    #[inline(always)]
+    fn atan2(self, x: Self) -> Self {
+        // d atan2(y, x) = (x dy − y dx) / (x² + y²).
+        let (y, r) = (self.re, x.re);
+        let inv = T::one() / r.fma(r, y * y);
+        let mut eps = self.eps;
+        for (e, f) in eps.iter_mut().zip(x.eps) {
+            *e = (r * *e - y * f) * inv;
+        }
+        DualVec {
+            re: y.atan2(r),
+            eps,
+        }
+    }
+    #[inline(always)]
+    fn fused_mul_add(self, a: Self, b: Self) -> Self {
+        let mut eps = b.eps;
+        for ((e, s), t) in eps.iter_mut().zip(self.eps).zip(a.eps) {
+            *e = self.re.fma(t, s.fma(a.re, *e));
+        }
+        DualVec {
+            re: self.re.fma(a.re, b.re),
+            eps,
+        }
+    }
+}
+
+/// The rhs's Jacobians by forward-mode dual numbers, in one call: `dstate`
+/// as [`Model::rhs`] writes it, `a` = ∂rhs/∂state (S×S row-major) and
+/// `b` = ∂rhs/∂inputs (S×I row-major), from ⌈(S + I) / W⌉ evaluations of
+/// the model's rhs in [`DualVec<T, W>`], each seeded with the next `W`
+/// columns. `S` and `I` are the model's state and input lengths. No
+/// allocation; errors as the rhs's, and [`ModelError::NonFinite`] naming
+/// the Jacobian when a derivative is not finite.
+///
+/// The derive writes `rhs_jacobian` as this call when it is cheaper than
+/// the symbolic derivatives; any model can call it.
+///
+/// ```
+/// use appell_runtime::dual::rhs_jacobian_by_duals;
+/// use appell_runtime::ModelError;
+/// // θ̈ = −(g/l) sin θ + τ, written by hand.
+/// use appell_runtime::__doc_model::Pendulum;
+///
+/// let model = Pendulum { g_over_l: 9.81 };
+/// let (mut ds, mut a, mut b) = ([0.0; 2], [0.0; 4], [0.0; 2]);
+/// // Two directions per pass: the three columns take two passes.
+/// rhs_jacobian_by_duals::<_, f64, 2, 1, 2>(&model, 0.0, &[0.3, 0.0], &[0.5], &mut ds, &mut a, &mut b)?;
+/// assert_eq!(a, [0.0, 1.0, -9.81 * 0.3_f64.cos(), 0.0]);
+/// assert_eq!(b, [0.0, 1.0]);
+/// # Ok::<(), ModelError>(())
+/// ```
+#[allow(clippy::too_many_arguments)] // the rhs's arguments and the two Jacobians, as `Model::rhs_jacobian`
+pub fn rhs_jacobian_by_duals<M: Model, T: Scalar, const S: usize, const I: usize, const W: usize>(
+    model: &M,
+    t: T,
+    state: &[T],
+    inputs: &[T],
+    dstate: &mut [T],
+    a: &mut [T],
+    b: &mut [T],
+) -> Result<(), ModelError> {
+    crate::check_len("state", state, S)?;
+    crate::check_len("inputs", inputs, I)?;
+    crate::check_len("dstate", dstate, S)?;
+    crate::check_len("a", a, S * S)?;
+    crate::check_len("b", b, S * I)?;
+    let prepared = model.prepare::<DualVec<T, W>>();
+    let time = DualVec::constant(t);
+    let mut x = [DualVec::<T, W>::constant(T::zero()); S];
+    let mut u = [DualVec::<T, W>::constant(T::zero()); I];
+    let mut dx = [DualVec::<T, W>::constant(T::zero()); S];
+    let mut first = 0;
+    // At least one pass, so that a model with no state and no inputs still
+    // reports a failing rhs.
+    loop {
+        // Column c = first + k is direction k of this pass.
+        for (c, (x, &v)) in x.iter_mut().zip(state).enumerate() {
+            *x = DualVec::variable(v, c.wrapping_sub(first));
+        }
+        for (c, (u, &v)) in u.iter_mut().zip(inputs).enumerate() {
+            *u = DualVec::variable(v, (S + c).wrapping_sub(first));
+        }
+        model.rhs(&prepared, time, &x, &u, &mut dx)?;
+        for (row, d) in dx.iter().enumerate() {
+            for (k, &e) in d.eps.iter().enumerate() {
+                let c = first + k;
+                if c < S {
+                    a[row * S + c] = e;
+                } else if c < S + I {
+                    b[row * I + c - S] = e;
+                }
+            }
+        }
+        first += W;
+        if first >= S + I {
+            break;
+        }
+    }
+    for (d, x) in dstate.iter_mut().zip(&dx) {
+        *d = x.re;
+    }
+    if !a.iter().chain(b.iter()).all(|v| v.re().is_finite()) {
+        return Err(ModelError::NonFinite {
+            what: "the rhs's Jacobian",
+        });
+    }
+    Ok(())
+}
+
+/// The scalar operations [`rhs_jacobian_by_duals`] performs for a model
+/// whose rhs costs `rhs`, in `passes` passes of `width` directions. Each
+/// dual addition is 1 + W additions; each product 1 + 2W products and W
+/// additions; each quotient two divisions, 2W products and W additions;
+/// each call two calls and W products; the rest of the rhs's total (its
+/// numeric solves, negations) 1 + 2W operations each.
+///
+/// ```
+/// use appell_runtime::{dual::pass_costs, OpCounts};
+/// let rhs = OpCounts { add: 10, mul: 10, div: 1, calls: 2, total: 25 };
+/// let c = pass_costs(rhs, 4, 2);
+/// assert_eq!(c.add, 2 * (10 * 5 + 10 * 4 + 4));
+/// assert_eq!(c.total, c.add + c.mul + c.div + c.calls + 2 * 2 * 9);
+/// ```
+pub const fn pass_costs(rhs: OpCounts, width: usize, passes: usize) -> OpCounts {
+    let w = width;
+    let add = passes * (rhs.add * (1 + w) + rhs.mul * w + rhs.div * w);
+    let mul = passes * (rhs.mul * (1 + 2 * w) + rhs.div * 2 * w + rhs.calls * w);
+    let div = passes * rhs.div * 2;
+    let calls = passes * rhs.calls * 2;
+    let rest = rhs
+        .total
+        .saturating_sub(rhs.add + rhs.mul + rhs.div + rhs.calls);
+    OpCounts {
+        add,
+        mul,
+        div,
+        calls,
+        total: add + mul + div + calls + passes * rest * (1 + 2 * w),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::DualVec;
+    use crate::Scalar;
+
+    type D = DualVec<f64, 2>;
+
+    /// f(x, y) and its gradient by hand, at (x, y).
+    fn check(f: impl Fn(D, D) -> D, x: f64, y: f64, value: f64, grad: [f64; 2]) {
+        let r = f(D::variable(x, 0), D::variable(y, 1));
+        let scale = 1.0 + value.abs();
+        assert!((r.re - value).abs() <= 1e-15 * scale, "{} vs {value}", r.re);
+        for k in 0..2 {
+            let s = 1.0 + grad[k].abs();
+            assert!((r.eps[k] - grad[k]).abs() <= 1e-14 * s, "{k}: {:?} vs {grad:?}", r.eps);
+        }
+    }
+
+    #[test]
+    fn arithmetic_follows_the_chain_rule() {
+        let (x, y) = (0.7, -1.3);
+        check(|a, b| a * b, x, y, x * y, [y, x]);
+        check(|a, b| a / b, x, y, x / y, [1.0 / y, -x / (y * y)]);
+        check(|a, b| a - b, x, y, x - y, [1.0, -1.0]);
+        check(|a, b| -(a + b), x, y, -(x + y), [-1.0, -1.0]);
+        check(|a, b| a.fma(b, a), x, y, x * y + x, [y + 1.0, x]);
+        check(|a, b| b.atan2(a), x, y, y.atan2(x), {
+            let r = x * x + y * y;
+            [-y / r, x / r]
+        });
+    }
+
+    #[test]
+    fn functions_follow_the_chain_rule() {
+        let x = 0.7;
+        let one = |f: fn(D) -> D, value: f64, slope: f64| {
+            check(|a, _| f(a), x, 0.0, value, [slope, 0.0]);
+        };
+        one(|a| a.sin(), x.sin(), x.cos());
+        one(|a| a.cos(), x.cos(), -x.sin());
+        one(|a| a.tan(), x.tan(), 1.0 / (x.cos() * x.cos()));
+        one(|a| a.exp(), x.exp(), x.exp());
+        one(|a| a.ln(), x.ln(), 1.0 / x);
+        one(|a| a.sqrt(), x.sqrt(), 0.5 / x.sqrt());
+        one(|a| a.powi(3), x.powi(3), 3.0 * x * x);
+        one(|a| a.powi(0), 1.0, 0.0);
+        one(|a| (-a).abs(), x, 1.0);
+        one(|a| a.asin(), x.asin(), 1.0 / (1.0 - x * x).sqrt());
+        one(|a| a.tanh(), x.tanh(), 1.0 - x.tanh().powi(2));
+    }
+
+    #[test]
+    fn a_direction_past_the_width_is_a_constant() {
+        let d = DualVec::<f64, 2>::variable(1.5, 2);
+        assert_eq!(d.eps, [0.0, 0.0]);
+        assert_eq!(DualVec::<f32, 1>::from_f64(2.0).re(), 2.0);
+    }
+}
