@@ -280,6 +280,131 @@ fn assert_agrees<M: Model>(model: &M, robot: &str) {
     );
 }
 
+/// Pinocchio's derivatives at a reference state (`derivatives/`), each
+/// matrix a list of rows in its joint order.
+struct Derivatives {
+    q: Vec<f64>,
+    v: Vec<f64>,
+    a: Vec<f64>,
+    tau: Vec<f64>,
+    /// dtau_dq, dtau_dv, dtau_da, ddq_dq, ddq_dv, ddq_dtau.
+    matrices: [Vec<Vec<f64>>; 6],
+}
+
+const DERIVATIVES: [&str; 6] = [
+    "dtau_dq", "dtau_dv", "dtau_da", "ddq_dq", "ddq_dv", "ddq_dtau",
+];
+
+fn derivative_reference(robot: &str) -> (Vec<String>, Vec<Derivatives>) {
+    let path = format!(
+        "{}/tests/reference/pinocchio/derivatives/{robot}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let text = std::fs::read_to_string(&path).expect("reference file");
+    let data: Value = serde_json::from_str(&text).expect("JSON");
+    assert_eq!(data["gravity"], serde_json::json!([0.0, 0.0, -9.81]));
+    let joints = data["joints"]
+        .as_array()
+        .expect("joints")
+        .iter()
+        .map(|j| j.as_str().expect("name").to_string())
+        .collect();
+    let rows = |v: &Value| v.as_array().expect("rows").iter().map(numbers).collect();
+    let states = data["states"]
+        .as_array()
+        .expect("states")
+        .iter()
+        .map(|s| Derivatives {
+            q: numbers(&s["q"]),
+            v: numbers(&s["v"]),
+            a: numbers(&s["a"]),
+            tau: numbers(&s["tau"]),
+            matrices: DERIVATIVES.map(|k| rows(&s[k])),
+        })
+        .collect();
+    (joints, states)
+}
+
+/// The worst relative difference of each generated derivative (row-major,
+/// `rows` × `cols` in the model's order) from Pinocchio's, over the
+/// reference's states: `inverse_dynamics_derivatives` against
+/// computeRNEADerivatives and `forward_dynamics_derivatives` against
+/// computeABADerivatives.
+fn derivatives_agreement<M: Model>(model: &M, robot: &str) -> [f64; 6] {
+    let info = M::info();
+    let (joints, states) = derivative_reference(robot);
+    let o = orders(&joints, info);
+    let (n, l, ni) = (info.coordinates.len(), info.speeds.len(), info.inputs.len());
+    let mut worst = [0.0f64; 6];
+    for s in &states {
+        let (q, u) = (pick(&o.q_at, &s.q), pick(&o.u_at, &s.v));
+        let (a, tau) = (pick(&o.u_at, &s.a), pick(&o.in_at, &s.tau));
+        let mut tau_out = vec![0.0; l];
+        let (mut dq, mut du, mut m) = (vec![0.0; l * n], vec![0.0; l * l], vec![0.0; l * l]);
+        model
+            .inverse_dynamics_derivatives(0.0, &q, &u, &a, &mut tau_out, &mut dq, &mut du, &mut m)
+            .unwrap();
+        let mut accel = vec![0.0; l];
+        let (mut fq, mut fu, mut ft) = (vec![0.0; l * n], vec![0.0; l * l], vec![0.0; l * ni]);
+        model
+            .forward_dynamics_derivatives(0.0, &q, &u, &tau, &mut accel, &mut fq, &mut fu, &mut ft)
+            .unwrap();
+        // Each generated matrix, and where its columns are in Pinocchio's.
+        let generated: [(&[f64], &[usize]); 6] = [
+            (&dq, &o.q_at),
+            (&du, &o.u_at),
+            (&m, &o.u_at),
+            (&fq, &o.q_at),
+            (&fu, &o.u_at),
+            (&ft, &o.in_at),
+        ];
+        for (k, (values, cols)) in generated.iter().enumerate() {
+            let reference: Vec<f64> = o
+                .u_at
+                .iter()
+                .flat_map(|&i| cols.iter().map(move |&j| (i, j)))
+                .map(|(i, j)| s.matrices[k][i][j])
+                .collect();
+            worst[k] = worst[k].max(relative(values, &reference));
+        }
+    }
+    println!(
+        "{robot}: derivatives against Pinocchio over {} states: {}",
+        states.len(),
+        DERIVATIVES
+            .iter()
+            .zip(worst)
+            .map(|(k, w)| format!("{k} {w:.1e}"))
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    worst
+}
+
+/// The generated derivatives of the inverse and forward dynamics against
+/// Pinocchio's analytical ones (`make_derivatives_reference.py`), to 1e-9
+/// relative: the UR5 and the 8-link chain (dual numbers for the rhs's),
+/// the Panda.
+#[test]
+fn the_derivatives_agree_with_pinocchio() {
+    let cases = [
+        ("ur5", derivatives_agreement(&ur5::Ur5, "ur5")),
+        ("panda", derivatives_agreement(&panda::Panda, "panda")),
+        (
+            "spatial_chain_8",
+            derivatives_agreement(&spatial_chain::SpatialChain8, "spatial_chain_8"),
+        ),
+    ];
+    for (robot, worst) in cases {
+        for (k, w) in DERIVATIVES.iter().zip(worst) {
+            assert!(
+                w <= 1e-9,
+                "{robot}: {k} differs from Pinocchio's by {w:.2e}"
+            );
+        }
+    }
+}
+
 #[test]
 fn the_ur5_from_its_urdf_agrees_with_pinocchio() {
     assert_agrees(&ur5::Ur5, "ur5");

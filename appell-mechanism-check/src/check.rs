@@ -10,7 +10,10 @@
 //!   columns (Cᵀ Dᵀ λ = 0), and the oracle's q̈ behind them equals the
 //!   generated accelerations of the privileged coordinates;
 //! - where the loads are conservative (gravity) or inputs, the energy
-//!   balance d(T + V)/dt = input power ([`appell::energy::energies`]).
+//!   balance d(T + V)/dt = input power ([`appell::energy::energies`]);
+//! - the generated `rhs_jacobian` (symbolic or by the derive's dual
+//!   numbers) against num-dual's dual numbers through the rhs
+//!   ([`appell::linearize::dual_linearize`]).
 //!
 //! A state where both the generated code and the oracle refuse (a
 //! singular configuration) is counted and skipped; one where only one of
@@ -48,6 +51,8 @@ pub struct Report {
     pub inverse_dynamics: f64,
     pub reactions: f64,
     pub energy: f64,
+    /// The generated Jacobian against dual numbers.
+    pub jacobian: f64,
     /// States whose energy balance was checked.
     pub energy_states: usize,
 }
@@ -63,6 +68,7 @@ impl Report {
         self.inverse_dynamics = self.inverse_dynamics.max(other.inverse_dynamics);
         self.reactions = self.reactions.max(other.reactions);
         self.energy = self.energy.max(other.energy);
+        self.jacobian = self.jacobian.max(other.jacobian);
     }
 
     /// The largest of the differences.
@@ -71,6 +77,7 @@ impl Report {
             .max(self.inverse_dynamics)
             .max(self.reactions)
             .max(self.energy)
+            .max(self.jacobian)
     }
 }
 
@@ -166,6 +173,7 @@ pub fn model<M: Model>(model: &M, rng: &mut Rng, energy: bool) -> Result<Report,
         report.reactions = report
             .reactions
             .max(reactions(model, &q, &u, &inputs, &rates[kept..])?);
+        report.jacobian = report.jacobian.max(jacobian(model, &state, &inputs)?);
         if energy {
             let e = appell::energy::energies(model, 0.0, &q, &u, &inputs)
                 .map_err(|e| format!("{}: energies: {e}", info.name))?;
@@ -175,6 +183,29 @@ pub fn model<M: Model>(model: &M, rng: &mut Rng, energy: bool) -> Result<Report,
         }
     }
     Ok(report)
+}
+
+/// The generated Jacobian against dual numbers through the rhs, each
+/// matrix relative to its largest entry.
+fn jacobian<M: Model>(model: &M, state: &[f64], inputs: &[f64]) -> Result<f64, String> {
+    let info = M::info();
+    let (s, ni) = (state.len(), inputs.len());
+    let (mut v, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
+    let generated = model.rhs_jacobian(0.0, state, inputs, &mut v, &mut a, &mut b);
+    let dual = appell::linearize::dual_linearize(model, 0.0, state, inputs);
+    match (generated, dual) {
+        (Ok(()), Ok(d)) => {
+            // nalgebra stores by columns; the generated matrices by rows.
+            let (da, db) = (d.a.transpose(), d.b.transpose());
+            Ok(worst_of(&a, da.as_slice()).max(worst_of(&b, db.as_slice())))
+        }
+        (Err(ModelError::NotGenerated { .. }), _) if info.jacobian.is_none() => Ok(0.0),
+        (g, d) => Err(format!(
+            "{}: at state {state:?}, inputs {inputs:?} the generated Jacobian gives {g:?} and the dual numbers {:?}",
+            info.name,
+            d.map(|_| ())
+        )),
+    }
 }
 
 /// The inverse dynamics at the oracle's accelerations against the

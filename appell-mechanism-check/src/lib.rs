@@ -1,8 +1,9 @@
 //! Random mechanisms, drawn with a fixed seed and written through the real
 //! derive when this crate builds (`build/`), each with a function that
 //! checks its generated code against the multiplier oracle: the rhs, the
-//! inverse dynamics, the constraint reactions and, where the loads are
-//! conservative, the energy balance (see [`check`]). The test in `tests/`
+//! inverse dynamics, the constraint reactions, the generated Jacobian
+//! against dual numbers and, where the loads are conservative, the energy
+//! balance (see [`check`]). The test in `tests/`
 //! runs them all and reports how many were generated, derived and agreed.
 #![allow(missing_docs, clippy::all, unused, nonstandard_style)] // generated models
 

@@ -41,7 +41,7 @@ fn random_mechanisms_agree_with_the_oracle() {
         }
     }
     println!(
-        "agreed: {} of {} derived ({} models and scenes, {} states, {} singular skipped, {} energy states); largest differences: rhs {:.1e}, inverse dynamics {:.1e}, reactions {:.1e}, energy {:.1e}",
+        "agreed: {} of {} derived ({} models and scenes, {} states, {} singular skipped, {} energy states); largest differences: rhs {:.1e}, inverse dynamics {:.1e}, reactions {:.1e}, energy {:.1e}, Jacobian {:.1e}",
         CASES.len() - failures.len(),
         CASES.len(),
         total.variants,
@@ -51,7 +51,8 @@ fn random_mechanisms_agree_with_the_oracle() {
         total.rhs,
         total.inverse_dynamics,
         total.reactions,
-        total.energy
+        total.energy,
+        total.jacobian
     );
     for f in &failures {
         println!("FAILED {f}");

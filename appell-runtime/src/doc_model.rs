@@ -108,6 +108,29 @@ impl Model for Pendulum {
         Ok(())
     }
 
+    fn inverse_dynamics<T: Scalar>(
+        &self,
+        _t: T,
+        q: &[T],
+        u: &[T],
+        accel: &[T],
+        forces: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("q", q, 1)?;
+        crate::check_len("u", u, 1)?;
+        crate::check_len("accel", accel, 1)?;
+        crate::check_len("forces", forces, 1)?;
+        forces[0] = accel[0] - forcing(T::from_f64(self.g_over_l), q, &[T::zero()]);
+        Ok(())
+    }
+
+    fn mass_matrix<T: Scalar>(&self, _t: T, q: &[T], m: &mut [T]) -> Result<(), ModelError> {
+        crate::check_len("q", q, 1)?;
+        crate::check_len("m", m, 1)?;
+        m[0] = T::one();
+        Ok(())
+    }
+
     fn speed_transform<T: Scalar>(
         &self,
         _t: T,

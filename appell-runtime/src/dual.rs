@@ -1,7 +1,9 @@
 //! Forward-mode derivatives without `std`: [`DualVec`], a number that
 //! carries `W` directional derivatives beside its value over any
-//! [`Scalar`], and [`rhs_jacobian_by_duals`], the rhs's Jacobians from
-//! ⌈(s + i) / W⌉ passes of the model's own rhs in it.
+//! [`Scalar`]; [`rhs_jacobian_by_duals`], the rhs's Jacobians from
+//! ⌈(s + i) / W⌉ passes of the model's own rhs in it; and
+//! [`inverse_dynamics_derivatives_by_duals`], likewise for the inverse
+//! dynamics.
 //!
 //! The derive writes `rhs_jacobian` this way for a model whose symbolic
 //! derivatives would cost more than the passes (or grow its code past the
@@ -262,7 +264,13 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
 /// # Ok::<(), ModelError>(())
 /// ```
 #[allow(clippy::too_many_arguments)] // the rhs's arguments and the two Jacobians, as `Model::rhs_jacobian`
-pub fn rhs_jacobian_by_duals<M: Model, T: Scalar, const S: usize, const I: usize, const W: usize>(
+pub fn rhs_jacobian_by_duals<
+    M: Model,
+    T: Scalar,
+    const S: usize,
+    const I: usize,
+    const W: usize,
+>(
     model: &M,
     t: T,
     state: &[T],
@@ -319,6 +327,102 @@ pub fn rhs_jacobian_by_duals<M: Model, T: Scalar, const S: usize, const I: usize
     Ok(())
 }
 
+/// The inverse dynamics and its derivatives by forward-mode dual numbers,
+/// in one call: `forces` as [`Model::inverse_dynamics`] writes them,
+/// `dq` = ∂Q/∂q (L×N row-major, one column per coordinate), `du` = ∂Q/∂u
+/// (L×L) from ⌈(N + L) / W⌉ evaluations of the model's inverse dynamics in
+/// [`DualVec<T, W>`], and `m` = ∂Q/∂accel = M from
+/// [`Model::mass_matrix`]. `N` and `L` are the model's coordinates and
+/// privileged speeds. No allocation; errors as the inverse dynamics', and
+/// [`ModelError::NonFinite`] when a derivative is not finite.
+///
+/// The derive writes `inverse_dynamics_derivatives` as this call where it
+/// does not differentiate the recursions symbolically.
+///
+/// ```
+/// use appell_runtime::dual::inverse_dynamics_derivatives_by_duals;
+/// use appell_runtime::ModelError;
+/// // θ̈ = −(g/l) sin θ + τ: Q = θ̈ + (g/l) sin θ.
+/// use appell_runtime::__doc_model::Pendulum;
+///
+/// let model = Pendulum { g_over_l: 9.81 };
+/// let (mut q_force, mut dq, mut du, mut m) = ([0.0; 1], [0.0; 1], [0.0; 1], [0.0; 1]);
+/// inverse_dynamics_derivatives_by_duals::<_, f64, 1, 1, 2>(
+///     &model, 0.0, &[0.3], &[0.1], &[2.0], &mut q_force, &mut dq, &mut du, &mut m,
+/// )?;
+/// assert_eq!(q_force[0], 2.0 + 9.81 * 0.3_f64.sin());
+/// assert_eq!((dq[0], du[0], m[0]), (9.81 * 0.3_f64.cos(), 0.0, 1.0));
+/// # Ok::<(), ModelError>(())
+/// ```
+#[allow(clippy::too_many_arguments)] // Pinocchio's computeRNEADerivatives: q, u, accel in; Q and its three Jacobians out
+pub fn inverse_dynamics_derivatives_by_duals<
+    M: Model,
+    T: Scalar,
+    const N: usize,
+    const L: usize,
+    const W: usize,
+>(
+    model: &M,
+    t: T,
+    q: &[T],
+    u: &[T],
+    accel: &[T],
+    forces: &mut [T],
+    dq: &mut [T],
+    du: &mut [T],
+    m: &mut [T],
+) -> Result<(), ModelError> {
+    crate::check_len("q", q, N)?;
+    crate::check_len("u", u, L)?;
+    crate::check_len("accel", accel, L)?;
+    crate::check_len("forces", forces, L)?;
+    crate::check_len("dq", dq, L * N)?;
+    crate::check_len("du", du, L * L)?;
+    crate::check_len("m", m, L * L)?;
+    let time = DualVec::constant(t);
+    let mut qd = [DualVec::<T, W>::constant(T::zero()); N];
+    let mut ud = [DualVec::<T, W>::constant(T::zero()); L];
+    let mut ad = [DualVec::<T, W>::constant(T::zero()); L];
+    for (a, &v) in ad.iter_mut().zip(accel) {
+        *a = DualVec::constant(v);
+    }
+    let mut out = [DualVec::<T, W>::constant(T::zero()); L];
+    let mut first = 0;
+    loop {
+        for (c, (x, &v)) in qd.iter_mut().zip(q).enumerate() {
+            *x = DualVec::variable(v, c.wrapping_sub(first));
+        }
+        for (c, (x, &v)) in ud.iter_mut().zip(u).enumerate() {
+            *x = DualVec::variable(v, (N + c).wrapping_sub(first));
+        }
+        model.inverse_dynamics(time, &qd, &ud, &ad, &mut out)?;
+        for (row, d) in out.iter().enumerate() {
+            for (k, &e) in d.eps.iter().enumerate() {
+                let c = first + k;
+                if c < N {
+                    dq[row * N + c] = e;
+                } else if c < N + L {
+                    du[row * L + c - N] = e;
+                }
+            }
+        }
+        first += W;
+        if first >= N + L {
+            break;
+        }
+    }
+    for (f, x) in forces.iter_mut().zip(&out) {
+        *f = x.re;
+    }
+    model.mass_matrix(t, q, m)?;
+    if !dq.iter().chain(du.iter()).all(|v| v.re().is_finite()) {
+        return Err(ModelError::NonFinite {
+            what: "the inverse dynamics' Jacobian",
+        });
+    }
+    Ok(())
+}
+
 /// The scalar operations [`rhs_jacobian_by_duals`] performs for a model
 /// whose rhs costs `rhs`, in `passes` passes of `width` directions. Each
 /// dual addition is 1 + W additions; each product 1 + 2W products and W
@@ -365,7 +469,11 @@ mod tests {
         assert!((r.re - value).abs() <= 1e-15 * scale, "{} vs {value}", r.re);
         for k in 0..2 {
             let s = 1.0 + grad[k].abs();
-            assert!((r.eps[k] - grad[k]).abs() <= 1e-14 * s, "{k}: {:?} vs {grad:?}", r.eps);
+            assert!(
+                (r.eps[k] - grad[k]).abs() <= 1e-14 * s,
+                "{k}: {:?} vs {grad:?}",
+                r.eps
+            );
         }
     }
 

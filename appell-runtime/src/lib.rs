@@ -12,6 +12,9 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
+#[doc(hidden)]
+#[path = "doc_model.rs"]
+pub mod __doc_model;
 #[cfg(feature = "std")]
 pub mod accuracy;
 #[cfg(feature = "std")]
@@ -26,9 +29,6 @@ pub mod conditioning;
 pub mod constraint_forces;
 #[cfg(feature = "std")]
 pub mod contact_watch;
-#[doc(hidden)]
-#[path = "doc_model.rs"]
-pub mod __doc_model;
 pub mod dual;
 #[cfg(feature = "std")]
 pub mod dynamic;
@@ -92,11 +92,11 @@ pub use num_dual;
 /// Items the generated code refers to; not a stable API.
 #[doc(hidden)]
 pub mod __private {
+    pub use crate::dual::{inverse_dynamics_derivatives_by_duals, rhs_jacobian_by_duals};
     pub use crate::linalg::{
         check_pivot, constraint_scale, ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs,
         pivot_margin,
     };
-    pub use crate::dual::{pass_costs, rhs_jacobian_by_duals};
     pub use crate::model::check_len;
     pub use crate::physical::check_body;
     pub use crate::{

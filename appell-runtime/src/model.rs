@@ -641,6 +641,70 @@ pub trait Model {
         })
     }
 
+    /// The inverse dynamics and its derivatives in one call (Pinocchio's
+    /// `computeRNEADerivatives`): `forces` = Q as
+    /// [`Model::inverse_dynamics`] writes them, `dq` = ∂Q/∂q (l×n
+    /// row-major: one column per coordinate, in [`ModelInfo::coordinates`]
+    /// order; a quaternion's four components each, where Pinocchio
+    /// differentiates along its tangent), `du` = ∂Q/∂u (l×l) and `m` =
+    /// ∂Q/∂accel = M (l×l, both triangles). For a fixed-base robot from a
+    /// URDF these are Pinocchio's `dtau_dq`, `dtau_dv` and `M`.
+    ///
+    /// The derive writes it for every model with its Jacobian on: a tree's
+    /// recursive Newton–Euler differentiated symbolically where that costs
+    /// at most 4 times its expressions (or with `jacobian(on)`), else the
+    /// inverse dynamics in dual numbers
+    /// ([`dual::inverse_dynamics_derivatives_by_duals`](crate::dual::inverse_dynamics_derivatives_by_duals)).
+    /// This default returns [`ModelError::NotGenerated`]. Errors otherwise
+    /// as [`Model::inverse_dynamics`]'s, and [`ModelError::NonFinite`]
+    /// when a derivative is not finite.
+    #[allow(clippy::too_many_arguments)] // Pinocchio's computeRNEADerivatives: q, u, accel in; Q and its three Jacobians out
+    fn inverse_dynamics_derivatives<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        u: &[T],
+        accel: &[T],
+        forces: &mut [T],
+        dq: &mut [T],
+        du: &mut [T],
+        m: &mut [T],
+    ) -> Result<(), ModelError> {
+        let _ = (t, q, u, accel, forces, dq, du, m);
+        Err(ModelError::NotGenerated {
+            function: "inverse_dynamics_derivatives",
+        })
+    }
+
+    /// The forward dynamics and its derivatives in full coordinates, in
+    /// one call (Pinocchio's `computeABADerivatives`): `accel` = ÿ at
+    /// coordinates `q`, privileged speeds `u` and `inputs`, `dq` = ∂ÿ/∂q
+    /// (l×n row-major, one column per coordinate in
+    /// [`ModelInfo::coordinates`] order, zero for the coordinates the
+    /// equations do not depend on), `du` = ∂ÿ/∂u (l×l) and `dinputs` =
+    /// ∂ÿ/∂inputs (l×i). For a fixed-base robot from a URDF these are
+    /// Pinocchio's `ddq_dq`, `ddq_dv` and `ddq_dtau` (= M⁻¹ where every
+    /// joint is actuated). The derive writes it from
+    /// [`Model::rhs_jacobian`]'s rows for ÿ wherever it writes that; this
+    /// default returns [`ModelError::NotGenerated`].
+    #[allow(clippy::too_many_arguments)] // Pinocchio's computeABADerivatives: q, u, inputs in; ÿ and its three Jacobians out
+    fn forward_dynamics_derivatives<T: Scalar>(
+        &self,
+        t: T,
+        q: &[T],
+        u: &[T],
+        inputs: &[T],
+        accel: &mut [T],
+        dq: &mut [T],
+        du: &mut [T],
+        dinputs: &mut [T],
+    ) -> Result<(), ModelError> {
+        let _ = (t, q, u, inputs, accel, dq, du, dinputs);
+        Err(ModelError::NotGenerated {
+            function: "forward_dynamics_derivatives",
+        })
+    }
+
     /// M(q) alone, l×l row-major (Pinocchio's `crba`, both triangles).
     fn mass_matrix<T: Scalar>(&self, t: T, q: &[T], m: &mut [T]) -> Result<(), ModelError> {
         let _ = (t, q, m);

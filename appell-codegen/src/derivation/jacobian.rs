@@ -115,6 +115,10 @@ pub struct Jacobians {
     /// The structured form's candidate (rows: the retained coordinates'
     /// rates, then ÿ; row-major over the columns), or why there is none.
     pub structured: Result<Vec<Id>, String>,
+    /// For a tree's recursive Newton–Euler inverse dynamics Q(q, u, ÿ):
+    /// ∂Q/∂q (l rows, one column per coordinate) then ∂Q/∂u (l × l), each
+    /// row-major; or why there is none (set by [`inverse_dynamics`]).
+    pub inverse: Result<Vec<Id>, String>,
 }
 
 impl Jacobians {
@@ -124,6 +128,7 @@ impl Jacobians {
             columns,
             closed: Err(reason.to_string()),
             structured: Err(reason.to_string()),
+            inverse: Err(reason.to_string()),
         }
     }
 }
@@ -170,7 +175,33 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
         columns,
         closed,
         structured,
+        inverse: Err("not asked for".to_string()),
     }
+}
+
+/// The derivatives of a tree's inverse dynamics Q(q, u, ÿ) by every
+/// coordinate, then every privileged speed (∂Q/∂ÿ is M), for the generated
+/// `inverse_dynamics_derivatives`; within the same budget as the rhs's.
+pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, String> {
+    if model.jacobian == Some(false) {
+        return Err("turned off by `jacobian(off)`".to_string());
+    }
+    let Ok(s) = &d.structured else {
+        return Err("no structured form".to_string());
+    };
+    let columns = Columns {
+        state: model
+            .coords
+            .iter()
+            .map(|c| c.1.q)
+            .chain(model.speed_specs.iter().map(|s| s.symbol))
+            .collect(),
+        inputs: Vec::new(),
+    };
+    let forced = model.jacobian == Some(true);
+    let g = &mut model.g;
+    let allowed = budget(g, &s.inverse, forced);
+    within_budget(g, allowed, |g| derivatives(g, &s.inverse, &columns))
 }
 
 /// The closed form's derivatives.

@@ -250,7 +250,9 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
     let Kinematics { mut model, twin } = kinematics;
     let scenes_twin = twin.clone();
     let mut full = complete(cx, &mut model, twin, options)?;
-    full.jacobians = Some(jacobian::differentiate(&mut model, &full));
+    let mut jacobians = jacobian::differentiate(&mut model, &full);
+    jacobians.inverse = jacobian::inverse_dynamics(&mut model, &full);
+    full.jacobians = Some(jacobians);
     let mut scenes = Vec::new();
     for scene in model.scenes.clone() {
         let d = if ConstraintSet::of_scene(&model, &scene).is_some() {

@@ -11,12 +11,14 @@ use quote::quote;
 use super::code::{braced, code, Target};
 use super::functions::Common;
 use super::{int, p, Emitter};
+use crate::derivation::jacobian::SIZE_LIMIT;
 use crate::derivation::tree::Structured;
 
 impl Emitter<'_> {
-    /// `inverse_dynamics`, `mass_matrix`, `bias_forces`, `gravity_forces`.
+    /// `inverse_dynamics`, `mass_matrix`, `bias_forces`, `gravity_forces`
+    /// and `inverse_dynamics_derivatives`.
     pub(super) fn controller_functions(&self, c: &Common) -> TokenStream {
-        match (&self.d.structured, self.scene) {
+        let functions = match (&self.d.structured, self.scene) {
             (Ok(s), None) => {
                 let inverse = self.structured_function(c, "inverse_dynamics", &s.inverse);
                 let mass = self.structured_function(c, "mass_matrix", &s.mass);
@@ -25,6 +27,153 @@ impl Emitter<'_> {
                 quote!(#inverse #mass #bias #gravity)
             }
             _ => self.closed_form_controller(),
+        };
+        let derivatives = self.inverse_derivatives(c);
+        let forward = self.forward_derivatives();
+        quote!(#functions #derivatives #forward)
+    }
+
+    /// `forward_dynamics_derivatives`: the rows of `rhs_jacobian` that
+    /// give the accelerations, with its retained coordinates' columns put
+    /// back among all the coordinates (zero for the ignorable ones), as
+    /// Pinocchio's `computeABADerivatives` returns them; nothing with
+    /// `jacobian(off)`.
+    fn forward_derivatives(&self) -> TokenStream {
+        if self.model.jacobian == Some(false) {
+            return TokenStream::new();
+        }
+        let p = p();
+        let (n, l, ni) = (self.d.n, self.d.l, self.inputs().len());
+        let retained = &self.d.reduction.retained;
+        let (nr, s) = (retained.len(), retained.len() + l);
+        let checks = [
+            self.check("__q", n),
+            self.check("__u", l),
+            self.check("__inputs", ni),
+            self.check("__accel", l),
+            self.check("__dq", l * n),
+            self.check("__du", l * l),
+            self.check("__dinputs", l * ni),
+        ];
+        let kept = retained.iter().map(|&r| int(r));
+        let zero = quote!(<__T as #p::Scalar>::zero());
+        let (n, l, ni, nr, s) = (int(n), int(l), int(ni), int(nr), int(s));
+        quote! {
+            fn forward_dynamics_derivatives<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __accel: &mut [__T], __dq: &mut [__T], __du: &mut [__T], __dinputs: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #(#checks)*
+                const __KEPT: [usize; #nr] = [#(#kept),*];
+                let mut __x = [#zero; #s];
+                for (__r, &__c) in __KEPT.iter().enumerate() {
+                    __x[__r] = __q[__c];
+                }
+                __x[#nr..].copy_from_slice(__u);
+                let mut __rates = [#zero; #s];
+                let mut __a = [#zero; #s * #s];
+                let mut __b = [#zero; #s * #ni];
+                self.rhs_jacobian(t, &__x, __inputs, &mut __rates, &mut __a, &mut __b)?;
+                for __k in 0..#l {
+                    let __row = #nr + __k;
+                    __accel[__k] = __rates[__row];
+                    for __c in 0..#n {
+                        __dq[__k * #n + __c] = #zero;
+                    }
+                    for (__r, &__c) in __KEPT.iter().enumerate() {
+                        __dq[__k * #n + __c] = __a[__row * #s + __r];
+                    }
+                    for __j in 0..#l {
+                        __du[__k * #l + __j] = __a[__row * #s + #nr + __j];
+                    }
+                    for __i in 0..#ni {
+                        __dinputs[__k * #ni + __i] = __b[__row * #ni + __i];
+                    }
+                }
+                #p::Ok(())
+            }
+        }
+    }
+
+    /// `inverse_dynamics_derivatives`: a tree's recursive Newton–Euler
+    /// differentiated (stage 14's `inverse`) when it has at most
+    /// [`SIZE_LIMIT`] times the expressions of the recursion (any size with
+    /// `jacobian(on)`), else the inverse dynamics in dual numbers; nothing
+    /// with `jacobian(off)`.
+    fn inverse_derivatives(&self, c: &Common) -> TokenStream {
+        if self.model.jacobian == Some(false) {
+            return TokenStream::new();
+        }
+        let symbolic = match (&self.d.structured, self.scene, &self.d.jacobians) {
+            (Ok(s), None, Some(j)) => j.inverse.as_ref().ok().map(|partials| (s, partials)),
+            _ => None,
+        };
+        if let Some((s, partials)) = symbolic {
+            let g = &self.model.g;
+            let mut roots = s.inverse.clone();
+            roots.extend(partials);
+            let (total, values) = (g.dag_size(&roots), g.dag_size(&s.inverse).max(1));
+            if self.model.jacobian == Some(true) || total <= SIZE_LIMIT * values {
+                return self.symbolic_inverse_derivatives(c, &roots);
+            }
+        }
+        let p = p();
+        let (n, l) = (self.d.n, self.d.l);
+        let width = (n + l).clamp(1, 8);
+        let (n, l, w) = (int(n), int(l), int(width));
+        quote! {
+            fn inverse_dynamics_derivatives<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __accel: &[__T], __forces: &mut [__T], __dq: &mut [__T], __du: &mut [__T], __m: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #p::inverse_dynamics_derivatives_by_duals::<Self, __T, #n, #l, #w>(self, t, __q, __u, __accel, __forces, __dq, __du, __m)
+            }
+        }
+    }
+
+    /// The symbolic `inverse_dynamics_derivatives`: one program for Q,
+    /// ∂Q/∂q and ∂Q/∂u (`roots`, in that order), M from `mass_matrix`.
+    fn symbolic_inverse_derivatives(&self, c: &Common, roots: &[Id]) -> TokenStream {
+        let p = p();
+        let g = &self.model.g;
+        let (n, l) = (self.d.n, self.d.l);
+        let mut program = code(g, roots, Target::Generic { hoist: false });
+        let body = program.take_statements();
+        let writes = program.outputs.iter().enumerate().map(|(k, v)| {
+            let (out, at) = if k < l {
+                (quote!(__forces), k)
+            } else if k < l + l * n {
+                (quote!(__dq), k - l)
+            } else {
+                (quote!(__du), k - l - l * n)
+            };
+            let at = int(at);
+            quote!(#out[#at] = #v;)
+        });
+        let checks = [
+            self.check("__q", n),
+            self.check("__u", l),
+            self.check("__accel", l),
+            self.check("__forces", l),
+            self.check("__dq", l * n),
+            self.check("__du", l * l),
+            self.check("__m", l * l),
+        ];
+        let (params_t, pos) = (&c.params_t, &c.positivity);
+        let (bind_q, bind_u) = (self.bind_q("__q"), self.bind_u("__u"));
+        let bind_a = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
+            let (a, k) = (self.ident(g.symbol_name(spec.accel)), int(k));
+            quote!(let #a = __accel[#k];)
+        });
+        let body = braced([quote! {
+            #params_t #bind_q #bind_u #(#bind_a)*
+            #body
+            #(#writes)*
+        }]);
+        quote! {
+            fn inverse_dynamics_derivatives<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __accel: &[__T], __forces: &mut [__T], __dq: &mut [__T], __du: &mut [__T], __m: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #(#checks)* #pos
+                #body
+                self.mass_matrix(t, __q, __m)?;
+                if !__dq.iter().chain(__du.iter()).all(|__v| #p::Scalar::re(*__v).is_finite()) {
+                    return #p::Err(#p::ModelError::NonFinite { what: "the inverse dynamics' Jacobian" });
+                }
+                #p::Ok(())
+            }
         }
     }
 

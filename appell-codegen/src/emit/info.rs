@@ -104,15 +104,27 @@ impl Emitter<'_> {
         let text = format!("rhs: {form}\njacobian: {}\n\n{}", jacobian.summary, d.text);
         let jacobian = match jacobian.dual {
             Some((width, passes)) => {
-                let (form, w, n) = (&jacobian.summary, int(width), int(passes));
+                // The runtime's count of the dual passes, taken here.
+                let rhs = appell_runtime::OpCounts {
+                    add: rhs_ops.add,
+                    mul: rhs_ops.mul,
+                    div: rhs_ops.div,
+                    calls: rhs_ops.calls,
+                    total: rhs_ops.total() + extra_ops,
+                };
+                let c = appell_runtime::dual::pass_costs(rhs, width, passes);
+                let form = &jacobian.summary;
+                let (add, mul, div, calls, total) = (
+                    int(c.add),
+                    int(c.mul),
+                    int(c.div),
+                    int(c.calls),
+                    int(c.total),
+                );
                 quote! {
                     ::core::option::Option::Some(#p::JacobianInfo {
                         form: #form,
-                        ops: #p::pass_costs(
-                            #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
-                            #w,
-                            #n,
-                        ),
+                        ops: #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
                     })
                 }
             }

@@ -98,8 +98,9 @@ impl Emitter<'_> {
                 function: TokenStream::new(),
                 info: quote!(::core::option::Option::None),
                 dual: None,
-                summary: "none (turned off by `jacobian(off)`; tools use dual numbers through the rhs)"
-                    .to_string(),
+                summary:
+                    "none (turned off by `jacobian(off)`; tools use dual numbers through the rhs)"
+                        .to_string(),
             };
         }
         let (width, passes) = self.dual_shape();
@@ -215,7 +216,10 @@ impl Emitter<'_> {
     fn dual_parts(&self, why: String) -> JacobianParts {
         let p = p();
         let (width, passes) = self.dual_shape();
-        let (s, i) = (self.d.reduction.retained.len() + self.d.l, self.inputs().len());
+        let (s, i) = (
+            self.d.reduction.retained.len() + self.d.l,
+            self.inputs().len(),
+        );
         let (su, iu, wu) = (int(s), int(i), int(width));
         let function = quote! {
             fn rhs_jacobian<__T: #p::Scalar>(&self, t: __T, __state: &[__T], __inputs: &[__T], __dstate: &mut [__T], __a: &mut [__T], __b: &mut [__T]) -> #p::Result<(), #p::ModelError> {

@@ -1,10 +1,12 @@
 //! The `jacobian` subcommand: A = ∂ẋ/∂x and B = ∂ẋ/∂u of the reduced
 //! equations at each state, or of one fixed step x⁺ of RK4 or
-//! semi-implicit Euler, by dual numbers through the generated code.
+//! semi-implicit Euler: by the model's generated `rhs_jacobian` (chained
+//! through the step's stages), or by dual numbers through the generated
+//! rhs for a model without one.
 
 use super::input::{number, Point};
 use crate::dynamic::{DynModel, DynRhs};
-use crate::linearize::discrete::step_with;
+use crate::linearize::discrete::{chained_with, step_with};
 use crate::linearize::jacobian::{dual_columns, state_names};
 use crate::linearize::FixedStep;
 use crate::model::ModelInfo;
@@ -37,7 +39,7 @@ pub(super) fn parse_step(obj: &Map<String, Value>) -> Result<Option<(FixedStep, 
 
 /// `{"state": [..], "inputs": [..], "rates": [..] | "next": [..], "a":
 /// [[..]], "b": [[..]]}` for `target` (the model or the scene that answers)
-/// at `point`: one dual pass per state component and input.
+/// at `point`.
 pub(super) fn jacobian_answer(
     target: &dyn DynModel,
     info: &ModelInfo,
@@ -45,9 +47,13 @@ pub(super) fn jacobian_answer(
     step: Option<(FixedStep, f64)>,
 ) -> Result<Map<String, Value>, String> {
     let rhs = target.dyn_prepare();
-    let (values, a, b) = dual_columns(&point.state, &point.inputs, |x, w| {
-        evaluate(rhs.as_ref(), info, point.t, x, w, step)
-    })
+    let (values, a, b) = if info.jacobian.is_some() {
+        generated(rhs.as_ref(), info, point, step)
+    } else {
+        dual_columns(&point.state, &point.inputs, |x, w| {
+            evaluate(rhs.as_ref(), info, point.t, x, w, step)
+        })
+    }
     .map_err(|e| e.to_string())?;
     if !(a
         .iter()
@@ -79,6 +85,39 @@ pub(super) fn jacobian_answer(
     answer.insert("a".into(), json!(a));
     answer.insert("b".into(), json!(b));
     Ok(answer)
+}
+
+/// The values (rates or the next state), A and B.
+type Columns = (Vec<f64>, DMatrix<f64>, DMatrix<f64>);
+
+/// The rates (or one step) and their Jacobians by the model's generated
+/// `rhs_jacobian`, chained through the step's stages.
+fn generated(
+    rhs: &dyn DynRhs,
+    info: &ModelInfo,
+    point: &Point,
+    step: Option<(FixedStep, f64)>,
+) -> Result<Columns, crate::model::ModelError> {
+    let (x, w) = (&point.state[..], &point.inputs[..]);
+    let (s, ni) = (x.len(), w.len());
+    let mut jacobian = |t: f64, y: &[f64], v: &mut [f64], a: &mut [f64], b: &mut [f64]| {
+        rhs.generated_jacobian(t, y, w, v, a, b).map(|_| ())
+    };
+    match step {
+        None => {
+            let (mut v, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
+            jacobian(point.t, x, &mut v, &mut a, &mut b)?;
+            let a = DMatrix::from_row_slice(s, s, &a);
+            Ok((v, a, DMatrix::from_row_slice(s, ni, &b)))
+        }
+        Some((method, h)) => {
+            let retained = info.retained.len();
+            let mut f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, w, dx);
+            let next = step_with(&mut f, retained, method, point.t, h, x)?;
+            let (a, b) = chained_with(&mut jacobian, retained, method, point.t, h, x, ni)?;
+            Ok((next, a, b))
+        }
+    }
 }
 
 /// The rates, or one step, in dual numbers.

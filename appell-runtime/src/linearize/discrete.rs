@@ -321,10 +321,34 @@ fn chained<M: Model>(
     x: &[f64],
     w: &[f64],
 ) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
-    let (s, ni) = (x.len(), w.len());
-    let eval = |t: f64, y: &[f64]| -> Result<Stage, ModelError> {
+    let mut jacobian = |t: f64, y: &[f64], v: &mut [f64], a: &mut [f64], b: &mut [f64]| {
+        model.rhs_jacobian(t, y, w, v, a, b)
+    };
+    let retained = M::info().retained.len();
+    chained_with(&mut jacobian, retained, method, t, h, x, w.len())
+}
+
+/// A generated rhs Jacobian at `(t, y)` with the inputs held: the rates,
+/// A and B (row-major) into the buffers.
+pub(crate) type StageJacobian<'a> =
+    dyn FnMut(f64, &[f64], &mut [f64], &mut [f64], &mut [f64]) -> Result<(), ModelError> + 'a;
+
+/// [`chained`] for any source of stage Jacobians (`retained` coordinates
+/// lead the state, `ni` inputs): what the command line calls on a model
+/// it knows as a trait object.
+pub(crate) fn chained_with(
+    jacobian: &mut StageJacobian<'_>,
+    retained: usize,
+    method: FixedStep,
+    t: f64,
+    h: f64,
+    x: &[f64],
+    ni: usize,
+) -> Result<(DMatrix<f64>, DMatrix<f64>), ModelError> {
+    let s = x.len();
+    let mut eval = |t: f64, y: &[f64]| -> Result<Stage, ModelError> {
         let (mut v, mut a, mut b) = (vec![0.0; s], vec![0.0; s * s], vec![0.0; s * ni]);
-        model.rhs_jacobian(t, y, w, &mut v, &mut a, &mut b)?;
+        jacobian(t, y, &mut v, &mut a, &mut b)?;
         Ok(Stage {
             rates: v,
             a: DMatrix::from_row_slice(s, s, &a),
@@ -353,7 +377,7 @@ fn chained<M: Model>(
             ))
         }
         FixedStep::SemiImplicitEuler => {
-            let r = M::info().retained.len();
+            let r = retained;
             // The speeds first: u⁺ = u + h u̇(x); y = (q, u⁺).
             let first = eval(t, x)?;
             let mut y = x.to_vec();
