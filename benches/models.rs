@@ -120,6 +120,28 @@ fn bench_model<M: Model>(
             }
         })
     });
+    // The generated Jacobian (symbolic, or the rhs in W-wide dual numbers:
+    // `info().jacobian`) against num-dual's column-by-column passes.
+    let s = info.state_len();
+    let (mut a, mut bm) = (vec![0.0; s * s], vec![0.0; s * info.inputs.len()]);
+    group.bench_function("rhs_jacobian generated (per call)", |b| {
+        b.iter(|| {
+            for (x, _, _) in &set {
+                model
+                    .rhs_jacobian(0.0, black_box(x), &inputs, &mut d, &mut a, &mut bm)
+                    .unwrap();
+            }
+            black_box(&a);
+        })
+    });
+    group.bench_function("rhs_jacobian num-dual columns (per call)", |b| {
+        b.iter(|| {
+            for (x, _, _) in &set {
+                let lin = appell::linearize::dual_linearize(model, 0.0, black_box(x), &inputs);
+                black_box(lin.unwrap());
+            }
+        })
+    });
     let input = derive_input(source, struct_name);
     group.bench_function("derive expansion", |b| {
         b.iter(|| appell_codegen::expand(black_box(&input)))
@@ -154,6 +176,38 @@ fn bench_model<M: Model>(
         "{name}: {} ops, rhs {rhs_ns:.1} ns, oracle {oracle_ns:.0} ns ({:.0}x), derive expansion {expand_ms:.2} ms",
         info.rhs_ops.total,
         oracle_ns / rhs_ns
+    );
+    // The Jacobians side by side: three alternating rounds, the medians.
+    let (mut generated, mut columns) = (Vec::new(), Vec::new());
+    for _ in 0..3 {
+        let t = Instant::now();
+        for _ in 0..50 {
+            for (x, _, _) in &set {
+                model
+                    .rhs_jacobian(0.0, black_box(x), &inputs, &mut d, &mut a, &mut bm)
+                    .unwrap();
+            }
+        }
+        generated.push(t.elapsed().as_secs_f64() * 1e9 / (50 * set.len()) as f64);
+        let t = Instant::now();
+        for _ in 0..5 {
+            for (x, _, _) in &set {
+                black_box(
+                    appell::linearize::dual_linearize(model, 0.0, black_box(x), &inputs).unwrap(),
+                );
+            }
+        }
+        columns.push(t.elapsed().as_secs_f64() * 1e9 / (5 * set.len()) as f64);
+    }
+    generated.sort_by(f64::total_cmp);
+    columns.sort_by(f64::total_cmp);
+    let form = info.jacobian.map_or("none", |j| j.form);
+    let form = form.split(':').next().unwrap_or(form);
+    println!(
+        "{name}: rhs_jacobian ({form}) {:.0} ns, num-dual columns {:.0} ns ({:.1}x)",
+        generated[1],
+        columns[1],
+        columns[1] / generated[1]
     );
 }
 

@@ -336,7 +336,12 @@ fn derivatives_agreement<M: Model>(model: &M, robot: &str) -> [f64; 6] {
     let o = orders(&joints, info);
     let (n, l, ni) = (info.coordinates.len(), info.speeds.len(), info.inputs.len());
     let mut worst = [0.0f64; 6];
-    for s in &states {
+    let mut values = 0.0f64;
+    // The values are in the states' own file (the same states, in order).
+    let base = reference(robot);
+    assert_eq!(base.states.len(), states.len());
+    for (s, b) in states.iter().zip(&base.states) {
+        assert_eq!((&s.q, &s.tau), (&b.q, &b.tau), "{robot}: the same states");
         let (q, u) = (pick(&o.q_at, &s.q), pick(&o.u_at, &s.v));
         let (a, tau) = (pick(&o.u_at, &s.a), pick(&o.in_at, &s.tau));
         let mut tau_out = vec![0.0; l];
@@ -349,6 +354,10 @@ fn derivatives_agreement<M: Model>(model: &M, robot: &str) -> [f64; 6] {
         model
             .forward_dynamics_derivatives(0.0, &q, &u, &tau, &mut accel, &mut fq, &mut fu, &mut ft)
             .unwrap();
+        // The values beside the derivatives: RNEA's torques and ABA's ÿ.
+        values = values
+            .max(relative(&tau_out, &pick(&o.u_at, &b.rnea)))
+            .max(relative(&accel, &pick(&o.u_at, &b.ddq)));
         // Each generated matrix, and where its columns are in Pinocchio's.
         let generated: [(&[f64], &[usize]); 6] = [
             (&dq, &o.q_at),
@@ -368,8 +377,9 @@ fn derivatives_agreement<M: Model>(model: &M, robot: &str) -> [f64; 6] {
             worst[k] = worst[k].max(relative(values, &reference));
         }
     }
+    assert!(values <= 1e-10, "{robot}: τ and ÿ differ by {values:.2e}");
     println!(
-        "{robot}: derivatives against Pinocchio over {} states: {}",
+        "{robot}: derivatives against Pinocchio over {} states (τ and ÿ beside them {values:.1e}): {}",
         states.len(),
         DERIVATIVES
             .iter()

@@ -236,7 +236,7 @@ fn dual_number_jacobians_agree() {
         // More than one dual pass costs more than the rhs.
         assert!(j.ops.total > 2 * info.rhs_ops.total, "{:?}", j.ops);
     }
-    // The 8-link chain: 15 states (the first joint's angle is cyclic) and
+    // The 8-link chain: 15 states (the first joint's angle is ignorable) and
     // 8 torques in 3 passes of 8.
     let chain = SpatialChain8::info();
     assert_eq!((chain.state_len(), chain.inputs.len()), (15, 8));

@@ -13,7 +13,9 @@
 //!   balance d(T + V)/dt = input power ([`appell::energy::energies`]);
 //! - the generated `rhs_jacobian` (symbolic or by the derive's dual
 //!   numbers) against num-dual's dual numbers through the rhs
-//!   ([`appell::linearize::dual_linearize`]).
+//!   ([`appell::linearize::dual_linearize`]), and the generated
+//!   `inverse_dynamics_derivatives` against num-dual through
+//!   `inverse_dynamics`.
 //!
 //! A state where both the generated code and the oracle refuse (a
 //! singular configuration) is counted and skipped; one where only one of
@@ -173,7 +175,10 @@ pub fn model<M: Model>(model: &M, rng: &mut Rng, energy: bool) -> Result<Report,
         report.reactions = report
             .reactions
             .max(reactions(model, &q, &u, &inputs, &rates[kept..])?);
-        report.jacobian = report.jacobian.max(jacobian(model, &state, &inputs)?);
+        report.jacobian = report
+            .jacobian
+            .max(jacobian(model, &state, &inputs)?)
+            .max(inverse_derivatives(model, &q, &u, udot)?);
         if energy {
             let e = appell::energy::energies(model, 0.0, &q, &u, &inputs)
                 .map_err(|e| format!("{}: energies: {e}", info.name))?;
@@ -206,6 +211,62 @@ fn jacobian<M: Model>(model: &M, state: &[f64], inputs: &[f64]) -> Result<f64, S
             d.map(|_| ())
         )),
     }
+}
+
+/// The generated `inverse_dynamics_derivatives` (∂Q/∂q, ∂Q/∂u) against
+/// num-dual's dual numbers through `inverse_dynamics`, one column at a
+/// time (0 where the model has neither).
+fn inverse_derivatives<M: Model>(
+    model: &M,
+    q: &[f64],
+    u: &[f64],
+    udot: &[f64],
+) -> Result<f64, String> {
+    use appell::num_dual::Dual64;
+    let name = M::info().name;
+    let (n, l) = (q.len(), u.len());
+    let (mut f, mut dq, mut du, mut m) = (
+        vec![0.0; l],
+        vec![0.0; l * n],
+        vec![0.0; l * l],
+        vec![0.0; l * l],
+    );
+    match model.inverse_dynamics_derivatives(0.0, q, u, udot, &mut f, &mut dq, &mut du, &mut m) {
+        Ok(()) => {}
+        Err(ModelError::NeedsInputs { .. } | ModelError::NotGenerated { .. }) => return Ok(0.0),
+        Err(e) => return Err(format!("{name}: inverse dynamics derivatives: {e}")),
+    }
+    let mut worst = 0.0f64;
+    for c in 0..n + l {
+        let seed = |values: &[f64], at: Option<usize>| -> Vec<Dual64> {
+            let mut d: Vec<Dual64> = values.iter().map(|&v| Dual64::from_re(v)).collect();
+            if let Some(k) = at {
+                d[k].eps = 1.0;
+            }
+            d
+        };
+        let (qd, ud) = if c < n {
+            (seed(q, Some(c)), seed(u, None))
+        } else {
+            (seed(q, None), seed(u, Some(c - n)))
+        };
+        let mut out = vec![Dual64::from_re(0.0); l];
+        model
+            .inverse_dynamics(Dual64::from_re(0.0), &qd, &ud, &seed(udot, None), &mut out)
+            .map_err(|e| format!("{name}: inverse dynamics in dual numbers: {e}"))?;
+        let column: Vec<f64> = (0..l)
+            .map(|i| {
+                if c < n {
+                    dq[i * n + c]
+                } else {
+                    du[i * l + c - n]
+                }
+            })
+            .collect();
+        let dual: Vec<f64> = out.iter().map(|d| d.eps).collect();
+        worst = worst.max(worst_of(&column, &dual));
+    }
+    Ok(worst)
 }
 
 /// The inverse dynamics at the oracle's accelerations against the

@@ -59,12 +59,21 @@ impl<T: Scalar, const W: usize> DualVec<T, W> {
         d
     }
 
-    /// The value `f(re)` with derivatives `f'(re) · eps`.
+    /// The value `f(re)` with derivatives `f'(re) · eps`. Where the slope
+    /// is infinite (√ and ln at 0) a direction the argument does not move
+    /// along stays zero rather than 0 · ∞.
     #[inline(always)]
     fn chain(self, value: T, slope: T) -> Self {
+        let finite = slope.re().is_finite();
         DualVec {
             re: value,
-            eps: self.eps.map(|e| e * slope),
+            eps: self.eps.map(|e| {
+                if finite || e.re() != 0.0 {
+                    e * slope
+                } else {
+                    e
+                }
+            }),
         }
     }
 }
@@ -149,9 +158,10 @@ impl<T: Scalar, const W: usize> MulAssign for DualVec<T, W> {
 impl<T: Scalar, const W: usize> DivAssign for DualVec<T, W> {
     #[inline(always)]
     fn div_assign(&mut self, o: Self) {
-        // (a / b)' = (a' − (a / b) b') / b.
+        // (a / b)' = (a' − (a / b) b') / b; the value by T's own division,
+        // as the rhs divides.
         let inv = T::one() / o.re;
-        let q = self.re * inv;
+        let q = self.re / o.re;
         for (e, f) in self.eps.iter_mut().zip(o.eps) {
             *e = (*e - q * f) * inv;
         }
@@ -208,8 +218,55 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
         if n == 0 {
             return Self::one();
         }
-        let below = self.re.powi(n - 1);
-        self.chain(below * self.re, T::from_f64(f64::from(n)) * below)
+        let value = self.re.powi(n);
+        let below = match n.checked_sub(1) {
+            Some(m) => self.re.powi(m),
+            None => value / self.re,
+        };
+        self.chain(value, T::from_f64(f64::from(n)) * below)
+    }
+    #[inline(always)]
+    fn sinh(self) -> Self {
+        self.chain(self.re.sinh(), self.re.cosh())
+    }
+    #[inline(always)]
+    fn cosh(self) -> Self {
+        self.chain(self.re.cosh(), self.re.sinh())
+    }
+    #[inline(always)]
+    fn tanh(self) -> Self {
+        let t = self.re.tanh();
+        self.chain(t, T::one() - t * t)
+    }
+    #[inline(always)]
+    fn asin(self) -> Self {
+        let c = ((T::one() - self.re) * (T::one() + self.re)).sqrt();
+        self.chain(self.re.asin(), T::one() / c)
+    }
+    #[inline(always)]
+    fn acos(self) -> Self {
+        let c = ((T::one() - self.re) * (T::one() + self.re)).sqrt();
+        self.chain(self.re.acos(), -(T::one() / c))
+    }
+    #[inline(always)]
+    fn atan(self) -> Self {
+        let r = self.re;
+        self.chain(r.atan(), T::one() / r.fma(r, T::one()))
+    }
+    #[inline(always)]
+    fn powf(self, y: Self) -> Self {
+        // d(x^y) = y x^(y−1) dx + x^y ln x dy; the second term only along
+        // directions the exponent moves in (a negative base to a constant
+        // power stays finite, as T's powf).
+        let value = self.re.powf(y.re);
+        let slope = y.re * self.re.powf(y.re - T::one());
+        let mut eps = self.eps.map(|e| e * slope);
+        for (e, f) in eps.iter_mut().zip(y.eps) {
+            if f.re() != 0.0 {
+                *e += value * self.re.ln() * f;
+            }
+        }
+        DualVec { re: value, eps }
     }
     #[inline(always)]
     fn atan2(self, x: Self) -> Self {
@@ -238,6 +295,42 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
     }
 }
 
+/// `values` as dual numbers whose entry k is the variable of column
+/// `first_column + k`, seen from a pass that starts at column `first`
+/// (a constant outside the pass's W columns).
+#[inline(always)]
+fn seed<T: Scalar, const W: usize>(
+    duals: &mut [DualVec<T, W>],
+    values: &[T],
+    first_column: usize,
+    first: usize,
+) {
+    for (k, (d, &v)) in duals.iter_mut().zip(values).enumerate() {
+        *d = DualVec::variable(v, (first_column + k).wrapping_sub(first));
+    }
+}
+
+/// A pass's derivatives into two row-major matrices with `rows.len()`
+/// rows: its columns below `split` into `left` (`split` columns), the
+/// others into `right` (`width` columns, numbered from `split`).
+fn scatter<T: Scalar, const W: usize>(
+    rows: &[DualVec<T, W>],
+    first: usize,
+    (left, split): (&mut [T], usize),
+    (right, width): (&mut [T], usize),
+) {
+    for (row, d) in rows.iter().enumerate() {
+        for (k, &e) in d.eps.iter().enumerate() {
+            let c = first + k;
+            if c < split {
+                left[row * split + c] = e;
+            } else if c < split + width {
+                right[row * width + c - split] = e;
+            }
+        }
+    }
+}
+
 /// The rhs's Jacobians by forward-mode dual numbers, in one call: `dstate`
 /// as [`Model::rhs`] writes it, `a` = ∂rhs/∂state (S×S row-major) and
 /// `b` = ∂rhs/∂inputs (S×I row-major), from ⌈(S + I) / W⌉ evaluations of
@@ -246,8 +339,12 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
 /// allocation; errors as the rhs's, and [`ModelError::NonFinite`] naming
 /// the Jacobian when a derivative is not finite.
 ///
-/// The derive writes `rhs_jacobian` as this call when it is cheaper than
-/// the symbolic derivatives; any model can call it.
+/// The derive writes `rhs_jacobian` as this call where it writes no
+/// symbolic derivatives (they would cost more, or grow the code past its
+/// bound, or the model is a scene with constraints of its own); any model
+/// can call it. Each pass's dual numbers take 1 + W times the stack of the
+/// rhs's values: a large model's rhs in `DualVec<f64, 8>` wants a few MiB
+/// of stack in a debug build.
 ///
 /// ```
 /// use appell_runtime::dual::rhs_jacobian_by_duals;
@@ -284,6 +381,7 @@ pub fn rhs_jacobian_by_duals<
     crate::check_len("dstate", dstate, S)?;
     crate::check_len("a", a, S * S)?;
     crate::check_len("b", b, S * I)?;
+    const { assert!(W > 0, "a pass carries at least one direction") };
     let prepared = model.prepare::<DualVec<T, W>>();
     let time = DualVec::constant(t);
     let mut x = [DualVec::<T, W>::constant(T::zero()); S];
@@ -294,23 +392,10 @@ pub fn rhs_jacobian_by_duals<
     // reports a failing rhs.
     loop {
         // Column c = first + k is direction k of this pass.
-        for (c, (x, &v)) in x.iter_mut().zip(state).enumerate() {
-            *x = DualVec::variable(v, c.wrapping_sub(first));
-        }
-        for (c, (u, &v)) in u.iter_mut().zip(inputs).enumerate() {
-            *u = DualVec::variable(v, (S + c).wrapping_sub(first));
-        }
+        seed(&mut x, state, 0, first);
+        seed(&mut u, inputs, S, first);
         model.rhs(&prepared, time, &x, &u, &mut dx)?;
-        for (row, d) in dx.iter().enumerate() {
-            for (k, &e) in d.eps.iter().enumerate() {
-                let c = first + k;
-                if c < S {
-                    a[row * S + c] = e;
-                } else if c < S + I {
-                    b[row * I + c - S] = e;
-                }
-            }
-        }
+        scatter(&dx, first, (&mut *a, S), (&mut *b, I));
         first += W;
         if first >= S + I {
             break;
@@ -337,7 +422,9 @@ pub fn rhs_jacobian_by_duals<
 /// [`ModelError::NonFinite`] when a derivative is not finite.
 ///
 /// The derive writes `inverse_dynamics_derivatives` as this call where it
-/// does not differentiate the recursions symbolically.
+/// does not differentiate the recursions symbolically (a model that is not
+/// a tree of joints, a scene, or recursions whose derivatives would pass
+/// its size bound).
 ///
 /// ```
 /// use appell_runtime::dual::inverse_dynamics_derivatives_by_duals;
@@ -379,6 +466,7 @@ pub fn inverse_dynamics_derivatives_by_duals<
     crate::check_len("dq", dq, L * N)?;
     crate::check_len("du", du, L * L)?;
     crate::check_len("m", m, L * L)?;
+    const { assert!(W > 0, "a pass carries at least one direction") };
     let time = DualVec::constant(t);
     let mut qd = [DualVec::<T, W>::constant(T::zero()); N];
     let mut ud = [DualVec::<T, W>::constant(T::zero()); L];
@@ -389,23 +477,10 @@ pub fn inverse_dynamics_derivatives_by_duals<
     let mut out = [DualVec::<T, W>::constant(T::zero()); L];
     let mut first = 0;
     loop {
-        for (c, (x, &v)) in qd.iter_mut().zip(q).enumerate() {
-            *x = DualVec::variable(v, c.wrapping_sub(first));
-        }
-        for (c, (x, &v)) in ud.iter_mut().zip(u).enumerate() {
-            *x = DualVec::variable(v, (N + c).wrapping_sub(first));
-        }
+        seed(&mut qd, q, 0, first);
+        seed(&mut ud, u, N, first);
         model.inverse_dynamics(time, &qd, &ud, &ad, &mut out)?;
-        for (row, d) in out.iter().enumerate() {
-            for (k, &e) in d.eps.iter().enumerate() {
-                let c = first + k;
-                if c < N {
-                    dq[row * N + c] = e;
-                } else if c < N + L {
-                    du[row * L + c - N] = e;
-                }
-            }
-        }
+        scatter(&out, first, (&mut *dq, N), (&mut *du, L));
         first += W;
         if first >= N + L {
             break;
@@ -508,6 +583,52 @@ mod tests {
         one(|a| (-a).abs(), x, 1.0);
         one(|a| a.asin(), x.asin(), 1.0 / (1.0 - x * x).sqrt());
         one(|a| a.tanh(), x.tanh(), 1.0 - x.tanh().powi(2));
+        one(|a| a.powi(-2), x.powi(-2), -2.0 * x.powi(-3));
+        one(|a| a.acos(), x.acos(), -1.0 / (1.0 - x * x).sqrt());
+        one(|a| a.atan(), x.atan(), 1.0 / (1.0 + x * x));
+        one(|a| a.sinh(), x.sinh(), x.cosh());
+        one(|a| a.cosh(), x.cosh(), x.sinh());
+        // atan2 in the left half plane, and a power with both moving.
+        check(|a, b| b.atan2(-a), x, 0.4, 0.4_f64.atan2(-x), {
+            let r = x * x + 0.16;
+            [0.4 / r, -x / r]
+        });
+        check(|a, b| a.powf(b), x, 1.7, x.powf(1.7), {
+            [1.7 * x.powf(0.7), x.powf(1.7) * x.ln()]
+        });
+    }
+
+    #[test]
+    fn values_are_the_scalars_own() {
+        // The value of a quotient, a power and a square root is T's, bit
+        // for bit, so the Jacobians' values are the rhs's.
+        let (x, y) = (0.7_f64, 0.3_f64);
+        let (a, b) = (D::variable(x, 0), D::variable(y, 1));
+        assert_eq!((a / b).re, x / y);
+        assert_eq!(a.powi(5).re, x.powi(5));
+        assert_eq!(a.powf(b).re, x.powf(y));
+        assert_eq!(a.sqrt().re, x.sqrt());
+        // A negative base to a constant power is finite, as for f64.
+        let c = DualVec::<f64, 2>::constant(2.0);
+        assert_eq!((-a).powf(c).re, (-x).powf(2.0));
+        assert!((-a).powf(c).eps.iter().all(|e| e.is_finite()));
+        // √ at zero along no direction stays zero.
+        let zero = DualVec::<f64, 2>::constant(0.0).sqrt();
+        assert_eq!(zero.eps, [0.0, 0.0]);
+    }
+
+    #[test]
+    fn duals_of_duals_carry_second_derivatives() {
+        // x ↦ x³ at 0.5: the inner dual's derivative of the outer one's is
+        // the second derivative 6x.
+        type Inner = DualVec<f64, 1>;
+        let x = DualVec::<Inner, 1> {
+            re: Inner::variable(0.5, 0),
+            eps: [Inner::constant(1.0)],
+        };
+        let y = x.powi(3);
+        assert_eq!(y.eps[0].re, 3.0 * 0.25);
+        assert!((y.eps[0].eps[0] - 6.0 * 0.5).abs() < 1e-15);
     }
 
     #[test]

@@ -682,7 +682,9 @@ pub trait Model {
     /// (l×n row-major, one column per coordinate in
     /// [`ModelInfo::coordinates`] order, zero for the coordinates the
     /// equations do not depend on), `du` = ∂ÿ/∂u (l×l) and `dinputs` =
-    /// ∂ÿ/∂inputs (l×i). For a fixed-base robot from a URDF these are
+    /// ∂ÿ/∂inputs (l×i); a quaternion's four components each, where
+    /// Pinocchio differentiates along its tangent. For a fixed-base robot
+    /// from a URDF these are
     /// Pinocchio's `ddq_dq`, `ddq_dv` and `ddq_dtau` (= M⁻¹ where every
     /// joint is actuated). The derive writes it from
     /// [`Model::rhs_jacobian`]'s rows for ÿ wherever it writes that; this

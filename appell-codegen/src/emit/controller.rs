@@ -116,7 +116,7 @@ impl Emitter<'_> {
         }
         let p = p();
         let (n, l) = (self.d.n, self.d.l);
-        let width = (n + l).clamp(1, 8);
+        let (width, _) = super::jacobian::dual_width(n + l);
         let (n, l, w) = (int(n), int(l), int(width));
         quote! {
             fn inverse_dynamics_derivatives<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __accel: &[__T], __forces: &mut [__T], __dq: &mut [__T], __du: &mut [__T], __m: &mut [__T]) -> #p::Result<(), #p::ModelError> {

@@ -102,34 +102,13 @@ impl Emitter<'_> {
         );
         let total = int(rhs_ops.total() + extra_ops);
         let text = format!("rhs: {form}\njacobian: {}\n\n{}", jacobian.summary, d.text);
-        let jacobian = match jacobian.dual {
-            Some((width, passes)) => {
-                // The runtime's count of the dual passes, taken here.
-                let rhs = appell_runtime::OpCounts {
-                    add: rhs_ops.add,
-                    mul: rhs_ops.mul,
-                    div: rhs_ops.div,
-                    calls: rhs_ops.calls,
-                    total: rhs_ops.total() + extra_ops,
-                };
-                let c = appell_runtime::dual::pass_costs(rhs, width, passes);
-                let form = &jacobian.summary;
-                let (add, mul, div, calls, total) = (
-                    int(c.add),
-                    int(c.mul),
-                    int(c.div),
-                    int(c.calls),
-                    int(c.total),
-                );
-                quote! {
-                    ::core::option::Option::Some(#p::JacobianInfo {
-                        form: #form,
-                        ops: #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
-                    })
-                }
-            }
-            None => jacobian.info.clone(),
-        };
+        let jacobian = jacobian.info(appell_runtime::OpCounts {
+            add: rhs_ops.add,
+            mul: rhs_ops.mul,
+            div: rhs_ops.div,
+            calls: rhs_ops.calls,
+            total: rhs_ops.total() + extra_ops,
+        });
         quote! {
             #p::ModelInfo {
                 name: #name,

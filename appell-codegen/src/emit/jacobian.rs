@@ -27,14 +27,58 @@ use crate::derivation::{singleton_rows, Elimination, NumericElimination};
 pub(super) struct JacobianParts {
     /// `fn rhs_jacobian`, or nothing (the trait's default).
     pub function: TokenStream,
-    /// `Some(JacobianInfo { .. })` or `None`; for dual numbers the info
-    /// is written with the rhs's operation counts (see `dual`).
-    pub info: TokenStream,
-    /// Dual numbers: (width W, passes), whose cost `ModelInfo` states from
-    /// the rhs's counts.
-    pub dual: Option<(usize, usize)>,
+    /// How `ModelInfo::jacobian` is written ([`JacobianParts::info`]).
+    info: InfoParts,
     /// How it is computed, or why there is none, for the equations text.
     pub summary: String,
+}
+
+/// What `ModelInfo::jacobian` says.
+enum InfoParts {
+    /// `None`.
+    Nothing,
+    /// A symbolic candidate's `Some(JacobianInfo { .. })`.
+    Symbolic(TokenStream),
+    /// Dual numbers: W directions a pass, the passes; the cost follows
+    /// from the rhs's.
+    Dual(usize, usize),
+}
+
+impl JacobianParts {
+    /// `ModelInfo::jacobian`'s value for a model whose rhs costs `rhs`.
+    pub(super) fn info(&self, rhs: appell_runtime::OpCounts) -> TokenStream {
+        let p = p();
+        match &self.info {
+            InfoParts::Nothing => quote!(::core::option::Option::None),
+            InfoParts::Symbolic(info) => info.clone(),
+            &InfoParts::Dual(width, passes) => {
+                // The runtime's count of the passes, taken here.
+                let c = appell_runtime::dual::pass_costs(rhs, width, passes);
+                let form = &self.summary;
+                let (add, mul, div, calls, total) = (
+                    int(c.add),
+                    int(c.mul),
+                    int(c.div),
+                    int(c.calls),
+                    int(c.total),
+                );
+                quote! {
+                    ::core::option::Option::Some(#p::JacobianInfo {
+                        form: #form,
+                        ops: #p::OpCounts { add: #add, mul: #mul, div: #div, calls: #calls, total: #total },
+                    })
+                }
+            }
+        }
+    }
+}
+
+/// Dual numbers over `columns` columns: (W, passes), at most 8 directions
+/// a pass (a large rhs's temporaries stay small) spread evenly over the
+/// fewest passes (9 columns: 5 and 4, not 8 and 1).
+pub(super) fn dual_width(columns: usize) -> (usize, usize) {
+    let passes = columns.div_ceil(8).max(1);
+    (columns.div_ceil(passes).max(1), passes)
 }
 
 /// A candidate's roots: the values, then the derivatives.
@@ -88,16 +132,17 @@ impl Layout {
 }
 
 impl Emitter<'_> {
-    /// `rhs_jacobian` and its info, from the candidate with fewer
-    /// expressions; nothing where stage 14 has none, or (unless the model
-    /// says `jacobian(on)`) where the chosen one has more than
-    /// [`SIZE_LIMIT`] times the expressions of the values it differentiates.
+    /// `rhs_jacobian` and its info: the symbolic candidate with fewer
+    /// expressions where it has at most [`SIZE_LIMIT`] times the
+    /// expressions of the values it differentiates and fewer than the dual
+    /// passes' estimate (any size with `jacobian(on)`); otherwise, and
+    /// where stage 14 has no candidate, the rhs in dual numbers; nothing
+    /// with `jacobian(off)`.
     pub(super) fn jacobian(&self, common: &super::functions::Common) -> JacobianParts {
         if self.model.jacobian == Some(false) {
             return JacobianParts {
                 function: TokenStream::new(),
-                info: quote!(::core::option::Option::None),
-                dual: None,
+                info: InfoParts::Nothing,
                 summary:
                     "none (turned off by `jacobian(off)`; tools use dual numbers through the rhs)"
                         .to_string(),
@@ -107,7 +152,9 @@ impl Emitter<'_> {
         // Expressions per rhs expression, over all passes (see the module).
         let dual_ratio = passes * (1 + 2 * width);
         let Some(j) = &self.d.jacobians else {
-            return self.dual_parts("not derived".to_string());
+            return self.dual_parts(
+                "stage 14 does not differentiate a scene with constraints of its own".to_string(),
+            );
         };
         let layout = self.layout(j);
         let g = &self.model.g;
@@ -197,18 +244,15 @@ impl Emitter<'_> {
         };
         JacobianParts {
             function: self.jacobian_function(common, &layout, chosen.body),
-            info,
-            dual: None,
+            info: InfoParts::Symbolic(info),
             summary: form,
         }
     }
 
-    /// The dual numbers' width W (at most 8 directions a pass, so that a
-    /// large rhs's temporaries stay small) and passes over the columns.
+    /// The dual numbers' width W and passes over the state's and the
+    /// inputs' columns.
     fn dual_shape(&self) -> (usize, usize) {
-        let columns = self.d.reduction.retained.len() + self.d.l + self.inputs().len();
-        let width = columns.clamp(1, 8);
-        (width, columns.div_ceil(width).max(1))
+        dual_width(self.d.reduction.retained.len() + self.d.l + self.inputs().len())
     }
 
     /// `rhs_jacobian` as the runtime's `rhs_jacobian_by_duals` over this
@@ -233,8 +277,7 @@ impl Emitter<'_> {
         );
         JacobianParts {
             function,
-            info: TokenStream::new(),
-            dual: Some((width, passes)),
+            info: InfoParts::Dual(width, passes),
             summary,
         }
     }

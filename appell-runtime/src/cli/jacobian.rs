@@ -100,8 +100,13 @@ fn generated(
 ) -> Result<Columns, crate::model::ModelError> {
     let (x, w) = (&point.state[..], &point.inputs[..]);
     let (s, ni) = (x.len(), w.len());
-    let mut jacobian = |t: f64, y: &[f64], v: &mut [f64], a: &mut [f64], b: &mut [f64]| {
-        rhs.generated_jacobian(t, y, w, v, a, b).map(|_| ())
+    let mut jacobian = |t: f64, y: &[f64], v: &mut [f64], a: &mut [f64], b: &mut [f64]| match rhs
+        .generated_jacobian(t, y, w, v, a, b)?
+    {
+        true => Ok(()),
+        false => Err(crate::model::ModelError::NotGenerated {
+            function: "rhs_jacobian",
+        }),
     };
     match step {
         None => {

@@ -599,11 +599,15 @@ fn jacobian_fields<M: Model>() -> String {
     }
 }
 
-/// [`bench`] of `model`, then, if it has no generated Jacobian, the
-/// Jacobians of its twin `with` ([`twin`]).
+/// [`bench`] of `model`, then, if its generated Jacobian is the rhs in
+/// dual numbers (or it has none), the symbolic Jacobians of its twin
+/// `with` ([`twin`]).
 fn with_twin<P: Model, M: Model>(model: &P, with: &M, opts: &Options) -> Result<(), String> {
     bench(model, opts)?;
-    if P::info().jacobian.is_none() {
+    let by_duals = P::info()
+        .jacobian
+        .is_none_or(|j| j.form.starts_with("dual numbers"));
+    if by_duals {
         twin(with, opts)?;
     }
     Ok(())
