@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import difflib
 import os
-import re
 from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 import numpy as np
@@ -36,10 +35,6 @@ def _hint(name: str, names: Sequence[str]) -> str:
     return f" (did you mean {close[0]!r}?)" if close else ""
 
 
-def _snake(camel: str) -> str:
-    return re.sub(r"(?<!^)(?=[A-Z])", "_", camel).lower()
-
-
 class Model:
     """A model compiled by :func:`appell.from_model` or
     :func:`appell.from_urdf` (or one of its scenes, :meth:`scene`).
@@ -54,7 +49,7 @@ class Model:
 
     Layouts (as in the Rust ``appell::Model``): the reduced state ``x`` is
     the retained coordinates then the speeds (:attr:`state_names`); ``q``
-    all coordinates, ``v`` the speeds, ``u`` the inputs.
+    all coordinates, ``v`` the speeds, ``u`` the inputs (None: all zero).
     """
 
     def __init__(self, native: Any, name: str, parameter_values: Mapping[str, float],
@@ -64,7 +59,7 @@ class Model:
         self._source = source
         info = native.info(scene)
         self._info = info
-        self.name: str = name if scene is None else info["name"]
+        self.name: str = name if scene is None else info["name"].split("::")[-1]
         self.parameter_names: List[str] = list(info["parameters"])
         self.state_names: List[str] = list(info["state"])
         self.coordinate_names: List[str] = list(info["coordinates"])
@@ -78,9 +73,7 @@ class Model:
         self._no_inputs = np.zeros(0)
         scene_infos = native.scene_names()
         model_name = native.info(None)["name"]
-        self._scene_names = [
-            _snake(s[len(model_name):]) if s.startswith(model_name) else _snake(s) for s in scene_infos
-        ]
+        self._scene_names = [s.split("::")[-1] for s in scene_infos]
         self._scene_types = list(scene_infos)
         if scene is None and parameter_values:
             self.parameters = dict(parameter_values)
@@ -102,8 +95,8 @@ class Model:
         return list(self._scene_names)
 
     def scene(self, name: str) -> "Model":
-        """Scene ``name`` (as declared, or its Rust type name) as a model of
-        its own, sharing this model's parameters."""
+        """Scene ``name`` (as declared in ``scene(name, ...)``) as a model
+        of its own, sharing this model's parameters."""
         for k, (short, typ) in enumerate(zip(self._scene_names, self._scene_types)):
             if name in (short, typ):
                 return Model(self._native, typ, {}, scene=k, source=self._source)
@@ -145,7 +138,7 @@ class Model:
     def _array(self, what: str, value: Any, names: Sequence[str], allow_none: bool = False) -> np.ndarray:
         width = len(names)
         if value is None:
-            if allow_none or width == 0:
+            if allow_none or width == 0 or what == "u":
                 return np.zeros(width)
             raise ValueError(f"`{what}` is required: {width} values {list(names)}")
         if isinstance(value, Mapping):
@@ -177,6 +170,19 @@ class Model:
     def _call(self, op: str, args: List[np.ndarray], t: float, params: Any) -> np.ndarray:
         p = None if params is None else self._parameter_array(params)
         return self._native.call(op, args, float(t), self._scene, p, _threads, _min_rows)
+
+    def reduced_state(self, q: ArrayLike, v: ArrayLike) -> np.ndarray:
+        """The reduced state x (retained coordinates, then the speeds) from
+        all coordinates ``q`` and the speeds ``v``, as Pinocchio's (q, v)
+        give it; batched like every function."""
+        qa = self._array("q", q, self.coordinate_names)
+        va = self._array("v", v, self.speed_names)
+        keep = [self.coordinate_names.index(r) for r in self._info["retained"]]
+        if qa.ndim == 2 or va.ndim == 2:
+            rows = qa.shape[0] if qa.ndim == 2 else va.shape[0]
+            qa = np.broadcast_to(qa, (rows, qa.shape[-1]))
+            va = np.broadcast_to(va, (rows, va.shape[-1]))
+        return np.concatenate([qa[..., keep], va], axis=-1)
 
     # ----- the functions -------------------------------------------------
 
