@@ -66,7 +66,7 @@ def bicycle(cache):
 
 @pytest.fixture(scope="session")
 def ur5(cache):
-    return appell.from_urdf(REPO / "examples/robots/ur5/ur5_robot.urdf", gravity=(0, 0, -9.81), name="Ur5")
+    return appell.from_urdf(REPO / "examples/robots/ur5/ur5_robot.urdf", gravity=(0, 0, -9.81))
 
 
 _examples: Dict[str, Path] = {}
