@@ -27,7 +27,8 @@ fn main() {
     let root = manifest.parent().unwrap().to_path_buf();
     let mut files: Vec<(String, PathBuf)> = Vec::new();
 
-    let root_manifest = fs::read_to_string(root.join("Cargo.toml")).expect("the workspace manifest");
+    let root_manifest =
+        fs::read_to_string(root.join("Cargo.toml")).expect("the workspace manifest");
     let members = CRATES
         .iter()
         .map(|c| format!("\"{c}\""))
@@ -45,14 +46,20 @@ fn main() {
         .collect::<Vec<_>>()
         .join("\n")
         + "\n";
-    files.push(("Cargo.toml".into(), written(&out, "root.Cargo.toml", &root_manifest)));
+    files.push((
+        "Cargo.toml".into(),
+        written(&out, "root.Cargo.toml", &root_manifest),
+    ));
     files.push(("README.md".into(), root.join("README.md")));
     collect(&root, &root.join("src"), &mut files);
     for krate in CRATES {
         let dir = root.join(krate);
         let text = fs::read_to_string(dir.join("Cargo.toml")).expect("a crate manifest");
         let name = format!("{krate}.Cargo.toml");
-        files.push((format!("{krate}/Cargo.toml"), written(&out, &name, &trim_manifest(&text))));
+        files.push((
+            format!("{krate}/Cargo.toml"),
+            written(&out, &name, &trim_manifest(&text)),
+        ));
         for extra in ["README.md", "build.rs"] {
             if dir.join(extra).exists() {
                 files.push((format!("{krate}/{extra}"), dir.join(extra)));
@@ -61,30 +68,63 @@ fn main() {
         collect(&root, &dir.join("src"), &mut files);
     }
     let glue = manifest.join("glue");
-    files.push(("appell-python/glue/Cargo.toml".into(), glue.join("Cargo.toml")));
-    files.push(("appell-python/glue/model.Cargo.lock".into(), glue.join("model.Cargo.lock")));
+    files.push((
+        "appell-python/glue/Cargo.toml".into(),
+        glue.join("Cargo.toml"),
+    ));
+    files.push((
+        "appell-python/glue/model.Cargo.lock".into(),
+        glue.join("model.Cargo.lock"),
+    ));
     collect(&root, &glue.join("src"), &mut files);
     files.sort();
 
-    // FNV-1a over paths and contents: the name of the cache's source tree.
+    // FNV-1a over paths and contents: the names of the cache's source
+    // trees, one for the appell crates and one for the glue, so that a
+    // change of the glue alone does not rebuild the appell crates.
     let mut hash: u64 = 0xcbf2_9ce4_8422_2325;
-    let mut code = String::from("/// (path, contents) of every carried file.\npub static SOURCES: &[(&str, &[u8])] = &[\n");
+    let mut glue_hash: u64 = 0xcbf2_9ce4_8422_2325;
+    let mut code = String::from(
+        "/// (path, contents) of every carried file.\npub static SOURCES: &[(&str, &[u8])] = &[\n",
+    );
     for (rel, path) in &files {
         let bytes = fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        let h = if rel.starts_with("appell-python/glue/") {
+            &mut glue_hash
+        } else {
+            &mut hash
+        };
         for b in rel.bytes().chain([0]).chain(bytes.iter().copied()) {
-            hash ^= u64::from(b);
-            hash = hash.wrapping_mul(0x0100_0000_01b3);
+            *h ^= u64::from(b);
+            *h = h.wrapping_mul(0x0100_0000_01b3);
         }
-        writeln!(code, "    ({rel:?}, include_bytes!({:?})),", path.display().to_string()).unwrap();
+        writeln!(
+            code,
+            "    ({rel:?}, include_bytes!({:?})),",
+            path.display().to_string()
+        )
+        .unwrap();
         println!("cargo:rerun-if-changed={}", path.display());
     }
     code.push_str("];\n");
-    writeln!(code, "/// A hash of [`SOURCES`].\npub const SOURCE_HASH: &str = \"{hash:016x}\";").unwrap();
+    writeln!(code, "/// A hash of the appell crates in [`SOURCES`].\npub const APPELL_HASH: &str = \"{hash:016x}\";").unwrap();
+    writeln!(
+        code,
+        "/// A hash of the glue in [`SOURCES`].\npub const GLUE_HASH: &str = \"{glue_hash:016x}\";"
+    )
+    .unwrap();
     fs::write(out.join("sources.rs"), code).unwrap();
-    for dir in CRATES.iter().map(|c| root.join(c).join("src")).chain([root.join("src"), glue.join("src")]) {
+    for dir in CRATES
+        .iter()
+        .map(|c| root.join(c).join("src"))
+        .chain([root.join("src"), glue.join("src")])
+    {
         println!("cargo:rerun-if-changed={}", dir.display());
     }
-    println!("cargo:rerun-if-changed={}", root.join("Cargo.toml").display());
+    println!(
+        "cargo:rerun-if-changed={}",
+        root.join("Cargo.toml").display()
+    );
 }
 
 /// Writes `text` to `out/name` and returns the path.
@@ -105,7 +145,11 @@ fn collect(root: &Path, dir: &Path, files: &mut Vec<(String, PathBuf)>) {
         if path.is_dir() {
             collect(root, &path, files);
         } else {
-            let rel = path.strip_prefix(root).unwrap().to_string_lossy().replace('\\', "/");
+            let rel = path
+                .strip_prefix(root)
+                .unwrap()
+                .to_string_lossy()
+                .replace('\\', "/");
             files.push((rel, path));
         }
     }

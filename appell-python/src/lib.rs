@@ -21,7 +21,12 @@ fn sources(py: Python<'_>) -> Vec<(&'static str, Bound<'_, PyBytes>)> {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(sources, m)?)?;
-    m.add("SOURCE_HASH", carried::SOURCE_HASH)?;
+    m.add("APPELL_HASH", carried::APPELL_HASH)?;
+    m.add("GLUE_HASH", carried::GLUE_HASH)?;
+    m.add(
+        "SOURCE_HASH",
+        format!("{}-{}", carried::APPELL_HASH, carried::GLUE_HASH),
+    )?;
     m.add("VERSION", env!("CARGO_PKG_VERSION"))?;
     Ok(())
 }

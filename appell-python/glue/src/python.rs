@@ -193,7 +193,11 @@ impl NativeModel {
 
     /// The scenes' struct names, in declaration order.
     fn scene_names(&self) -> Vec<&'static str> {
-        self.current().scene_infos().iter().map(|i| i.name).collect()
+        self.current()
+            .scene_infos()
+            .iter()
+            .map(|i| i.name)
+            .collect()
     }
 
     /// The parameter values, in the model's order.
@@ -263,6 +267,67 @@ impl NativeModel {
         Ok(PyArray1::from_vec(py, out))
     }
 
+    /// The reduced rhs of the model (not a scene) at one state, when `x`
+    /// and `u` (None: no inputs) are 1-D C-contiguous float64 arrays of
+    /// the right lengths; `None` otherwise, and the caller takes the
+    /// general path. The fast path of `Model.rhs`: no conversion, no
+    /// borrow bookkeeping.
+    #[pyo3(signature = (x, u, t))]
+    fn rhs_fast<'py>(
+        &self,
+        py: Python<'py>,
+        x: &Bound<'py, PyAny>,
+        u: Option<&Bound<'py, PyAny>>,
+        t: f64,
+    ) -> PyResult<Option<Bound<'py, PyArray1<f64>>>> {
+        let model = self.current();
+        let info = model.info(None);
+        let s = info.state_len();
+        let Ok(x) = x.downcast::<PyArray1<f64>>() else {
+            return Ok(None);
+        };
+        // SAFETY: the GIL is held from here to the end of the call and no
+        // Python code runs meanwhile, so nothing can write to or free the
+        // arrays while their slices are read.
+        let Ok(xs) = (unsafe { x.as_slice() }) else {
+            return Ok(None);
+        };
+        let us: &[f64] = match u {
+            None if info.inputs.is_empty() => &[],
+            None => return Ok(None),
+            Some(u) => {
+                let Ok(u) = u.downcast::<PyArray1<f64>>() else {
+                    return Ok(None);
+                };
+                // SAFETY: as for `x`.
+                match unsafe { u.as_slice() } {
+                    Ok(us) => us,
+                    Err(_) => return Ok(None),
+                }
+            }
+        };
+        if xs.len() != s || us.len() != info.inputs.len() {
+            return Ok(None);
+        }
+        let mut out = vec![0.0; s];
+        let args = [
+            Arg {
+                data: xs,
+                len: s,
+                batched: false,
+            },
+            Arg {
+                data: us,
+                len: us.len(),
+                batched: false,
+            },
+        ];
+        model
+            .rows(None, Op::Rhs, t, &args, &mut out, 0)
+            .map_err(|f| failure(py, f, false, Op::Rhs))?;
+        Ok(Some(PyArray1::from_vec(py, out)))
+    }
+
     /// Evaluates operation `op` (see `operations()`) on `args`, each a
     /// C-contiguous float64 array of one row (1-D) or of N rows (2-D, the
     /// same N for all); returns (N, width) or (width,). `params`: values
@@ -298,9 +363,9 @@ impl NativeModel {
         let mut rows: Option<usize> = None;
         let mut slices = Vec::with_capacity(args.len());
         for (arg, (name, len)) in args.iter().zip(&expected) {
-            let data = arg.as_slice().map_err(|_| {
-                PyValueError::new_err(format!("`{name}` must be C-contiguous"))
-            })?;
+            let data = arg
+                .as_slice()
+                .map_err(|_| PyValueError::new_err(format!("`{name}` must be C-contiguous")))?;
             let shape = arg.shape();
             let batched = match shape.len() {
                 1 => false,
@@ -388,7 +453,8 @@ impl NativeModel {
         let model = self.with(params).map_err(|m| model_error(py, m))?;
         let info = model.info(scene);
         let s = info.state_len();
-        let contiguous = |name: &str| PyValueError::new_err(format!("`{name}` must be C-contiguous"));
+        let contiguous =
+            |name: &str| PyValueError::new_err(format!("`{name}` must be C-contiguous"));
         let xs = x0.as_slice().map_err(|_| contiguous("x0"))?;
         let us = u.as_slice().map_err(|_| contiguous("u"))?;
         let times = t_eval.as_slice().map_err(|_| contiguous("t_eval"))?;

@@ -5,8 +5,9 @@ The cache directory (``appell.cache_dir()``; set it with
 ``APPELL_CACHE_DIR``; by default ``$XDG_CACHE_HOME/appell`` or
 ``~/.cache/appell``) holds:
 
-- ``src/<hash>/``: the source of the appell crates this package carries
-  (written once per package version from ``appell._native``);
+- ``src/appell-<hash>/`` and ``src/glue-<hash>/``: the source of the
+  appell crates and of the glue this package carries (written once per
+  package build from ``appell._native``);
 - ``target/``: one cargo target directory shared by every model, so that
   the derive, the runtime, PyO3 and NumPy's bindings are compiled once;
 - ``models/<key>/``: one small crate per model and the module built from
@@ -33,7 +34,7 @@ import threading
 import time
 from pathlib import Path
 from types import ModuleType
-from typing import Dict, List, Optional, Sequence
+from typing import Dict, List, Optional, Sequence, Tuple
 
 from . import _native
 from .errors import CompileError, Diagnostic, ToolchainError
@@ -89,14 +90,16 @@ def _cargo() -> str:
     return cargo
 
 
-def _source_tree(root: Path) -> Path:
-    """The carried crates, unpacked once per package build."""
-    tree = root / "src" / _native.SOURCE_HASH
+def _unpack(tree: Path, files: List[Tuple[str, bytes]], fix=None) -> Path:
+    """Writes ``files`` into ``tree`` once (atomically: other processes see
+    the whole tree or none)."""
     if (tree / ".complete").exists():
         return tree
     tree.parent.mkdir(parents=True, exist_ok=True)
     tmp = Path(tempfile.mkdtemp(prefix=".unpack-", dir=tree.parent))
-    for rel, data in _native.sources():
+    for rel, data in files:
+        if fix is not None:
+            data = fix(rel, data)
         path = tmp / rel
         path.parent.mkdir(parents=True, exist_ok=True)
         path.write_bytes(data)
@@ -107,6 +110,25 @@ def _source_tree(root: Path) -> Path:
         # Another process unpacked it first.
         shutil.rmtree(tmp, ignore_errors=True)
     return tree
+
+
+def _source_trees(root: Path) -> Tuple[Path, Path]:
+    """The carried appell crates and the glue, each in a directory named by
+    its hash (a new glue alone leaves the compiled appell crates valid)."""
+    glue_prefix = "appell-python/glue/"
+    files = _native.sources()
+    appell_tree = _unpack(root / "src" / f"appell-{_native.APPELL_HASH}",
+                          [(r, d) for r, d in files if not r.startswith(glue_prefix)])
+
+    def fix(rel: str, data: bytes) -> bytes:
+        if rel == "Cargo.toml":
+            # The glue's `appell = { path = "../.." }` points at the tree.
+            return data.replace(b'path = "../.."', b"path = " + json.dumps(str(appell_tree)).encode())
+        return data
+
+    glue_tree = _unpack(root / "src" / f"glue-{_native.GLUE_HASH}",
+                        [(r[len(glue_prefix):], d) for r, d in files if r.startswith(glue_prefix)], fix)
+    return appell_tree, glue_tree
 
 
 def _suffix() -> str:
@@ -204,7 +226,7 @@ def compile_crate(
             _loaded[key] = module
             return module
         cargo = _cargo()
-        tree = _source_tree(root)
+        appell_tree, glue_tree = _source_trees(root)
         crate.mkdir(parents=True, exist_ok=True)
         manifest = (
             "[package]\n"
@@ -213,8 +235,8 @@ def compile_crate(
             "[lib]\n"
             f'name = "{module_name}"\ncrate-type = ["cdylib"]\npath = "lib.rs"\n\n'
             "[dependencies]\n"
-            f"appell = {{ path = {json.dumps(str(tree))} }}\n"
-            f"appell-python-glue = {{ path = {json.dumps(str(tree / 'appell-python' / 'glue'))} }}\n"
+            f"appell = {{ path = {json.dumps(str(appell_tree))} }}\n"
+            f"appell-python-glue = {{ path = {json.dumps(str(glue_tree))} }}\n"
             'pyo3 = { version = "0.25", features = ["abi3-py39", "extension-module"] }\n'
             + PROFILE
             + "\n[workspace]\n"
@@ -222,7 +244,7 @@ def compile_crate(
         (crate / "Cargo.toml").write_text(manifest)
         (crate / "lib.rs").write_text(lib_rs_text)
         (crate / "model.txt").write_text(model_text)
-        lock = tree / "appell-python" / "glue" / "model.Cargo.lock"
+        lock = glue_tree / "model.Cargo.lock"
         if not (crate / "Cargo.lock").exists() and lock.exists():
             shutil.copyfile(lock, crate / "Cargo.lock")
         env = dict(os.environ)

@@ -189,12 +189,10 @@ class Model:
     def rhs(self, x: ArrayLike, u: Optional[ArrayLike] = None, t: float = 0.0,
             params: Any = None) -> np.ndarray:
         """The reduced equations of motion: ẋ = f(t, x, u); shape of ``x``."""
-        if (self._scene is None and params is None and type(x) is np.ndarray and x.ndim == 1
-                and x.dtype == np.float64 and x.flags.c_contiguous and x.shape[0] == self._s):
-            if u is None and self._ni == 0:
-                return self._native.rhs1(x, self._no_inputs, float(t))
-            if type(u) is np.ndarray and u.ndim == 1 and u.dtype == np.float64 and u.flags.c_contiguous and u.shape[0] == self._ni:
-                return self._native.rhs1(x, u, float(t))
+        if params is None and self._scene is None:
+            fast = self._native.rhs_fast(x, u, t)
+            if fast is not None:
+                return fast
         xa = self._array("x", x, self.state_names)
         ua = self._array("u", u, self.input_names)
         return self._call("rhs", [xa, ua], t, params)
