@@ -104,7 +104,7 @@ def throughput() -> dict:
     tau = rng.uniform(-10, 10, (n_app, 6))
     x = ur5.reduced_state(q, v)
     mine = ur5.rhs(x[:100], tau[:100])[:, 5:]
-    theirs = np.array([pin.aba(model, data, q[k], v[k], tau[k]) for k in range(100)])
+    theirs = np.array([pin.aba(model, data, q[k], v[k], tau[k]).copy() for k in range(100)])
     agree = float(np.max(np.abs(mine - theirs) / np.maximum(1.0, np.abs(theirs))))
 
     def pin_loop():
@@ -124,9 +124,11 @@ def throughput() -> dict:
         system = n_link_pendulum_on_cart(n=links, cart_force=True, joint_torques=False)
         values = {**{f"m{i}": 1.0 + 0.1 * i for i in range(links + 1)},
                   **{f"l{i}": 1.0 - 0.05 * i for i in range(links)}, "g": 9.81}
-        consts = np.array([values[str(c)] for c in system.constants_symbols])
         rhs = system.generate_ode_function(generator="cython", constants_arg_type="array",
                                            specifieds_arg_type="array")
+        # The generated function takes the constants in the order of the
+        # system's set of them as generation left it.
+        consts = np.array([values[str(c)] for c in system.constants_symbols])
         pydy_generation = time.perf_counter() - start
         coords = [str(c).replace("(t)", "") for c in system.coordinates]
         speeds = [str(c).replace("(t)", "") for c in system.speeds]
@@ -143,7 +145,8 @@ def throughput() -> dict:
         assert mine_model.state_names == coords[1:] + [f"q{i}_dot" for i in range(links + 1)], \
             (mine_model.state_names, coords, speeds)
         mine = mine_model.rhs(Xa[:100], F[:100])
-        theirs = np.array([rhs(X[k], 0.0, F[k], consts) for k in range(100)])[:, 1:]
+        # (the generated function may hand back one buffer each call: copy)
+        theirs = np.array([rhs(X[k], 0.0, F[k], consts).copy() for k in range(100)])[:, 1:]
         agree = float(np.max(np.abs(mine - theirs) / np.maximum(1.0, np.abs(theirs))))
 
         def pydy_loop():

@@ -253,7 +253,13 @@ def compile_crate(
             if os.environ.get("APPELL_CARGO_TARGET_DIR")
             else root / "target"
         )
-        env["PYO3_PYTHON"] = sys.executable
+        if os.name == "nt":
+            env["PYO3_PYTHON"] = sys.executable
+        else:
+            # abi3: the module needs no particular interpreter to build, so
+            # every venv shares the compiled PyO3.
+            env.pop("PYO3_PYTHON", None)
+            env["PYO3_NO_PYTHON"] = "1"
         env["RUSTFLAGS"] = flags
         env.pop("CARGO_BUILD_TARGET", None)
         cmd = [cargo, "build", "--release", "--lib", "--message-format=json"]
