@@ -74,11 +74,11 @@ _examples: Dict[str, Path] = {}
 
 def rust_example(name: str) -> Path:
     """The example program ``name``, built with cargo (test profile, the
-    environment's target directory: after ``cargo test --workspace`` it is
+    environment's target directory, features as the whole workspace: after ``cargo test --workspace`` it is
     already built)."""
     if name not in _examples:
         out = subprocess.run(
-            ["cargo", "build", "--profile", "test", "--example", name, "--message-format=json"],
+            ["cargo", "build", "--profile", "test", "--workspace", "--example", name, "--message-format=json"],
             cwd=REPO, capture_output=True, text=True,
         )
         assert out.returncode == 0, out.stderr[-3000:]

@@ -36,6 +36,9 @@ impl Method {
 /// of the state's length, a constant of the code).
 pub const DOP853_MAX_STATE: usize = 64;
 
+/// An event function `g(t, x)` (see [`SimJob::event`]).
+pub type Event<'a> = dyn FnMut(f64, &[f64]) -> f64 + 'a;
+
 /// A simulation: from `x0` at `t0`, the state at each of `t_eval` (ordered
 /// in the direction of integration, the first not before `t0`), written
 /// row after row into `out`.
@@ -62,7 +65,7 @@ pub struct SimJob<'a> {
     pub out: &'a mut [f64],
     /// An event function `g(t, x)`: the simulation stops where it changes
     /// sign (DOP853 only).
-    pub event: Option<&'a mut dyn FnMut(f64, &[f64]) -> f64>,
+    pub event: Option<&'a mut Event<'a>>,
     /// Set by the simulation: how many rows of `out` were written.
     pub written: usize,
     /// Set by the simulation: the time of the event and the state there.
