@@ -152,3 +152,14 @@ def test_constraint_forces_and_energies(wheel_axle, rng):
     assert e["kinetic"].shape == (3,) and np.all(e["kinetic"] > 0)
     M, f = m.mass_matrix_and_forcing(q, v, [0.3])
     np.testing.assert_allclose(np.linalg.solve(M, f), xdot[1:], rtol=1e-10)
+
+
+def test_two_models_from_one_module_keep_their_own_parameters(wheel_axle):
+    from conftest import rust_model
+
+    attributes, defaults, name = rust_model("wheel_axle.rs")
+    steep = appell.from_model(attributes, parameters={**defaults, "alpha": 0.5}, name=name)
+    assert appell.cache_info()["hits"] >= 1  # the same module, already loaded
+    assert steep.parameters["alpha"] == 0.5 and wheel_axle.parameters["alpha"] == 0.2
+    x = [0.3, 0.0, 0.0]
+    assert steep.rhs(x, [0.0])[2] > wheel_axle.rhs(x, [0.0])[2]

@@ -191,6 +191,14 @@ impl NativeModel {
         info_dict(py, self.current().info(scene))
     }
 
+    /// A new object with the same model and parameters, whose parameters
+    /// change apart from this one's (each `appell.Model` holds its own).
+    fn copy(&self) -> NativeModel {
+        NativeModel {
+            current: RwLock::new(self.current()),
+        }
+    }
+
     /// The scenes' struct names, in declaration order.
     fn scene_names(&self) -> Vec<&'static str> {
         self.current()

@@ -55,7 +55,8 @@ def _compile(name: str, text: str, parameters: Sequence[str], files: Sequence[Pa
              rustflags: Optional[str], progress: bool) -> Any:
     lib_rs, first = crate_source(name, text, list(parameters), "__APPELL_MODULE__")
     module = _build.compile_crate(name, lib_rs, first, text, files, rustflags, progress, _module_name)
-    return module.model
+    # Each Model its own parameters, even when two share a module.
+    return module.model.copy()
 
 
 def from_model(source: str, parameters: Union[Mapping[str, float], Sequence[str], None] = None,
