@@ -113,8 +113,12 @@ def throughput() -> dict:
 
     app = best(lambda: ur5.rhs(x, tau), 1, 5) / n_app
     pin_t = best(pin_loop, 1, 5) / n_pin
+    appell.set_num_threads(1)
+    app1 = best(lambda: ur5.rhs(x, tau), 1, 5) / n_app
+    appell.set_num_threads(2)
     out["ur5"] = {"appell_states_per_s": 1 / app, "pinocchio_states_per_s": 1 / pin_t,
-                  "ratio": pin_t / app, "max_relative_difference": agree,
+                  "ratio": pin_t / app, "appell_1_thread_states_per_s": 1 / app1,
+                  "ratio_1_thread": pin_t / app1, "max_relative_difference": agree,
                   "pinocchio": pin.__version__, "threads": 2}
     # --- n-link pendulum on a cart: appell against PyDy's Cython rhs
     from pydy.models import n_link_pendulum_on_cart
@@ -155,15 +159,20 @@ def throughput() -> dict:
 
         app = best(lambda: mine_model.rhs(Xa, F), 1, 5) / n_app
         py_t = best(pydy_loop, 1, 5) / n_py
+        appell.set_num_threads(1)
+        app1 = best(lambda: mine_model.rhs(Xa, F), 1, 5) / n_app
+        appell.set_num_threads(2)
         out[f"pendulum_on_cart_{links}"] = {
             "appell_states_per_s": 1 / app, "pydy_states_per_s": 1 / py_t, "ratio": py_t / app,
+            "appell_1_thread_states_per_s": 1 / app1, "ratio_1_thread": py_t / app1,
             "max_relative_difference": agree, "pydy_generation_s": pydy_generation,
             "appell_load_s": appell_load, "threads": 2,
         }
     for k, r in out.items():
         other = "pinocchio_states_per_s" if "pinocchio_states_per_s" in r else "pydy_states_per_s"
         print(f"{k:22} appell {r['appell_states_per_s']:12.0f}/s  {other.split('_')[0]} "
-              f"{r[other]:10.0f}/s  ratio {r['ratio']:6.1f}x  (max rel. diff {r['max_relative_difference']:.1e})")
+              f"{r[other]:10.0f}/s  ratio {r['ratio']:6.1f}x (1 thread {r['ratio_1_thread']:5.1f}x)  "
+              f"(max rel. diff {r['max_relative_difference']:.1e})")
     save("throughput", out)
     return out
 
