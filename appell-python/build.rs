@@ -89,6 +89,18 @@ fn main() {
     );
     for (rel, path) in &files {
         let bytes = fs::read(path).unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        // The READMEs are carried for the manifests' `readme` keys only:
+        // an edit of the documentation leaves the compiled crates valid.
+        if rel.ends_with("README.md") {
+            writeln!(
+                code,
+                "    ({rel:?}, include_bytes!({:?})),",
+                path.display().to_string()
+            )
+            .unwrap();
+            println!("cargo:rerun-if-changed={}", path.display());
+            continue;
+        }
         let h = if rel.starts_with("appell-python/glue/") {
             &mut glue_hash
         } else {

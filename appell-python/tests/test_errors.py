@@ -130,3 +130,19 @@ def test_cached_model_reloads_without_compiling(pendulum, cache):
     stats, rates = json.loads(out.stdout)
     assert stats["compilations"] == 0 and stats["loads"] == 1
     assert rates == list(pendulum.rhs([0.2, 0.0]))
+
+
+def test_parameters_without_values_refuse_to_run(pendulum):
+    named = appell.from_model(PENDULUM, parameters=["m", "l", "g"], name="Pendulum", progress=False)
+    with pytest.raises(ValueError, match=r"\['g', 'l', 'm'\] have no value"):
+        named.rhs([0.2, 0.0])
+    with pytest.raises(ValueError, match="no value"):
+        named.simulate([0.2, 0.0], [0.0, 1.0])
+    # a call's own values are enough
+    assert np.array_equal(named.rhs([0.2, 0.0], params={"m": 1.0, "l": 0.5, "g": 9.81}),
+                          pendulum.rhs([0.2, 0.0]))
+    named.parameters = {"m": 1.0, "l": 0.5}
+    with pytest.raises(ValueError, match=r"\['g'\]"):
+        named.rhs([0.2, 0.0])
+    named.parameters = {"g": 9.81}
+    assert np.array_equal(named.rhs([0.2, 0.0]), pendulum.rhs([0.2, 0.0]))

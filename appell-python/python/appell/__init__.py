@@ -109,7 +109,7 @@ def from_model(source: str, parameters: Union[Mapping[str, float], Sequence[str]
 
     source = re.sub(r'(urdf\(\s*)"([^"]+)"', absolute, source)
     native = _compile(name, source, names, files, rustflags, progress)
-    return Model(native, name, defaults, source=source)
+    return Model(native, name, defaults, source=source, unset=set(names) - set(defaults))
 
 
 def _camel(stem: str) -> str:

@@ -5,7 +5,7 @@ The cache directory (``appell.cache_dir()``; set it with
 ``APPELL_CACHE_DIR``; by default ``$XDG_CACHE_HOME/appell`` or
 ``~/.cache/appell``) holds:
 
-- ``src/appell-<hash>/`` and ``src/glue-<hash>/``: the source of the
+- ``src/appell-<hash>/`` and ``src/glue-<hash>-<hash>/``: the source of the
   appell crates and of the glue this package carries (written once per
   package build from ``appell._native``);
 - ``target/``: one cargo target directory shared by every model, so that
@@ -126,7 +126,8 @@ def _source_trees(root: Path) -> Tuple[Path, Path]:
             return data.replace(b'path = "../.."', b"path = " + json.dumps(str(appell_tree)).encode())
         return data
 
-    glue_tree = _unpack(root / "src" / f"glue-{_native.GLUE_HASH}",
+    # The glue's manifest names the appell tree: one glue tree per pair.
+    glue_tree = _unpack(root / "src" / f"glue-{_native.GLUE_HASH}-{_native.APPELL_HASH}",
                         [(r[len(glue_prefix):], d) for r, d in files if r.startswith(glue_prefix)], fix)
     return appell_tree, glue_tree
 

@@ -53,7 +53,7 @@ class Model:
     """
 
     def __init__(self, native: Any, name: str, parameter_values: Mapping[str, float],
-                 scene: Optional[int] = None, source: str = ""):
+                 scene: Optional[int] = None, source: str = "", unset: Optional[set] = None):
         self._native = native
         self._scene = scene
         self._source = source
@@ -75,6 +75,9 @@ class Model:
         model_name = native.info(None)["name"]
         self._scene_names = [s.split("::")[-1] for s in scene_infos]
         self._scene_types = list(scene_infos)
+        # Parameters declared by name only, without a value yet: calls
+        # refuse to run until they have one (never a silent zero).
+        self._unset = set(unset) if unset is not None and scene is None else (unset or set())
         if scene is None and parameter_values:
             self.parameters = dict(parameter_values)
 
@@ -99,7 +102,7 @@ class Model:
         of its own, sharing this model's parameters."""
         for k, (short, typ) in enumerate(zip(self._scene_names, self._scene_types)):
             if name in (short, typ):
-                return Model(self._native, typ, {}, scene=k, source=self._source)
+                return Model(self._native, typ, {}, scene=k, source=self._source, unset=self._unset)
         raise KeyError(f"no scene {name!r}; the scenes are {self._scene_names}{_hint(name, self._scene_names)}")
 
     @property
@@ -112,6 +115,22 @@ class Model:
     @parameters.setter
     def parameters(self, values: Union[Mapping[str, float], Sequence[float], np.ndarray]) -> None:
         self._native.set_parameters(self._parameter_array(values))
+        if isinstance(values, Mapping):
+            self._unset.difference_update(str(k) for k in values)
+        else:
+            self._unset.clear()
+
+    def _check_set(self, params: Any) -> None:
+        missing = set(self._unset)
+        if isinstance(params, Mapping):
+            missing.difference_update(str(k) for k in params)
+        elif params is not None:
+            missing.clear()
+        if missing:
+            raise ValueError(
+                f"parameters {sorted(missing)} have no value: set model.parameters = {{...}} "
+                "or pass params= to the call"
+            )
 
     def _parameter_array(self, values: Any) -> List[float]:
         if isinstance(values, Mapping):
@@ -168,6 +187,8 @@ class Model:
         return arr
 
     def _call(self, op: str, args: List[np.ndarray], t: float, params: Any) -> np.ndarray:
+        if self._unset:
+            self._check_set(params)
         p = None if params is None else self._parameter_array(params)
         return self._native.call(op, args, float(t), self._scene, p, _threads, _min_rows)
 
@@ -189,7 +210,7 @@ class Model:
     def rhs(self, x: ArrayLike, u: Optional[ArrayLike] = None, t: float = 0.0,
             params: Any = None) -> np.ndarray:
         """The reduced equations of motion: ẋ = f(t, x, u); shape of ``x``."""
-        if params is None and self._scene is None:
+        if params is None and self._scene is None and not self._unset:
             fast = self._native.rhs_fast(x, u, t)
             if fast is not None:
                 return fast
@@ -305,6 +326,8 @@ class Model:
         if times.ndim != 1 or times.size == 0:
             raise ValueError(f"`t_eval` must be a non-empty 1-D array, got shape {times.shape}")
         start = float(times[0]) if t0 is None else float(t0)
+        if self._unset:
+            self._check_set(params)
         p = None if params is None else self._parameter_array(params)
         return self._native.simulate(xa, ua, start, times, method, float(rtol), float(atol),
                                      None if h_max is None else float(h_max), int(max_steps),
