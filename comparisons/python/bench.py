@@ -7,6 +7,9 @@
     python bench.py compile      text to importable module: cold and cached,
                                  for the wheel-axle, the bicycle and the UR5
     python bench.py all
+    python bench.py throughput-native   throughput with the models compiled
+                                 with -C target-cpu=native (their own cache:
+                                 set APPELL_CACHE_DIR to another directory)
 
 Each writes results/<name>.json and prints a table. Timings are the best of
 several repetitions (the machine is shared), taken side by side in one run.
@@ -88,14 +91,14 @@ def overhead() -> dict:
     return data
 
 
-def throughput() -> dict:
+def throughput(rustflags=None, name="throughput") -> dict:
     import pinocchio as pin
 
     rng = np.random.default_rng(2)
     appell.set_num_threads(2)
     out = {}
     # --- UR5: appell's batched forward dynamics against pinocchio.aba in a loop
-    ur5 = appell.from_urdf(UR5_URDF)
+    ur5 = appell.from_urdf(UR5_URDF, rustflags=rustflags)
     model = pin.buildModelFromUrdf(str(UR5_URDF))
     data = model.createData()
     n_app, n_pin = 400_000, 40_000
@@ -139,7 +142,7 @@ def throughput() -> dict:
         text, params = pendulum_on_cart(links)
         start = time.perf_counter()
         mine_model = appell.from_model(text, parameters={p: values[p] for p in params},
-                                       name=f"PendulumOnCart{links}")
+                                       name=f"PendulumOnCart{links}", rustflags=rustflags)
         appell_load = time.perf_counter() - start
         n_app, n_py = 400_000, 40_000
         X = rng.uniform(-1, 1, (n_app, 2 * links + 2))  # PyDy's layout: q0..qn, u0..un
@@ -169,11 +172,14 @@ def throughput() -> dict:
             "appell_load_s": appell_load, "threads": 2,
         }
     for k, r in out.items():
+        if not isinstance(r, dict):
+            continue
         other = "pinocchio_states_per_s" if "pinocchio_states_per_s" in r else "pydy_states_per_s"
         print(f"{k:22} appell {r['appell_states_per_s']:12.0f}/s  {other.split('_')[0]} "
               f"{r[other]:10.0f}/s  ratio {r['ratio']:6.1f}x (1 thread {r['ratio_1_thread']:5.1f}x)  "
               f"(max rel. diff {r['max_relative_difference']:.1e})")
-    save("throughput", out)
+    out["rustflags"] = rustflags or ""
+    save(name, out)
     return out
 
 
@@ -224,3 +230,5 @@ if __name__ == "__main__":
         throughput()
     if what in ("compile", "all"):
         compile_times()
+    if what == "throughput-native":
+        throughput("-C target-cpu=native", "throughput_native")
