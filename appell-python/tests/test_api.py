@@ -1,0 +1,165 @@
+"""Batches, threads, argument forms, simulation, scenes, info."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import appell
+
+
+def test_batched_equals_looped(ur5, rng):
+    q = rng.uniform(-3, 3, (300, 6))
+    v = rng.uniform(-2, 2, (300, 6))
+    tau = rng.uniform(-5, 5, (300, 6))
+    x = ur5.reduced_state(q, v)
+    assert x.shape == (300, 11)  # the shoulder pan is cyclic under gravity along z
+    assert np.array_equal(x[7], ur5.reduced_state(q[7], v[7]))
+    batch = ur5.rhs(x, tau)
+    assert batch.shape == (300, 11)
+    looped = np.array([ur5.rhs(x[k], tau[k]) for k in range(300)])
+    assert np.array_equal(batch, looped)
+    m = ur5.mass_matrix(q)
+    assert m.shape == (300, 6, 6)
+    assert np.array_equal(m, np.array([ur5.mass_matrix(q[k]) for k in range(300)]))
+    g = ur5.gravity_forces(q)
+    assert np.array_equal(g, np.array([ur5.gravity_forces(q[k]) for k in range(300)]))
+    a = ur5.inverse_dynamics(q, v, batch[:, 5:])
+    assert np.array_equal(a, np.array([ur5.inverse_dynamics(q[k], v[k], batch[k, 5:]) for k in range(300)]))
+    np.testing.assert_allclose(a, tau, rtol=1e-9, atol=1e-9)  # rnea(aba(tau)) = tau
+    A, B = ur5.linearize(x[:5], tau[:5])
+    assert A.shape == (5, 11, 11) and B.shape == (5, 11, 6)
+    A0, B0 = ur5.linearize(x[3], tau[3])
+    assert np.array_equal(A[3], A0) and np.array_equal(B[3], B0)
+
+
+def test_threads_do_not_change_results(ur5, rng):
+    x = rng.uniform(-2, 2, (1000, 11))
+    tau = rng.uniform(-5, 5, 6)  # one row of inputs for every state
+    before = appell.get_num_threads()
+    try:
+        appell.set_num_threads(1)
+        one = ur5.rhs(x, tau)
+        appell.set_num_threads(2)
+        two = ur5.rhs(x, tau)
+    finally:
+        appell.set_num_threads(before)
+    assert np.array_equal(one, two)
+    with pytest.raises(ValueError):
+        appell.set_num_threads(0)
+
+
+def test_argument_forms(wheel_axle):
+    m = wheel_axle
+    x = np.array([0.3, 0.2, 1.0])
+    ref = m.rhs(x, [0.4])
+    assert np.array_equal(m.rhs([0.3, 0.2, 1.0], np.array([0.4])), ref)
+    assert np.array_equal(m.rhs({"phi": 0.3, "phi_dot": 0.2, "psi1_dot": 1.0}, {"tau": 0.4}), ref)
+    # float32, non-contiguous, Fortran order: converted
+    wide = np.zeros((3, 2), order="F")
+    wide[:, 0] = x
+    assert np.array_equal(m.rhs(wide[:, 0], [0.4]), ref)
+    assert np.array_equal(m.rhs(np.tile(x, (4, 1))[:, :], np.full((4, 1), 0.4))[2], ref)
+    # parameters for one call, by dict or array
+    p = m.parameters
+    other = m.rhs(x, [0.4], params={"alpha": 0.0})
+    assert other[2] != ref[2]
+    assert m.parameters == p
+    arr = [p[k] for k in m.parameter_names]
+    arr[m.parameter_names.index("alpha")] = 0.0
+    assert np.array_equal(m.rhs(x, [0.4], params=np.array(arr)), other)
+
+
+def test_info(wheel_axle, bicycle):
+    info = wheel_axle.info
+    assert info["name"] == "WheelAxle"
+    assert info["state"] == ["phi", "phi_dot", "psi1_dot"]
+    assert info["cyclic"] == ["x1", "y1", "x2", "y2", "psi2"]
+    assert info["scenes"] == ["coasting", "driven", "track", "contact_check"]
+    assert info["rhs_ops"]["total"] > 0
+    assert info["parameter_values"]["a"] == 0.3
+    assert "psi1" in info["equations"]
+    assert wheel_axle.scene("driven").info["inputs"] == ["tau"]
+    assert bicycle.info["jacobian"] is not None and bicycle.has_jacobian
+    with pytest.raises(KeyError, match="did you mean 'coasting'"):
+        wheel_axle.scene("coastin")
+
+
+def test_parameters_persist_and_are_checked(wheel_axle):
+    m = wheel_axle
+    before = m.parameters
+    try:
+        m.parameters = {"alpha": 0.1}
+        assert m.parameters["alpha"] == 0.1
+        with pytest.raises(appell.ModelError, match="positive"):
+            m.parameters = {"a": -1.0}
+        assert m.parameters["a"] == before["a"]
+    finally:
+        m.parameters = before
+
+
+def test_simulate_methods_and_scipy(wheel_axle):
+    from scipy.integrate import solve_ivp, odeint
+
+    m = wheel_axle
+    x0 = np.array([0.3, 0.1, 0.0])
+    t = np.linspace(0.0, 2.0, 21)
+    dop = m.simulate(x0, t, u=[0.5], rtol=1e-11, atol=1e-12)
+    assert dop.shape == (21, 3)
+    assert np.array_equal(dop[0], x0)
+    radau = m.simulate(x0, t, u=[0.5], method="radau5", rtol=1e-10, atol=1e-12)
+    rk4 = m.simulate(x0, t, u=[0.5], method="rk4", h_max=1e-3)
+    np.testing.assert_allclose(radau, dop, atol=1e-7)
+    np.testing.assert_allclose(rk4, dop, atol=1e-9)
+    f = m.ode_function(u=[0.5])
+    sol = solve_ivp(f, (0.0, 2.0), x0, t_eval=t, method="DOP853", rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(sol.y.T, dop, atol=1e-8)
+    vec = solve_ivp(f, (0.0, 2.0), x0, t_eval=t, method="Radau", vectorized=True, rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(vec.y.T, dop, atol=1e-6)
+    g = m.ode_function(form="odeint")
+    y = odeint(g, x0, t, args=({"tau": 0.5}, m.parameters), rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(y, dop, atol=1e-7)
+    # a batch of initial states equals the single runs
+    many = np.array([x0, x0 + 0.1, x0 - 0.2])
+    batch = m.simulate(many, t, u=[0.5])
+    assert batch.shape == (3, 21, 3)
+    for k in range(3):
+        assert np.array_equal(batch[k], m.simulate(many[k], t, u=[0.5]))
+
+
+def test_simulate_event(wheel_axle):
+    # psi1_dot grows from 0 under gravity; stop where it reaches 1.
+    times, states, event = wheel_axle.simulate([0.3, 0.0, 0.0], np.linspace(0, 5, 51), u=[0.0],
+                                               event=lambda t, x: x[2] - 1.0)
+    assert event is not None
+    t_event, x_event = event
+    assert abs(x_event[2] - 1.0) < 1e-6
+    assert len(times) == len(states) and times[-1] <= t_event
+
+
+def test_constraint_forces_and_energies(wheel_axle, rng):
+    m = wheel_axle
+    q = rng.uniform(-1, 1, 7)
+    v = rng.uniform(-1, 1, 2)
+    lam, qdd = m.constraint_forces(q, v, [0.3])
+    assert lam.shape == (m.info["constraints"],) and qdd.shape == (7,)
+    x = np.array([q[m.coordinate_names.index("phi")], *v])
+    xdot = m.rhs(x, [0.3])
+    # the oracle's accelerations of the privileged speeds agree with the rhs
+    np.testing.assert_allclose(qdd[[m.coordinate_names.index("phi"), m.coordinate_names.index("psi1")]],
+                               xdot[1:], rtol=1e-10, atol=1e-10)
+    e = m.energies(np.tile(q, (3, 1)), np.tile(v, (3, 1)), [0.3])
+    assert e["kinetic"].shape == (3,) and np.all(e["kinetic"] > 0)
+    M, f = m.mass_matrix_and_forcing(q, v, [0.3])
+    np.testing.assert_allclose(np.linalg.solve(M, f), xdot[1:], rtol=1e-10)
+
+
+def test_two_models_from_one_module_keep_their_own_parameters(wheel_axle):
+    from conftest import rust_model
+
+    attributes, defaults, name = rust_model("wheel_axle.rs")
+    steep = appell.from_model(attributes, parameters={**defaults, "alpha": 0.5}, name=name)
+    assert appell.cache_info()["hits"] >= 1  # the same module, already loaded
+    assert steep.parameters["alpha"] == 0.5 and wheel_axle.parameters["alpha"] == 0.2
+    x = [0.3, 0.0, 0.0]
+    assert steep.rhs(x, [0.0])[2] > wheel_axle.rhs(x, [0.0])[2]

@@ -1,0 +1,162 @@
+"""The Python results against the Rust examples (bit for bit), SymPy's
+bicycle, the paper's closed form for the wheel-axle, and Pinocchio's UR5."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+
+from conftest import REPO, rust_answers
+
+
+def full_coordinates(model, rng, scale=1.0):
+    return rng.uniform(-scale, scale, size=len(model.coordinate_names))
+
+
+def test_wheel_axle_rhs_equals_rust_bit_for_bit(wheel_axle, rng):
+    m = wheel_axle
+    lines, xs, qs, vs, us = [], [], [], [], []
+    for _ in range(40):
+        q = full_coordinates(m, rng, 3.0)
+        v = rng.uniform(-5, 5, size=len(m.speed_names))
+        u = rng.uniform(-1, 1, size=len(m.input_names))
+        lines.append({"q": dict(zip(m.coordinate_names, q)), "u": dict(zip(m.speed_names, v)),
+                      "inputs": dict(zip(m.input_names, u)), "params": m.parameters})
+        retained = [q[m.coordinate_names.index(r)] for r in m.info["retained"]]
+        xs.append(np.concatenate([retained, v]))
+        qs.append(q), vs.append(v), us.append(u)
+    answers = rust_answers("wheel_axle", lines)
+    for x, q, v, u, a in zip(xs, qs, vs, us, answers):
+        expected = [a["qdot"][r] for r in m.info["retained"]] + [a["udot"][s] for s in m.speed_names]
+        assert np.array_equal(m.rhs(x, u), np.array(expected))
+        qdot = m.coordinate_rates(q, v, u)
+        assert np.array_equal(qdot, np.array([a["qdot"][c] for c in m.coordinate_names]))
+
+
+def test_wheel_axle_scene_and_energies_equal_rust(wheel_axle, rng):
+    scene = wheel_axle.scene("contact_check")
+    assert scene.name == "contact_check"
+    q = full_coordinates(wheel_axle, rng, 2.0)
+    v = rng.uniform(-3, 3, size=2)
+    answers = rust_answers("wheel_axle", [{"q": dict(zip(scene.coordinate_names, q)),
+                                            "u": dict(zip(scene.speed_names, v))}], scene="contact_check")
+    a = answers[0]
+    x = np.concatenate([[q[scene.coordinate_names.index(r)] for r in scene.info["retained"]], v])
+    expected = [a["qdot"][r] for r in scene.info["retained"]] + [a["udot"][s] for s in scene.speed_names]
+    assert np.array_equal(scene.rhs(x), np.array(expected))
+    e = scene.energies(q, v)
+    assert e["kinetic"] == a["energies"]["kinetic"]
+    assert e["potential"] == a["energies"]["potential"]
+
+
+def test_wheel_axle_matches_eq_64(wheel_axle, rng):
+    """Wang & Pao's eq. 64 with the drive torque, solved by Cramer's rule."""
+    p = wheel_axle.parameters
+    a, l, M, r, g, alpha = p["a"], p["l"], p["mass"], p["rim"], p["g"], p["alpha"]
+    x = np.column_stack([rng.uniform(-3, 3, 200), rng.uniform(-5, 5, 200), rng.uniform(-5, 5, 200)])
+    tau = rng.uniform(-1, 1, (200, 1))
+    d = wheel_axle.rhs(x, tau)
+    s = g * np.sin(alpha) * np.cos(x[:, 0])
+    a11, a12, b1 = 2 * a * (M + r), -l * (M + r), 2 * M * s + tau[:, 0] / a
+    a21, a22, b2 = a * l * (M + r), -(M * l * l + r * l * l + r * a * a), M * l * s
+    det = a11 * a22 - a12 * a21
+    psi = (b1 * a22 - a12 * b2) / det
+    phi = (a11 * b2 - b1 * a21) / det
+    assert np.array_equal(d[:, 0], x[:, 1])
+    np.testing.assert_allclose(d[:, 1], phi, rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(d[:, 2], psi, rtol=1e-12, atol=1e-12)
+
+
+def test_bicycle_against_sympy_reference(bicycle):
+    """The rows SymPy mechanics' generated C computed
+    (comparisons/sympy-whipple/build/check.json): state (q4, q5, q7, u4,
+    u6, u7), steer torque, and the six rates."""
+    data = json.loads((REPO / "comparisons/sympy-whipple/build/check.json").read_text())
+    assert bicycle.info["retained"] == ["q4", "q5", "q7"]
+    assert bicycle.speed_names == ["q4", "q6", "q7"]
+    worst = 0.0
+    for row in data["rows"]:
+        state, torque = row["state"][:6], row["state"][6]
+        got = bicycle.rhs(np.array(state), np.array([torque]))
+        sympy = np.array(row["sympy"])
+        worst = max(worst, float(np.max(np.abs(got - sympy) / np.maximum(np.abs(sympy), 1e-6))))
+        # appell's answers committed beside SymPy's came from the generated
+        # code of 2026-12-02, whose operations have been reordered since:
+        # equal to round-off, not to the bit.
+        np.testing.assert_allclose(got, np.array(row["appell"]), rtol=1e-13, atol=1e-13)
+    # check.json reports 1.36e-12 between the two at these rows.
+    assert worst < 1e-11, worst
+
+
+def test_bicycle_rhs_and_jacobian_equal_rust(bicycle, rng):
+    m = bicycle
+    lines, xs, us = [], [], []
+    for _ in range(10):
+        q = full_coordinates(m, rng, 0.5)
+        v = rng.uniform(-3, 3, size=3)
+        u = rng.uniform(-1, 1, size=1)
+        lines.append({"q": dict(zip(m.coordinate_names, q)), "u": dict(zip(m.speed_names, v)),
+                      "inputs": dict(zip(m.input_names, u))})
+        xs.append(np.concatenate([[q[m.coordinate_names.index(r)] for r in m.info["retained"]], v]))
+        us.append(u)
+    evals = rust_answers("whipple_bicycle", lines)
+    jacs = rust_answers("whipple_bicycle", lines, action="jacobian")
+    for line, x, u, e, j in zip(lines, xs, us, evals, jacs):
+        expected = [e["qdot"][r] for r in m.info["retained"]] + [e["udot"][s] for s in m.speed_names]
+        got = m.rhs(x, u)
+        # The accelerations, and the rates of the coordinates whose rates are
+        # speeds, to the bit; the pitch rate q5' (a dependent rate) the
+        # command line takes from coordinate_rates, which the Python call
+        # gives to the bit too.
+        k = m.info["retained"].index("q5")
+        keep = [i for i in range(len(got)) if i != k]
+        assert np.array_equal(got[keep], np.array(expected)[keep])
+        q = np.array([line["q"][c] for c in m.coordinate_names])
+        qdot = m.coordinate_rates(q, x[3:], u)
+        assert np.array_equal(qdot, np.array([e["qdot"][c] for c in m.coordinate_names]))
+        np.testing.assert_allclose(got[k], expected[k], rtol=1e-12, atol=1e-14)
+        A, B = m.linearize(x, u)
+        # The command line's `jacobian` runs the rhs in dual numbers; the
+        # generated Jacobian agrees with it to round-off, not to the bit.
+        np.testing.assert_allclose(A, np.array(j["a"]), rtol=1e-12, atol=1e-12)
+        np.testing.assert_allclose(B, np.array(j["b"]), rtol=1e-12, atol=1e-12)
+        xdot, A2, B2 = m.rhs_jacobian(x, u)
+        assert np.array_equal(A2, A) and np.array_equal(B2, B)
+        # the Jacobian's program computes the rates its own way
+        np.testing.assert_allclose(xdot, got, rtol=1e-12, atol=1e-12)
+
+
+def test_ur5_from_urdf_equals_rust_bit_for_bit(ur5, rng):
+    lines, xs, us = [], [], []
+    for _ in range(20):
+        q = rng.uniform(-3, 3, 6)
+        v = rng.uniform(-2, 2, 6)
+        tau = rng.uniform(-10, 10, 6)
+        lines.append({"q": dict(zip(ur5.coordinate_names, q)), "u": dict(zip(ur5.speed_names, v)),
+                      "inputs": dict(zip(ur5.input_names, tau))})
+        xs.append(ur5.reduced_state(q, v))
+        us.append(tau)
+    for x, u, a in zip(xs, us, rust_answers("ur5", lines)):
+        expected = [a["qdot"][r] for r in ur5.info["retained"]] + [a["udot"][s] for s in ur5.speed_names]
+        assert np.array_equal(ur5.rhs(x, u), np.array(expected))
+
+
+def test_ur5_against_pinocchio(ur5):
+    data = json.loads((REPO / "tests/reference/pinocchio/ur5.json").read_text())
+    assert ur5.coordinate_names == data["joints"]
+    states = data["states"]
+    q = np.array([s["q"] for s in states])
+    v = np.array([s["v"] for s in states])
+    tau = np.array([s["tau"] for s in states])
+    a = np.array([s["a"] for s in states])
+    ddq = ur5.rhs(ur5.reduced_state(q, v), tau)[:, 5:]
+    np.testing.assert_allclose(ddq, np.array([s["ddq"] for s in states]), rtol=1e-9, atol=1e-9)
+    np.testing.assert_allclose(ur5.inverse_dynamics(q, v, a), np.array([s["rnea"] for s in states]),
+                               rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(ur5.mass_matrix(q), np.array([s["mass_matrix"] for s in states]),
+                               rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(ur5.bias_forces(q, v), np.array([s["nle"] for s in states]),
+                               rtol=1e-10, atol=1e-10)
+    np.testing.assert_allclose(ur5.gravity_forces(q), np.array([s["gravity_torque"] for s in states]),
+                               rtol=1e-10, atol=1e-10)
