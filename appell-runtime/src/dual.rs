@@ -10,6 +10,12 @@
 //! derive's bound): the generated code is one call here, so the model's
 //! code does not grow, and the Jacobian keeps everything the rhs has (no
 //! allocation, any scalar, `no_std`).
+//!
+//! The arithmetic and the elementary functions are kept out of line
+//! (`#[inline(never)]`): inlined, a large model's rhs in `DualVec` becomes
+//! one function about `W` times the rhs's size, whose compile time grows
+//! much faster than its size, and the passes run no faster for it (the
+//! measurements are in `docs/optimization-log.md`).
 
 use core::fmt::Debug;
 use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAssign};
@@ -40,7 +46,7 @@ pub struct DualVec<T, const W: usize> {
 
 impl<T: Scalar, const W: usize> DualVec<T, W> {
     /// A constant: `x` with zero derivatives.
-    #[inline(always)]
+    #[inline]
     pub fn constant(x: T) -> Self {
         DualVec {
             re: x,
@@ -50,7 +56,7 @@ impl<T: Scalar, const W: usize> DualVec<T, W> {
 
     /// `x` as the variable of direction `k` (derivative one there, zero
     /// elsewhere); a constant when `k >= W`.
-    #[inline(always)]
+    #[inline]
     pub fn variable(x: T, k: usize) -> Self {
         let mut d = Self::constant(x);
         if k < W {
@@ -62,7 +68,7 @@ impl<T: Scalar, const W: usize> DualVec<T, W> {
     /// The value `f(re)` with derivatives `f'(re) · eps`. Where the slope
     /// is infinite (√ and ln at 0) a direction the argument does not move
     /// along stays zero rather than 0 · ∞.
-    #[inline(always)]
+    #[inline]
     fn chain(self, value: T, slope: T) -> Self {
         let finite = slope.re().is_finite();
         DualVec {
@@ -80,7 +86,7 @@ impl<T: Scalar, const W: usize> DualVec<T, W> {
 
 impl<T: Scalar, const W: usize> Add for DualVec<T, W> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn add(mut self, o: Self) -> Self {
         self += o;
         self
@@ -89,7 +95,7 @@ impl<T: Scalar, const W: usize> Add for DualVec<T, W> {
 
 impl<T: Scalar, const W: usize> Sub for DualVec<T, W> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn sub(mut self, o: Self) -> Self {
         self -= o;
         self
@@ -98,7 +104,7 @@ impl<T: Scalar, const W: usize> Sub for DualVec<T, W> {
 
 impl<T: Scalar, const W: usize> Mul for DualVec<T, W> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn mul(mut self, o: Self) -> Self {
         self *= o;
         self
@@ -107,7 +113,7 @@ impl<T: Scalar, const W: usize> Mul for DualVec<T, W> {
 
 impl<T: Scalar, const W: usize> Div for DualVec<T, W> {
     type Output = Self;
-    #[inline(always)]
+    #[inline]
     fn div(mut self, o: Self) -> Self {
         self /= o;
         self
@@ -116,7 +122,7 @@ impl<T: Scalar, const W: usize> Div for DualVec<T, W> {
 
 impl<T: Scalar, const W: usize> Neg for DualVec<T, W> {
     type Output = Self;
-    #[inline(always)]
+    #[inline(never)]
     fn neg(self) -> Self {
         DualVec {
             re: -self.re,
@@ -126,7 +132,7 @@ impl<T: Scalar, const W: usize> Neg for DualVec<T, W> {
 }
 
 impl<T: Scalar, const W: usize> AddAssign for DualVec<T, W> {
-    #[inline(always)]
+    #[inline(never)]
     fn add_assign(&mut self, o: Self) {
         self.re += o.re;
         for (e, f) in self.eps.iter_mut().zip(o.eps) {
@@ -136,7 +142,7 @@ impl<T: Scalar, const W: usize> AddAssign for DualVec<T, W> {
 }
 
 impl<T: Scalar, const W: usize> SubAssign for DualVec<T, W> {
-    #[inline(always)]
+    #[inline(never)]
     fn sub_assign(&mut self, o: Self) {
         self.re -= o.re;
         for (e, f) in self.eps.iter_mut().zip(o.eps) {
@@ -146,7 +152,7 @@ impl<T: Scalar, const W: usize> SubAssign for DualVec<T, W> {
 }
 
 impl<T: Scalar, const W: usize> MulAssign for DualVec<T, W> {
-    #[inline(always)]
+    #[inline(never)]
     fn mul_assign(&mut self, o: Self) {
         for (e, f) in self.eps.iter_mut().zip(o.eps) {
             *e = f.fma(self.re, *e * o.re);
@@ -156,7 +162,7 @@ impl<T: Scalar, const W: usize> MulAssign for DualVec<T, W> {
 }
 
 impl<T: Scalar, const W: usize> DivAssign for DualVec<T, W> {
-    #[inline(always)]
+    #[inline(never)]
     fn div_assign(&mut self, o: Self) {
         // (a / b)' = (a' − (a / b) b') / b; the value by T's own division,
         // as the rhs divides.
@@ -170,37 +176,37 @@ impl<T: Scalar, const W: usize> DivAssign for DualVec<T, W> {
 }
 
 impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
-    #[inline(always)]
+    #[inline]
     fn from_f64(x: f64) -> Self {
         Self::constant(T::from_f64(x))
     }
-    #[inline(always)]
+    #[inline]
     fn re(self) -> f64 {
         self.re.re()
     }
-    #[inline(always)]
+    #[inline(never)]
     fn sin(self) -> Self {
         self.chain(self.re.sin(), self.re.cos())
     }
-    #[inline(always)]
+    #[inline(never)]
     fn cos(self) -> Self {
         self.chain(self.re.cos(), -self.re.sin())
     }
-    #[inline(always)]
+    #[inline(never)]
     fn tan(self) -> Self {
         let t = self.re.tan();
         self.chain(t, t.fma(t, T::one()))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn exp(self) -> Self {
         let e = self.re.exp();
         self.chain(e, e)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn ln(self) -> Self {
         self.chain(self.re.ln(), T::one() / self.re)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn abs(self) -> Self {
         if self.re.re() < 0.0 {
             -self
@@ -208,12 +214,12 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
             self
         }
     }
-    #[inline(always)]
+    #[inline(never)]
     fn sqrt(self) -> Self {
         let s = self.re.sqrt();
         self.chain(s, T::from_f64(0.5) / s)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn powi(self, n: i32) -> Self {
         if n == 0 {
             return Self::one();
@@ -225,35 +231,35 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
         };
         self.chain(value, T::from_f64(f64::from(n)) * below)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn sinh(self) -> Self {
         self.chain(self.re.sinh(), self.re.cosh())
     }
-    #[inline(always)]
+    #[inline(never)]
     fn cosh(self) -> Self {
         self.chain(self.re.cosh(), self.re.sinh())
     }
-    #[inline(always)]
+    #[inline(never)]
     fn tanh(self) -> Self {
         let t = self.re.tanh();
         self.chain(t, T::one() - t * t)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn asin(self) -> Self {
         let c = ((T::one() - self.re) * (T::one() + self.re)).sqrt();
         self.chain(self.re.asin(), T::one() / c)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn acos(self) -> Self {
         let c = ((T::one() - self.re) * (T::one() + self.re)).sqrt();
         self.chain(self.re.acos(), -(T::one() / c))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn atan(self) -> Self {
         let r = self.re;
         self.chain(r.atan(), T::one() / r.fma(r, T::one()))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn powf(self, y: Self) -> Self {
         // d(x^y) = y x^(y−1) dx + x^y ln x dy; the second term only along
         // directions the exponent moves in (a negative base to a constant
@@ -268,7 +274,7 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
         }
         DualVec { re: value, eps }
     }
-    #[inline(always)]
+    #[inline(never)]
     fn atan2(self, x: Self) -> Self {
         // d atan2(y, x) = (x dy − y dx) / (x² + y²).
         let (y, r) = (self.re, x.re);
@@ -282,7 +288,7 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
             eps,
         }
     }
-    #[inline(always)]
+    #[inline(never)]
     fn fused_mul_add(self, a: Self, b: Self) -> Self {
         let mut eps = b.eps;
         for ((e, s), t) in eps.iter_mut().zip(self.eps).zip(a.eps) {
@@ -298,7 +304,7 @@ impl<T: Scalar, const W: usize> Scalar for DualVec<T, W> {
 /// `values` as dual numbers whose entry k is the variable of column
 /// `first_column + k`, seen from a pass that starts at column `first`
 /// (a constant outside the pass's W columns).
-#[inline(always)]
+#[inline]
 fn seed<T: Scalar, const W: usize>(
     duals: &mut [DualVec<T, W>],
     values: &[T],
