@@ -133,13 +133,15 @@ impl Emitter<'_> {
         let (n, l) = (self.d.n, self.d.l);
         let mut program = code(g, roots, Target::Generic { hoist: false });
         let body = program.take_statements();
+        // The partials come row by row, each row's coordinates then speeds.
         let writes = program.outputs.iter().enumerate().map(|(k, v)| {
+            let (row, column) = (k.wrapping_sub(l) / (n + l), k.wrapping_sub(l) % (n + l));
             let (out, at) = if k < l {
                 (quote!(__forces), k)
-            } else if k < l + l * n {
-                (quote!(__dq), k - l)
+            } else if column < n {
+                (quote!(__dq), row * n + column)
             } else {
-                (quote!(__du), k - l - l * n)
+                (quote!(__du), row * l + column - n)
             };
             let at = int(at);
             quote!(#out[#at] = #v;)
