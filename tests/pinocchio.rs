@@ -61,12 +61,9 @@ fn numbers(v: &Value) -> Vec<f64> {
         .collect()
 }
 
-fn reference(robot: &str) -> Reference {
-    let path = format!(
-        "{}/tests/reference/pinocchio/{robot}.json",
-        env!("CARGO_MANIFEST_DIR")
-    );
-    let text = std::fs::read_to_string(&path).expect("reference file");
+/// A reference file's JSON and its joint names, its gravity checked.
+fn load(path: &str) -> (Value, Vec<String>) {
+    let text = std::fs::read_to_string(path).expect("reference file");
     let data: Value = serde_json::from_str(&text).expect("JSON");
     assert_eq!(data["gravity"], serde_json::json!([0.0, 0.0, -9.81]));
     let joints = data["joints"]
@@ -75,6 +72,15 @@ fn reference(robot: &str) -> Reference {
         .iter()
         .map(|j| j.as_str().expect("name").to_string())
         .collect();
+    (data, joints)
+}
+
+fn reference(robot: &str) -> Reference {
+    let path = format!(
+        "{}/tests/reference/pinocchio/{robot}.json",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let (data, joints) = load(&path);
     let states = data["states"]
         .as_array()
         .expect("states")
@@ -300,15 +306,7 @@ fn derivative_reference(robot: &str) -> (Vec<String>, Vec<Derivatives>) {
         "{}/tests/reference/pinocchio/derivatives/{robot}.json",
         env!("CARGO_MANIFEST_DIR")
     );
-    let text = std::fs::read_to_string(&path).expect("reference file");
-    let data: Value = serde_json::from_str(&text).expect("JSON");
-    assert_eq!(data["gravity"], serde_json::json!([0.0, 0.0, -9.81]));
-    let joints = data["joints"]
-        .as_array()
-        .expect("joints")
-        .iter()
-        .map(|j| j.as_str().expect("name").to_string())
-        .collect();
+    let (data, joints) = load(&path);
     let rows = |v: &Value| v.as_array().expect("rows").iter().map(numbers).collect();
     let states = data["states"]
         .as_array()
