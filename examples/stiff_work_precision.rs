@@ -1,7 +1,8 @@
 //! What accuracy costs on stiff models: DOP853, Radau5 and TR-BDF2 on
 //! Andrews' squeezer (the IVP Test Set's mechanism, to t = 0.03 s) and on
 //! the stiff spring pendulum (k = 1e8 N/m, to t = 1 s), each over a sweep
-//! of tolerances against a tight reference; writes
+//! of tolerances against a tight reference, and Radau5 with the models'
+//! generated Jacobians against Radau5 with dual numbers; writes
 //! `docs/work_precision/stiff.md` and one chart per model.
 //!
 //! Run: `cargo run --release --example stiff_work_precision`.
@@ -180,6 +181,57 @@ fn report(title: &str, points: &[Point], out: &mut String) {
     let _ = writeln!(out);
 }
 
+/// Radau5 with the model's generated Jacobian against the same with the
+/// Jacobian by dual numbers, at each tolerance: both errors, the Jacobians
+/// computed, both median times and their ratio.
+fn jacobian_report<M: Model, const S: usize>(
+    model: &M,
+    (x0, t_end): (&[f64; S], f64),
+    (reference, compare): (&[f64; S], std::ops::Range<usize>),
+    out: &mut String,
+) {
+    let form = M::info().jacobian.map_or("none", |j| j.form);
+    let _ = writeln!(
+        out,
+        "Radau5's Newton Jacobian: the model's generated `rhs_jacobian` ({form}) against dual \
+         numbers through the rhs (`jacobian_by_duals(true)`), median of {REPEATS} runs each:\n"
+    );
+    let _ = writeln!(
+        out,
+        "| rtol | error, generated | error, dual numbers | Jacobians | generated | dual numbers | dual / generated |"
+    );
+    let _ = writeln!(out, "| ---: | ---: | ---: | ---: | ---: | ---: | ---: |");
+    for k in 3..=11 {
+        let tol = 10f64.powi(-k);
+        let run = |by_duals: bool| {
+            Radau5::new()
+                .rtol(tol)
+                .atol(tol * 1e-3)
+                .max_steps(2_000_000)
+                .jacobian_by_duals(by_duals)
+                .solve_model(model, &[], 0.0, x0, t_end)
+        };
+        let (generated_s, generated) = timed(|| run(false));
+        let (duals_s, duals) = timed(|| run(true));
+        let (Ok(generated), Ok(duals)) = (generated, duals) else {
+            let _ = writeln!(out, "| {tol:.0e} | failed | | | | | |");
+            continue;
+        };
+        let _ = writeln!(
+            out,
+            "| {tol:.0e} | {:.1e} | {:.1e} | {} / {} | {:.3} ms | {:.3} ms | {:.2} |",
+            error(&generated.x, reference, compare.clone()),
+            error(&duals.x, reference, compare.clone()),
+            generated.stats.jacobians,
+            duals.stats.jacobians,
+            generated_s * 1e3,
+            duals_s * 1e3,
+            duals_s / generated_s
+        );
+    }
+    let _ = writeln!(out);
+}
+
 fn main() {
     let mut md = String::from(
         "# Stiff models: what accuracy costs\n\n`cargo run --release --example stiff_work_precision` \
@@ -212,6 +264,8 @@ fn main() {
         &points,
         &mut md,
     );
+    let reference: [f64; 8] = tight.x;
+    jacobian_report(&p, (&x0, 0.03), (&reference, 0..7), &mut md);
     std::fs::write(
         "docs/work_precision/andrews_squeezer.svg",
         svg_chart("Andrews' squeezer: error against time", &points),
@@ -239,6 +293,7 @@ fn main() {
         &points,
         &mut md,
     );
+    jacobian_report(&s, (&x0, 1.0), (&reference, 0..2), &mut md);
     std::fs::write(
         "docs/work_precision/stiff_spring.svg",
         svg_chart("Stiff spring pendulum: error against time", &points),

@@ -2,7 +2,7 @@
 //! runtime cannot use the derive, and one model shared by the examples is
 //! easier to trust than one hidden in each. Not part of the API.
 
-use crate::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+use crate::{JacobianInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 
 /// A driven pendulum, θ̈ = −(g/l) sin θ + τ: coordinate θ, speed θ̇, input
 /// τ (a torque per unit inertia), parameter `g_over_l`.
@@ -40,7 +40,16 @@ static INFO: ModelInfo = ModelInfo {
         calls: 1,
         total: 4,
     },
-    jacobian: None,
+    jacobian: Some(JacobianInfo {
+        form: "closed form, written by hand",
+        ops: OpCounts {
+            add: 1,
+            mul: 2,
+            div: 0,
+            calls: 2,
+            total: 7,
+        },
+    }),
     equations: "theta'' = -g_over_l sin(theta) + tau",
 };
 
@@ -87,6 +96,24 @@ impl Model for Pendulum {
         crate::check_len("dstate", dstate, 2)?;
         dstate[0] = state[1];
         dstate[1] = forcing(*g_over_l, state, inputs);
+        Ok(())
+    }
+
+    fn rhs_jacobian<T: Scalar>(
+        &self,
+        t: T,
+        state: &[T],
+        inputs: &[T],
+        dstate: &mut [T],
+        a: &mut [T],
+        b: &mut [T],
+    ) -> Result<(), ModelError> {
+        let g_over_l = T::from_f64(self.g_over_l);
+        self.rhs(&g_over_l, t, state, inputs, dstate)?;
+        crate::check_len("a", a, 4)?;
+        crate::check_len("b", b, 2)?;
+        a.copy_from_slice(&[T::zero(), T::one(), -g_over_l * state[0].cos(), T::zero()]);
+        b.copy_from_slice(&[T::zero(), T::one()]);
         Ok(())
     }
 

@@ -120,6 +120,9 @@ pub trait DynRhs {
         b: &mut [f64],
     ) -> Result<bool, ModelError>;
 
+    /// Whether the model has a generated [`Model::rhs_jacobian`].
+    fn has_generated_jacobian(&self) -> bool;
+
     /// Calls [`DynRhs::rhs`] at `t` on every `(state, inputs)` of `cases`
     /// into `dstate`, every argument and result through
     /// [`black_box`], results dropped: one pass of a timing loop, whose
@@ -179,11 +182,15 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
         a: &mut [f64],
         b: &mut [f64],
     ) -> Result<bool, ModelError> {
-        if M::info().jacobian.is_none() {
+        if !self.has_generated_jacobian() {
             return Ok(false);
         }
         self.model.rhs_jacobian(t, state, inputs, values, a, b)?;
         Ok(true)
+    }
+
+    fn has_generated_jacobian(&self) -> bool {
+        M::info().jacobian.is_some()
     }
 
     fn rhs_pass(&self, t: f64, cases: &[(&[f64], &[f64])], dstate: &mut [f64]) {
@@ -202,12 +209,13 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
 
 /// The Jacobian `∂f/∂x` of `rhs` (row-major n×n into its last argument)
 /// at `(t, x)` with `inputs` held constant: the model's generated
-/// [`Model::rhs_jacobian`] where it has one, else exactly by forward-mode
-/// dual numbers, one [`DynRhs::rhs_dual`] per state component. What the
-/// implicit integrators use for a model.
+/// [`Model::rhs_jacobian`] where it has one and `by_duals` is false, else
+/// exactly by forward-mode dual numbers, one [`DynRhs::rhs_dual`] per state
+/// component. What the implicit integrators use for a model.
 pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
     rhs: &'a R,
     inputs: &[f64],
+    by_duals: bool,
 ) -> impl FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError> + 'a {
     let n = rhs.state_len();
     let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
@@ -217,7 +225,7 @@ pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
     let real_inputs = inputs.to_vec();
     let (mut values, mut b) = (vec![0.0; n], vec![0.0; n * inputs.len()]);
     move |t: f64, x: &[f64], j: &mut [f64]| {
-        if rhs.generated_jacobian(t, x, &real_inputs, &mut values, j, &mut b)? {
+        if !by_duals && rhs.generated_jacobian(t, x, &real_inputs, &mut values, j, &mut b)? {
             return Ok(());
         }
         let td = Dual64::from_re(t);

@@ -91,6 +91,7 @@ pub struct TrBdf2 {
     pub(super) adaptive: bool,
     pub(super) event_tol: f64,
     pub(super) contact_watch: bool,
+    pub(super) jacobian_by_duals: bool,
 }
 
 impl Default for TrBdf2 {
@@ -113,6 +114,7 @@ impl TrBdf2 {
             adaptive: true,
             event_tol: 1e-12,
             contact_watch: true,
+            jacobian_by_duals: false,
         }
     }
 
@@ -197,6 +199,36 @@ impl TrBdf2 {
     /// ```
     pub const fn contact_watch(mut self, on: bool) -> Self {
         self.contact_watch = on;
+        self
+    }
+
+    /// Whether the `solve_model*` methods compute the Newton Jacobian by
+    /// forward-mode dual numbers (one evaluation of the rhs per state
+    /// component, counted in the stats' `jacobian_rhs_calls`) even where
+    /// the model has a generated [`Model::rhs_jacobian`](crate::Model::rhs_jacobian),
+    /// which they use by default (default `false`). For checking or timing
+    /// the generated Jacobian; a model without one always takes the dual
+    /// numbers.
+    ///
+    /// ```
+    /// use appell_runtime::integrate::TrBdf2;
+    /// use appell_runtime::__doc_model::Pendulum;
+    ///
+    /// let model = Pendulum { g_over_l: 9.81 };
+    /// let x0 = [1.0, 0.0];
+    /// let generated = TrBdf2::new().solve_model(&model, &[0.5], 0.0, &x0, 2.0).unwrap();
+    /// let duals = TrBdf2::new()
+    ///     .jacobian_by_duals(true)
+    ///     .solve_model(&model, &[0.5], 0.0, &x0, 2.0)
+    ///     .unwrap();
+    /// assert_eq!(generated.stats.jacobian_rhs_calls, 0);
+    /// assert_eq!(duals.stats.jacobian_rhs_calls, 2 * duals.stats.jacobians);
+    /// // The same Jacobians to rounding: the same steps and solution.
+    /// assert_eq!(generated.stats.accepted, duals.stats.accepted);
+    /// assert!((generated.x[0] - duals.x[0]).abs() < 1e-12);
+    /// ```
+    pub const fn jacobian_by_duals(mut self, on: bool) -> Self {
+        self.jacobian_by_duals = on;
         self
     }
 

@@ -202,9 +202,10 @@ impl TrBdf2 {
 
     /// Integrates a model's reduced equations ([`Model::rhs`]) from
     /// `(t0, x0)` to `t_end` with `inputs` held constant. The Jacobian is
+    /// the model's generated [`Model::rhs_jacobian`] where it has one, else
     /// computed exactly by forward-mode dual numbers: one [`Dual64`]
     /// evaluation of the generated rhs per state component (counted in
-    /// [`TrBdf2Stats::jacobian_rhs_calls`]).
+    /// [`TrBdf2Stats::jacobian_rhs_calls`]; see [`TrBdf2::jacobian_by_duals`]).
     ///
     /// Errors: [`ModelError::Length`] (as [`IntegrateError::Model`]) when
     /// `x0` is not [`ModelInfo::state_len`](crate::ModelInfo::state_len)
@@ -489,9 +490,10 @@ impl TrBdf2 {
         let n = rhs.state_len();
         check_len("state", x0, n)?;
         let f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, inputs, dx);
-        let jac = dual_jacobian(rhs, inputs);
+        let by_duals = self.jacobian_by_duals || !rhs.has_generated_jacobian();
+        let jac = dual_jacobian(rhs, inputs, by_duals);
         let mut sol = self.run(f, jac, t0, x0, t_end, out, event, project)?;
-        sol.stats.jacobian_rhs_calls = sol.stats.jacobians * n;
+        sol.stats.jacobian_rhs_calls = if by_duals { sol.stats.jacobians * n } else { 0 };
         Ok(sol)
     }
 }

@@ -13,7 +13,8 @@ pub struct TrBdf2Stats {
     pub rhs_calls: usize,
     /// Evaluations of the right-hand side in dual numbers for Jacobians
     /// ([`TrBdf2::solve_model`]: one per state component and Jacobian; 0
-    /// with a user Jacobian).
+    /// with a user Jacobian or the model's generated one, see
+    /// [`TrBdf2::jacobian_by_duals`]).
     pub jacobian_rhs_calls: usize,
     /// Accepted steps.
     pub accepted: usize,

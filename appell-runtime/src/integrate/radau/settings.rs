@@ -72,7 +72,7 @@ use super::Radau5Stats;
 /// Defaults: `rtol = 1e-6`, `atol = 1e-9`, `max_steps = 100_000`,
 /// `h0 = None` (automatic), `h_max = None` (the interval length),
 /// `newton_max_iter = 7`, `event_tol = 1e-12`, `jacobian_reuse` 0.001
-/// with a given Jacobian and 0.1 with one by dual numbers.
+/// with a given Jacobian and 0.1 with a model's.
 ///
 /// ```
 /// use appell_runtime::integrate::Radau5;
@@ -110,6 +110,7 @@ pub struct Radau5 {
     pub(super) jacobian_reuse: Option<f64>,
     pub(super) event_tol: f64,
     pub(super) contact_watch: bool,
+    pub(super) jacobian_by_duals: bool,
 }
 
 impl Default for Radau5 {
@@ -136,6 +137,7 @@ impl Radau5 {
             jacobian_reuse: None,
             event_tol: 1e-12,
             contact_watch: true,
+            jacobian_by_duals: false,
         }
     }
 
@@ -299,9 +301,10 @@ impl Radau5 {
     /// Jacobian costs many rhs calls. A Newton solve that converged in one
     /// iteration keeps the Jacobian at any setting. Default: `0.001` (as
     /// RADAU5) where the Jacobian is given, `0.1` (RADAU5's advice for
-    /// costly Jacobians) for the `solve_model*` methods, whose Jacobian by
-    /// dual numbers costs one evaluation of the equations per state
-    /// component.
+    /// costly Jacobians) for the `solve_model*` methods, whose Jacobian
+    /// (the model's generated one, or by dual numbers at one evaluation of
+    /// the equations per state component) costs several evaluations of the
+    /// equations.
     ///
     /// ```
     /// use appell_runtime::integrate::{IntegrateError, Radau5};
@@ -377,6 +380,36 @@ impl Radau5 {
     /// ```
     pub const fn contact_watch(mut self, on: bool) -> Self {
         self.contact_watch = on;
+        self
+    }
+
+    /// Whether the `solve_model*` methods compute the Newton Jacobian by
+    /// forward-mode dual numbers (one evaluation of the rhs per state
+    /// component, counted in the stats' `jacobian_rhs_calls`) even where
+    /// the model has a generated [`Model::rhs_jacobian`](crate::Model::rhs_jacobian),
+    /// which they use by default (default `false`). For checking or timing
+    /// the generated Jacobian; a model without one always takes the dual
+    /// numbers.
+    ///
+    /// ```
+    /// use appell_runtime::integrate::Radau5;
+    /// use appell_runtime::__doc_model::Pendulum;
+    ///
+    /// let model = Pendulum { g_over_l: 9.81 };
+    /// let x0 = [1.0, 0.0];
+    /// let generated = Radau5::new().solve_model(&model, &[0.5], 0.0, &x0, 2.0).unwrap();
+    /// let duals = Radau5::new()
+    ///     .jacobian_by_duals(true)
+    ///     .solve_model(&model, &[0.5], 0.0, &x0, 2.0)
+    ///     .unwrap();
+    /// assert_eq!(generated.stats.jacobian_rhs_calls, 0);
+    /// assert_eq!(duals.stats.jacobian_rhs_calls, 2 * duals.stats.jacobians);
+    /// // The same Jacobians to rounding: the same steps and solution.
+    /// assert_eq!(generated.stats.accepted, duals.stats.accepted);
+    /// assert!((generated.x[0] - duals.x[0]).abs() < 1e-12);
+    /// ```
+    pub const fn jacobian_by_duals(mut self, on: bool) -> Self {
+        self.jacobian_by_duals = on;
         self
     }
 

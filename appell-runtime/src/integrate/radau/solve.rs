@@ -239,10 +239,11 @@ impl Radau5 {
 
     /// Integrates a model's reduced equations ([`Model::rhs`]) with `inputs`
     /// held constant from `(t0, x0)` to `t_end` (the argument order of the
-    /// explicit integrators' `solve_model`). The Jacobian is computed
+    /// explicit integrators' `solve_model`). The Jacobian is the model's
+    /// generated [`Model::rhs_jacobian`] where it has one, else computed
     /// exactly by forward-mode dual numbers: one [`Dual64`] evaluation of
     /// the generated rhs per state component (counted in
-    /// [`Radau5Stats::jacobian_rhs_calls`]).
+    /// [`Radau5Stats::jacobian_rhs_calls`]; see [`Radau5::jacobian_by_duals`]).
     ///
     /// Errors: [`ModelError::Length`] (as [`IntegrateError::Model`]) when
     /// `x0` is not [`ModelInfo::state_len`](crate::ModelInfo::state_len)
@@ -577,13 +578,14 @@ impl Radau5 {
         let n = rhs.state_len();
         check_len("state", x0, n)?;
         let f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, inputs, dx);
-        let jac = dual_jacobian(rhs, inputs);
+        let by_duals = self.jacobian_by_duals || !rhs.has_generated_jacobian();
+        let jac = dual_jacobian(rhs, inputs, by_duals);
         let settings = Radau5 {
             jacobian_reuse: Some(self.jacobian_reuse.unwrap_or(REUSE_DUAL)),
             ..*self
         };
         let mut sol = settings.run(f, jac, t0, x0, t_end, out, event, project)?;
-        sol.stats.jacobian_rhs_calls = sol.stats.jacobians * n;
+        sol.stats.jacobian_rhs_calls = if by_duals { sol.stats.jacobians * n } else { 0 };
         Ok(sol)
     }
 }

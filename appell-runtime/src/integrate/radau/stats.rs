@@ -37,7 +37,8 @@ pub struct Radau5Stats {
     pub rhs_calls: usize,
     /// Evaluations of the right-hand side in dual numbers for Jacobians
     /// ([`Radau5::solve_model`]: one per state component and Jacobian; 0
-    /// with a user Jacobian).
+    /// with a user Jacobian or the model's generated one, see
+    /// [`Radau5::jacobian_by_duals`]).
     pub jacobian_rhs_calls: usize,
     /// Jacobian evaluations.
     pub jacobians: usize,
