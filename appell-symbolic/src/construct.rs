@@ -10,6 +10,7 @@
 //! | fold constants exactly | `1/2 + 1/3 → 5/6` |
 //! | identities | `x + 0 → x`, `x·1 → x`, `x·0 → 0`, `x⁰ → 1` |
 //! | distribute a coefficient over a sum | `2(x + y) → 2x + 2y` |
+//! | except over a held sum | `2·hold(x + y)` stays a product |
 //! | sums as factors are primitive, leading term positive | `(4y − 2x)/z → −2(x − 2y)/z` |
 //! | square roots and absolute values of powers | `√x² → x` (as `√x·√x`), `|x|² → x²` |
 //! | parity | `sin(−x) → −sin x`, `cos(−x) → cos x`, `|−x| → |x|` |
@@ -567,6 +568,12 @@ impl Graph {
                 }
             }
             Func::Acos => {}
+            // Only a sum is held: anything else is already one factor.
+            Func::Hold => {
+                if !matches!(self.node(a), Node::Add { .. }) {
+                    return Ok(a);
+                }
+            }
             Func::Sign => {
                 if let Some(p) = self.negated(a)? {
                     let inner = self.func(f, p)?;
@@ -645,6 +652,7 @@ impl Graph {
             Func::Acos if n.is_one() && !n.is_float() => Some(Number::ZERO),
             Func::Sign if n.is_zero() => Some(Number::ZERO),
             Func::Sign => Some(Number::int(if n.is_negative() { -1 } else { 1 })),
+            Func::Hold => Some(n),
             _ => None,
         };
         if let Some(v) = exact {
@@ -716,6 +724,27 @@ impl Graph {
     pub fn atan(&mut self, a: Id) -> Result<Id> {
         self.func(Func::Atan, a)
     }
+    /// `a`, held as one factor where it is a sum ([`Func::Hold`]): `k ·
+    /// hold(x + y)` stays a product of two factors where `k · (x + y)`
+    /// becomes `k x + k y`.
+    ///
+    /// ```
+    /// use appell_symbolic::Graph;
+    /// let mut g = Graph::new();
+    /// let [x, sum, three] = ["x", "x + y", "3"].map(|s| g.parse(s).unwrap());
+    /// let held = g.hold(sum).unwrap();
+    /// let product = g.mul(three, held).unwrap();
+    /// assert_eq!(g.display(product).to_string(), "3*(x + y)");
+    /// let spread = g.mul(three, sum).unwrap();
+    /// assert_eq!(g.display(spread).to_string(), "3*x + 3*y");
+    /// assert_eq!(g.hold(x).unwrap(), x);
+    /// let at = [("x", 1.0), ("y", 2.0)];
+    /// assert_eq!(g.eval_named(product, &at).unwrap(), 9.0);
+    /// ```
+    pub fn hold(&mut self, a: Id) -> Result<Id> {
+        self.func(Func::Hold, a)
+    }
+
     /// `sign(a)`: 1, −1, or 0 at zero ([`Func::Sign`]).
     pub fn signum(&mut self, a: Id) -> Result<Id> {
         self.func(Func::Sign, a)

@@ -247,6 +247,7 @@ impl Graph {
                     }
                     // Piecewise constant: zero away from 0.
                     Func::Sign => return self.int(0),
+                    Func::Hold => return Ok(da),
                 };
                 self.mul(outer, da)
             }
@@ -305,6 +306,24 @@ mod tests {
             "d/d{var} {a} = {} (expected {expected})",
             g.display(r)
         );
+    }
+
+    #[test]
+    fn a_held_sum_differentiates_as_the_sum() {
+        let mut g = Graph::new();
+        let [s, x] = ["x*x + 3*x*y", "x"].map(|t| g.parse(t).unwrap());
+        let held = g.hold(s).unwrap();
+        let k = g.mul(held, x).unwrap();
+        let (sx, kx) = (g.symbol_named("x").unwrap(), g.mul(s, x).unwrap());
+        // The derivative is the unheld one's: (x² + 3xy)·x → 3x² + 6xy.
+        let (dk, expected) = (g.diff(k, sx).unwrap(), g.diff(kx, sx).unwrap());
+        let at = [("x", 0.7), ("y", -1.3)];
+        let (a, b) = (
+            g.eval_named(dk, &at).unwrap(),
+            g.eval_named(expected, &at).unwrap(),
+        );
+        assert!((a - b).abs() < 1e-15, "{a} vs {b}");
+        assert_eq!(d("x*y", "x"), "y");
     }
 
     #[test]

@@ -3,7 +3,7 @@
 
 use std::fmt::{self, Write};
 
-use crate::graph::{Graph, Id, Node};
+use crate::graph::{Func, Graph, Id, Node};
 use crate::number::Number;
 
 /// An expression together with its graph, for formatting.
@@ -107,6 +107,11 @@ fn write_expr(g: &Graph, id: Id, min: Prec, f: &mut dyn Write) -> fmt::Result {
                 f.write_char(')')?;
             }
             Ok(())
+        }
+        Node::Fun(Func::Hold, a) => {
+            f.write_char('(')?;
+            write_expr(g, *a, Prec::Sum, f)?;
+            f.write_char(')')
         }
         Node::Fun(func, a) => {
             write!(f, "{}(", func.name())?;

@@ -75,6 +75,13 @@ pub enum Func {
     /// The sign: 1 above zero, −1 below, 0 at zero. Piecewise constant: its
     /// derivative is zero away from 0 (and taken as zero there).
     Sign,
+    /// The identity, held: `hold(a + b)` is a sum the constructors treat as
+    /// one factor, so a coefficient or a product is not distributed over
+    /// it. A recursion over links holds each link's quantities, so that
+    /// the next link multiplies them, computed once, instead of expanding
+    /// their terms into its own (see `Graph::hold`). Lowered to its
+    /// argument: it costs nothing.
+    Hold,
 }
 
 impl Func {
@@ -95,6 +102,7 @@ impl Func {
             Func::Acos => "acos",
             Func::Atan => "atan",
             Func::Sign => "sign",
+            Func::Hold => "hold",
         }
     }
 
@@ -138,6 +146,7 @@ impl Func {
             Func::Acos => x.acos(),
             Func::Atan => x.atan(),
             Func::Sign => sign(x),
+            Func::Hold => x,
         }
     }
 }
@@ -596,9 +605,15 @@ impl Graph {
             .collect()
     }
 
-    /// Number of distinct nodes reachable from `roots` (the DAG size).
+    /// Number of distinct nodes reachable from `roots` (the DAG size),
+    /// not counting [`Func::Hold`], which the emitted code does not see.
     pub fn dag_size(&self, roots: &[Id]) -> usize {
-        self.reachable(roots).len()
+        let reachable = self.reachable(roots);
+        let held = reachable
+            .iter()
+            .filter(|&&id| matches!(self.node(id), Node::Fun(Func::Hold, _)))
+            .count();
+        reachable.len() - held
     }
 }
 

@@ -5,7 +5,7 @@
 //! parts merged, products with their parameter-only factors grouped into one
 //! hoistable value.
 
-use crate::graph::{FxHashMap, Graph, Id, Node};
+use crate::graph::{Func, FxHashMap, Graph, Id, Node};
 use crate::number::Number;
 
 use super::inst::Inst;
@@ -545,6 +545,7 @@ impl Lowering<'_> {
                 let factors = factors.to_vec();
                 self.product(*coeff, &factors, None)
             }
+            Node::Fun(Func::Hold, a) => self.memo[a],
             Node::Fun(f, a) => {
                 let a = self.memo[a];
                 self.push(Inst::Call(*f, a))
@@ -568,8 +569,53 @@ impl Lowering<'_> {
 #[cfg(test)]
 mod tests {
     use crate::emit::tests::check;
-    use crate::emit::Inst;
+    use crate::emit::{Inst, Program};
     use crate::graph::Graph;
+
+    #[test]
+    fn held_sums_keep_a_recursion_from_multiplying_out() {
+        // A velocity handed down a chain of turns, as a tree's recursions
+        // do: each level is the previous one turned and shifted. Unheld,
+        // each level's terms are multiplied into the next level's products
+        // (2, 4, 8, ... terms; the lowering takes common factors out again,
+        // not all of them); held, each level is one factor of the next.
+        let mut g = Graph::new();
+        let chain = |g: &mut Graph, hold: bool| {
+            let mut v = [g.parse("x").unwrap(), g.parse("y").unwrap()];
+            for k in 0..5 {
+                let (c, s) = (
+                    g.parse(&format!("cos(v{k})")).unwrap(),
+                    g.parse(&format!("sin(v{k})")).unwrap(),
+                );
+                let a = g.mul(c, v[0]).unwrap();
+                let b = g.mul(s, v[1]).unwrap();
+                let e = g.mul(s, v[0]).unwrap();
+                let f = g.mul(c, v[1]).unwrap();
+                let three = g.int(3).unwrap();
+                let shift = g.mul(three, v[1]).unwrap();
+                v = [g.sub(a, b).unwrap(), g.add(e, f).unwrap()];
+                v[0] = g.add(v[0], shift).unwrap();
+                if hold {
+                    v = [g.hold(v[0]).unwrap(), g.hold(v[1]).unwrap()];
+                }
+            }
+            v
+        };
+        let spread = chain(&mut g, false);
+        let kept = chain(&mut g, true);
+        let count = |roots: &[crate::graph::Id]| Program::lower(&g, roots).op_count().total();
+        assert!(
+            count(&kept) < count(&spread),
+            "{} against {}",
+            count(&kept),
+            count(&spread)
+        );
+        let at = crate::emit::tests::values(&g);
+        let value = |roots: &[crate::graph::Id]| Program::lower(&g, roots).eval(&at).unwrap();
+        for (a, b) in value(&kept).iter().zip(value(&spread)) {
+            assert!((a - b).abs() <= 1e-13 * b.abs().max(1.0), "{a} vs {b}");
+        }
+    }
 
     #[test]
     fn a_shared_denominator_is_taken_out_of_a_sum() {

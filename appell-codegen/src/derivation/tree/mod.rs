@@ -5,8 +5,11 @@
 //! expression graph, with every constant folded: a joint axis along z,
 //! a placement along one axis and a diagonal inertia leave only the
 //! products that do not vanish. Every link's quantities are nodes shared
-//! by its children, so the form grows linearly with the links where the
-//! closed form of Appell's equations grows like n³.
+//! by its children, held as single factors (`Graph::hold`) so that a child
+//! multiplies a parent's velocity, acceleration, force or articulated
+//! inertia once instead of multiplying out its terms, and the form grows
+//! linearly with the links where the closed form of Appell's equations
+//! grows like n³.
 //!
 //! A tree under constraints gets M and f projected onto its privileged
 //! speeds instead ([`projected`]).

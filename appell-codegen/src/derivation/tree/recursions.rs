@@ -67,6 +67,7 @@ impl<'g, 'l> Recursions<'g, 'l> {
                 }
                 None => joint,
             };
+            let v = self.a.hold(v)?;
             out.push((v, joint));
         }
         Ok(out)
@@ -116,11 +117,13 @@ impl<'g, 'l> Recursions<'g, 'l> {
             let (v, joint) = vel[i];
             let coriolis = self.a.cross_motion(v, joint)?;
             a = self.a.add(a, coriolis)?;
+            a = self.a.hold(a)?;
             let inertia = self.links[i].inertia;
             let ia = self.a.mat6_vec(&inertia, a)?;
             let iv = self.a.mat6_vec(&inertia, v)?;
             let gyro = self.a.cross_force(v, iv)?;
-            forces.push(self.a.add(ia, gyro)?);
+            let f = self.a.add(ia, gyro)?;
+            forces.push(self.a.hold(f)?);
             acc.push(a);
         }
         let mut tau = vec![zero; self.size];
@@ -133,7 +136,8 @@ impl<'g, 'l> Recursions<'g, 'l> {
                 let moved = self
                     .a
                     .force_to_parent(&self.links[i].transform, forces[i])?;
-                forces[p] = self.a.add(forces[p], moved)?;
+                let sum = self.a.add(forces[p], moved)?;
+                forces[p] = self.a.hold(sum)?;
             }
         }
         Ok(tau)
@@ -165,6 +169,9 @@ impl<'g, 'l> Recursions<'g, 'l> {
     /// M by the composite-rigid-body algorithm, row-major over the speeds.
     pub fn composite_rigid_body(&mut self) -> R<Vec<Id>> {
         let (n, size) = (self.links.len(), self.size);
+        // Unlike the other recursions' quantities, the composite inertias
+        // are not held: their entries collect over the subtree into few
+        // terms, and holding them measured more operations, not fewer.
         let mut composite: Vec<M6> = self.links.iter().map(|l| l.inertia).collect();
         for i in (0..n).rev() {
             if let Some(p) = self.links[i].parent {
@@ -215,11 +222,14 @@ impl<'g, 'l> Recursions<'g, 'l> {
             let step = self.articulate(i, &inertia[i], bias[i])?;
             if let Some(p) = self.links[i].parent {
                 let (ia, pa) = self.handed_on(i, &step, &inertia[i], bias[i], coriolis[i])?;
+                let (ia, pa) = (self.a.hold6(&ia)?, self.a.hold(pa)?);
                 let transform = self.links[i].transform;
                 let moved = self.a.congruence(&transform, &ia)?;
-                inertia[p] = self.a.add6(&inertia[p], &moved)?;
+                let sum = self.a.add6(&inertia[p], &moved)?;
+                inertia[p] = self.a.hold6(&sum)?;
                 let pushed = self.a.force_to_parent(&transform, pa)?;
-                bias[p] = self.a.add(bias[p], pushed)?;
+                let sum = self.a.add(bias[p], pushed)?;
+                bias[p] = self.a.hold(sum)?;
             }
             solved.push(step);
         }
@@ -242,7 +252,8 @@ impl<'g, 'l> Recursions<'g, 'l> {
                 qdd[self.links[i].speeds[c]] = value;
             }
             let sa = self.along_subspace(i, &qdd)?;
-            acc.push(self.a.add(a, sa)?);
+            let sum = self.a.add(a, sa)?;
+            acc.push(self.a.hold(sum)?);
         }
         Ok(qdd)
     }

@@ -60,6 +60,24 @@ impl<'g> Algebra<'g> {
         self.g.sum(&terms)
     }
 
+    /// Each entry held as one factor ([`Graph::hold`]).
+    pub fn hold<const N: usize>(&mut self, a: [Id; N]) -> R<[Id; N]> {
+        let mut out = a;
+        for x in out.iter_mut() {
+            *x = self.g.hold(*x)?;
+        }
+        Ok(out)
+    }
+
+    /// Each entry of a 6×6 matrix held as one factor.
+    pub fn hold6(&mut self, m: &M6) -> R<M6> {
+        let mut out = *m;
+        for row in out.iter_mut() {
+            *row = self.hold(*row)?;
+        }
+        Ok(out)
+    }
+
     /// a + b, elementwise.
     pub fn add<const N: usize>(&mut self, a: [Id; N], b: [Id; N]) -> R<[Id; N]> {
         let mut out = [self.zero; N];
