@@ -293,6 +293,9 @@ def check_derivatives(pin_bin, rust_bin, name, urdf, weld, joints, seed):
            if "ddq_dq" in x]
     if not app:
         return None
+    # A model with a `jacobian(on)` twin (rust/src/jacobian.rs) dumps both
+    # under its name: compare the first, the model as the examples write it.
+    app = [x for x in app if x.get("type") == app[0].get("type")]
     assert len(app) == len(pin), (name, len(app), len(pin))
     out = {"states": len(app), "type": app[0]["type"]}
     for key in ("ddq", "ddq_dq", "ddq_dv", "ddq_dtau"):
