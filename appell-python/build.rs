@@ -16,6 +16,7 @@ use std::path::{Path, PathBuf};
 const CRATES: &[&str] = &[
     "appell-trig",
     "appell-symbolic",
+    "appell-core",
     "appell-runtime",
     "appell-codegen",
     "appell-derive",

@@ -1,9 +1,9 @@
 //! Whether a rigid body's inertia can be physical, in the words of a
-//! compile error: the rules are the runtime's (`appell_runtime::physical`,
+//! compile error: the rules are the runtime's (`appell_core::physical`,
 //! which `Model::validate` applies to inertias made of parameters), used
 //! here on URDF inertials and on the inertias a model writes in numbers.
 
-use appell_runtime::physical::{check_inertia, BodyRule};
+use appell_core::physical::{check_inertia, BodyRule};
 
 /// Checks a central inertia matrix (a zero one, a point mass, and a
 /// slender rod's pass); `Err` says which rule it breaks, with its entries.

@@ -16,7 +16,7 @@ use crate::dynamic::{DynRhs, Prepared};
 use crate::integrate::{
     heun_step_fn, midpoint_step_fn, rk4_step_fn, Dop853, Dopri5, IntegrateError, Radau5, TrBdf2,
 };
-use crate::model::{Model, ModelError};
+use crate::{Model, ModelError};
 
 /// An integrator and its setting.
 #[derive(Clone, Copy, Debug, PartialEq)]

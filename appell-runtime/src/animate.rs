@@ -69,7 +69,7 @@ pub use plot::{line_plot, Curve};
 
 use crate::contact_watch::ContactWatch;
 use crate::dynamic::{DynModel, DynRhs};
-use crate::model::{check_len, ModelError};
+use crate::{check_len, ModelError};
 
 /// One instant of a motion: the time and every coordinate.
 #[derive(Clone, Debug, PartialEq)]

@@ -90,8 +90,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::model::Model;
 use crate::oracle::{full_dynamics, FullDynamics, OracleError};
+use crate::Model;
 use crate::ModelError;
 
 /// Settings of the augmented Lagrangian formulation.

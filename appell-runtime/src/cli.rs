@@ -197,7 +197,7 @@
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::model::{Model, ModelError, ModelInfo};
+use crate::{Model, ModelError, ModelInfo};
 
 mod animate;
 mod bench;

@@ -55,7 +55,7 @@ use nalgebra::DMatrix;
 
 use crate::dynamic::DynModel;
 use crate::integrate::ProjectionFailed;
-use crate::model::{check_len, ModelError};
+use crate::{check_len, ModelError};
 
 /// The threshold [`ConditionWatch::new`] is usually given: κ(D′) = 1e8
 /// leaves about 8 of f64's 16 digits in the dependent rates.

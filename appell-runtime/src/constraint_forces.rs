@@ -58,9 +58,9 @@
 //! ([`crate::hybrid::Guard::lift_off`]).
 
 use crate::dynamic::DynModel;
-use crate::model::{Model, ModelInfo, RowSource};
 use crate::oracle::{self, finite_all as finite, mul, mul_bt, vee, OracleError};
-use crate::scalar::Scalar;
+use crate::Scalar;
+use crate::{Model, ModelInfo, RowSource};
 use nalgebra::{DMatrix, DVector};
 use num_dual::{Dual2_64, Dual64};
 
@@ -361,7 +361,7 @@ type RollingContact = (ContactForce, Option<[f64; 3]>, Option<f64>);
 fn rolling_contact(
     info: &ModelInfo,
     c: usize,
-    ci: &crate::model::ContactInfo,
+    ci: &crate::ContactInfo,
     points: &[[f64; 3]],
     directions: &[[f64; 3]],
     multipliers: &[f64],

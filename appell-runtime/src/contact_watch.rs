@@ -109,8 +109,8 @@
 use crate::constraint_forces::{contact_forces_parts, ConstraintForces, Normal};
 use crate::dynamic::DynModel;
 use crate::integrate::ProjectionFailed;
-use crate::model::{check_len, ContactEvent, ContactViolation, ModelError};
 use crate::oracle::OracleError;
+use crate::{check_len, ContactEvent, ContactViolation, ModelError};
 
 /// The relative tolerance [`ContactWatch::new`] starts with: a normal
 /// force is negative when it is below −1e-9 × the largest contact force

@@ -15,7 +15,7 @@
 //! The methods are prefixed `dyn_` so that both traits can be in scope
 //! together without making calls such as `model.rhs(..)` ambiguous.
 
-use crate::model::{Model, ModelError, ModelInfo, SceneVisitor};
+use crate::{Model, ModelError, ModelInfo, SceneVisitor};
 use num_dual::{Dual2_64, Dual64};
 use std::hint::black_box;
 
@@ -588,7 +588,7 @@ pub trait DynModel: sealed::Sealed {
     fn dyn_contact_links(&self) -> &'static [&'static str];
 
     /// [`Model::joint_limits`].
-    fn dyn_joint_limits(&self) -> &'static [crate::model::JointLimit];
+    fn dyn_joint_limits(&self) -> &'static [crate::JointLimit];
 
     /// [`Model::contact_points`].
     fn dyn_contact_points(
@@ -938,7 +938,7 @@ impl<M: Model> DynModel for M {
         M::contact_links()
     }
 
-    fn dyn_joint_limits(&self) -> &'static [crate::model::JointLimit] {
+    fn dyn_joint_limits(&self) -> &'static [crate::JointLimit] {
         M::joint_limits()
     }
 

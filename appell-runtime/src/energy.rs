@@ -18,8 +18,8 @@
 //! times its coordinate's rate, which [`Model::input_power`] leaves out.
 
 use crate::dynamic::DynModel;
-use crate::model::{Model, ModelError};
 use crate::motion::{first_rates, seeded_inputs};
+use crate::{Model, ModelError};
 use num_dual::Dual64;
 
 /// The energies at one state, from [`energies`].

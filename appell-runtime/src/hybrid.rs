@@ -48,9 +48,9 @@ use num_dual::Dual64;
 use crate::constraint_forces::{contact_forces_dyn, Normal};
 use crate::dynamic::{DynModel, DynRhs};
 use crate::integrate::{Dop853, IntegrateError, Radau5};
-use crate::model::ModelError;
 use crate::oracle::OracleError;
 use crate::switch::{impact_state, switch_state, SwitchError};
+use crate::ModelError;
 
 /// A guard's value at `(t, q, u)`: every coordinate, the phase's speeds.
 pub type GuardFn<'a> = Box<dyn Fn(f64, &[f64], &[f64]) -> Result<f64, ModelError> + 'a>;

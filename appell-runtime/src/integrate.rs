@@ -26,8 +26,7 @@
 //! numbers) and reports [`ModelError::NonFinite`] with `what: "state"`
 //! otherwise, so a blow-up never goes unnoticed as NaN.
 
-use crate::model::{check_model, check_state_len, Model, ModelError};
-use crate::scalar::Scalar;
+use crate::{Model, ModelError, Scalar};
 
 mod dop853;
 pub use dop853::*;
@@ -45,6 +44,28 @@ pub use implicit::*;
 mod radau;
 #[cfg(feature = "std")]
 pub use radau::*;
+
+/// Checks that an array length `found` (the `S` of a `[T; S]` state) is the
+/// model's reduced state length ([`ModelInfo::state_len`](crate::ModelInfo::state_len)).
+pub(crate) fn check_state_len<M: Model>(found: usize) -> Result<(), ModelError> {
+    let expected = M::info().state_len();
+    if found == expected {
+        Ok(())
+    } else {
+        Err(ModelError::Length {
+            argument: "state",
+            expected,
+            found,
+        })
+    }
+}
+
+/// [`check_state_len`], then [`Model::validate`]: what a simulation entry
+/// point checks once before its first step.
+pub(crate) fn check_model<M: Model>(model: &M, state_len: usize) -> Result<(), ModelError> {
+    check_state_len::<M>(state_len)?;
+    model.validate()
+}
 
 /// One step of Heun's method (the explicit trapezoidal rule, order 2) of
 /// `dx/dt = f(t, x)` of size `h` from `(t, x)`: an Euler predictor

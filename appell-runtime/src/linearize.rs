@@ -127,7 +127,7 @@
 //! hand-written models in the ignored test `dual64_vs_dualsvec64_timing`).
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::model::Model;
+use crate::Model;
 #[cfg(doc)]
 use num_dual::Dual64;
 

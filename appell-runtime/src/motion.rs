@@ -10,7 +10,7 @@
 //! companion inputs (`x` changes at `x_rate`, `x_rate` at `x_accel`).
 
 use crate::dynamic::DynModel;
-use crate::model::{check_len, Model, ModelError, ModelInfo};
+use crate::{check_len, Model, ModelError, ModelInfo};
 use num_dual::Dual64;
 
 /// The rates of the motion at one state, from [`rates`].

@@ -126,7 +126,7 @@
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::model::{Model, ModelInfo};
+use crate::{Model, ModelInfo};
 #[cfg(doc)]
 use num_dual::{Dual2_64, Dual64};
 

@@ -58,7 +58,7 @@ use std::fmt;
 use std::string::String;
 use std::vec::Vec;
 
-use crate::model::check_len;
+use crate::check_len;
 use crate::{ModelError, Scalar};
 
 /// Why a map cannot be made from a model's names.

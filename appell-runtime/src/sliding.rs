@@ -54,8 +54,8 @@ use nalgebra::{DMatrix, DVector};
 
 use crate::constraint_forces::{contact_forces_parts, momentum_residual, Normal};
 use crate::dynamic::DynModel;
-use crate::model::ModelError;
 use crate::oracle::OracleError;
+use crate::ModelError;
 
 /// A contact point's position at `(t, q)`, N components.
 pub type PointFn<'a> = Box<dyn Fn(f64, &[f64]) -> Result<[f64; 3], ModelError> + 'a>;

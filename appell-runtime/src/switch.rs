@@ -90,7 +90,7 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::dynamic::DynModel;
-use crate::model::{ModelError, ModelInfo};
+use crate::{ModelError, ModelInfo};
 
 /// Relative size below which the target's constraint residual counts as
 /// satisfied (no impulse), and below which a singular value of G M⁻¹ Gᵀ

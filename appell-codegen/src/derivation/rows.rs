@@ -22,7 +22,7 @@ use crate::ctxt::Ctxt;
 use crate::model::Model;
 use crate::probe::same_function;
 
-pub use appell_runtime::RowSource;
+pub use appell_core::RowSource;
 
 /// The material velocity at a rolling contact, as written (the twin's).
 #[derive(Clone, Copy)]

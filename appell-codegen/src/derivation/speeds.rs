@@ -14,7 +14,7 @@ use super::rows::ConstraintRows;
 use crate::ctxt::Ctxt;
 use crate::model::{Model, SpeedSpec};
 use crate::probe::dependent_row;
-use appell_runtime::RowSource;
+use appell_core::RowSource;
 
 /// The output of stage 2.
 #[derive(Clone)]

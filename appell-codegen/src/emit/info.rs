@@ -102,7 +102,7 @@ impl Emitter<'_> {
         );
         let total = int(rhs_ops.total() + extra_ops);
         let text = format!("rhs: {form}\njacobian: {}\n\n{}", jacobian.summary, d.text);
-        let jacobian = jacobian.info(appell_runtime::OpCounts {
+        let jacobian = jacobian.info(appell_core::OpCounts {
             add: rhs_ops.add,
             mul: rhs_ops.mul,
             div: rhs_ops.div,

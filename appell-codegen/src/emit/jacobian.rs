@@ -46,14 +46,14 @@ enum InfoParts {
 
 impl JacobianParts {
     /// `ModelInfo::jacobian`'s value for a model whose rhs costs `rhs`.
-    pub(super) fn info(&self, rhs: appell_runtime::OpCounts) -> TokenStream {
+    pub(super) fn info(&self, rhs: appell_core::OpCounts) -> TokenStream {
         let p = p();
         match &self.info {
             InfoParts::Nothing => quote!(::core::option::Option::None),
             InfoParts::Symbolic(info) => info.clone(),
             &InfoParts::Dual(width, passes) => {
                 // The runtime's count of the passes, taken here.
-                let c = appell_runtime::dual::pass_costs(rhs, width, passes);
+                let c = appell_core::dual::pass_costs(rhs, width, passes);
                 let form = &self.summary;
                 let (add, mul, div, calls, total) = (
                     int(c.add),

@@ -14,7 +14,7 @@
 
 use std::collections::HashSet;
 
-use appell_runtime::linalg::{lu_factor_ops, lu_substitute_ops};
+use appell_core::linalg::{lu_factor_ops, lu_substitute_ops};
 use appell_symbolic::Id;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};

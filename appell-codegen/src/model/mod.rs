@@ -289,7 +289,7 @@ pub struct Constraint {
     /// The effect it belongs to; None: every scene keeps it.
     pub effect: Option<String>,
     /// For a row of a `contact(...)`: the contact's index and the row's
-    /// axis (see `appell_runtime::RowSource::Contact`).
+    /// axis (see `appell_core::RowSource::Contact`).
     pub contact: Option<(usize, usize)>,
 }
 

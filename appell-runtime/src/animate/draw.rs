@@ -7,7 +7,7 @@ use std::fmt::Write;
 use super::geometry::{self, Pose, Projection, Scene};
 use super::Frame;
 use crate::dynamic::DynModel;
-use crate::model::ModelError;
+use crate::ModelError;
 
 /// How the motion is looked at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -6,7 +6,7 @@ use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
 
 use super::Frame;
 use crate::dynamic::DynModel;
-use crate::model::ModelError;
+use crate::ModelError;
 
 /// A body at one frame, in N.
 #[derive(Clone, Copy, Debug)]

@@ -3,7 +3,7 @@
 use super::error::CliError;
 use super::output::finite_or_null;
 use crate::dynamic::DynModel;
-use crate::model::Model;
+use crate::Model;
 use serde_json::{json, Value};
 use std::hint::black_box;
 use std::time::{Duration, Instant};

@@ -1,6 +1,6 @@
 //! [`CliError`]: why the command line failed.
 
-use crate::model::ModelError;
+use crate::ModelError;
 use std::error::Error;
 
 /// Why the command line failed.

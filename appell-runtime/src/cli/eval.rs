@@ -9,7 +9,7 @@ use super::jacobian::{jacobian_answer, parse_step};
 use super::json::parse_object;
 use super::output::{contact_forces_json, finite_or_null, result_number};
 use crate::dynamic::DynModel;
-use crate::model::{Model, ModelError, ModelInfo};
+use crate::{Model, ModelError, ModelInfo};
 use serde_json::{json, Map, Value};
 use std::io::{BufRead, Write};
 

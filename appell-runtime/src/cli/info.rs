@@ -2,7 +2,7 @@
 
 use super::output::finite_or_null;
 use crate::dynamic::DynModel;
-use crate::model::{Model, ModelError};
+use crate::{Model, ModelError};
 use serde_json::{json, Value};
 
 /// The metadata printed by `info` (layout in the module documentation).

@@ -9,7 +9,7 @@ use crate::dynamic::{DynModel, DynRhs};
 use crate::linearize::discrete::{chained_with, step_with};
 use crate::linearize::jacobian::{dual_columns, state_names};
 use crate::linearize::FixedStep;
-use crate::model::ModelInfo;
+use crate::ModelInfo;
 use nalgebra::DMatrix;
 use num_dual::Dual64;
 use serde_json::{json, Map, Value};
@@ -97,14 +97,14 @@ fn generated(
     info: &ModelInfo,
     point: &Point,
     step: Option<(FixedStep, f64)>,
-) -> Result<Columns, crate::model::ModelError> {
+) -> Result<Columns, crate::ModelError> {
     let (x, w) = (&point.state[..], &point.inputs[..]);
     let (s, ni) = (x.len(), w.len());
     let mut jacobian = |t: f64, y: &[f64], v: &mut [f64], a: &mut [f64], b: &mut [f64]| match rhs
         .generated_jacobian(t, y, w, v, a, b)?
     {
         true => Ok(()),
-        false => Err(crate::model::ModelError::NotGenerated {
+        false => Err(crate::ModelError::NotGenerated {
             function: "rhs_jacobian",
         }),
     };
@@ -133,7 +133,7 @@ fn evaluate(
     x: &[Dual64],
     w: &[Dual64],
     step: Option<(FixedStep, f64)>,
-) -> Result<Vec<Dual64>, crate::model::ModelError> {
+) -> Result<Vec<Dual64>, crate::ModelError> {
     let t = Dual64::from_re(t);
     match step {
         None => {

@@ -3,7 +3,7 @@
 
 use crate::constraint_forces::{contact_forces_dyn, Friction, Normal, NormalSource};
 use crate::dynamic::DynModel;
-use crate::model::RowSource;
+use crate::RowSource;
 use serde_json::{json, Value};
 
 /// A JSON number, or `null` for a value JSON cannot hold.

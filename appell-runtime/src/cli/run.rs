@@ -8,7 +8,7 @@ use super::eval::{eval_stream, Answer, EvalState};
 use super::info::info_json_dyn;
 use super::sweep::accuracy_dyn;
 use crate::dynamic::DynModel;
-use crate::model::{Model, ModelInfo};
+use crate::{Model, ModelInfo};
 use serde_json::json;
 use std::error::Error;
 use std::io::{BufRead, IsTerminal, Write};

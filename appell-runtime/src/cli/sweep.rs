@@ -6,7 +6,7 @@ use super::json::parse_object;
 use super::output::finite_or_null;
 use crate::accuracy::{standard_methods, Run};
 use crate::dynamic::{DynModel, DynRhs};
-use crate::model::Model;
+use crate::Model;
 use serde_json::{json, Value};
 
 /// The largest reduced state `accuracy` handles (the integrators work on

@@ -4,12 +4,13 @@
 // The coefficients are kept with the digits they are published with.
 #![allow(clippy::excessive_precision)]
 
+use super::check_model;
 use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, Sink, SliceSink,
 };
 use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
-use crate::model::{check_model, Model, ModelError};
-use crate::scalar::Scalar;
+use crate::Scalar;
+use crate::{Model, ModelError};
 
 /// Adaptive Dormand–Prince 8(5,3) integrator (Hairer, Nørsett & Wanner,
 /// *Solving ODEs I*, 2nd ed., the `DOP853` scheme), configured by a builder

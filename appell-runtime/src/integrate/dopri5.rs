@@ -1,12 +1,13 @@
 //! Adaptive Dormand–Prince 5(4) integration with dense output and event
 //! location, on fixed-size arrays and without allocation.
 
+use super::check_model;
 use super::explicit::{
     self, all_finite, CallbackSink, DenseOutput, EmbeddedPair, Settings, Sink, SliceSink,
 };
 use super::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
-use crate::model::{check_model, Model, ModelError};
-use crate::scalar::Scalar;
+use crate::Scalar;
+use crate::{Model, ModelError};
 
 /// Adaptive Dormand–Prince 5(4) integrator (Hairer, Nørsett & Wanner,
 /// *Solving ODEs I*, the `DOPRI5` scheme), configured by a builder.

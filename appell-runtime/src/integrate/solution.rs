@@ -5,7 +5,7 @@
 //! ([`Dopri5`](super::Dopri5), [`Dop853`](super::Dop853)), the adaptive loop
 //! they run on, and the implicit integrator.
 
-use crate::model::{ContactEvent, ModelError};
+use crate::{ContactEvent, ModelError};
 
 /// Why an adaptive integration stopped without reaching its end.
 #[derive(Clone, Copy, Debug, PartialEq)]

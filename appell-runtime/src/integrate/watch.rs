@@ -4,8 +4,8 @@
 //! accepted step; its stop becomes [`IntegrateError::Contact`].
 
 use super::solution::{IntegrateError, ProjectionFailed};
-use crate::model::Model;
-use crate::scalar::Scalar;
+use crate::Model;
+use crate::Scalar;
 
 /// The check the integrators compose after a caller's projection: the
 /// reduced state in `f64` (the real parts, for dual numbers).

@@ -16,8 +16,8 @@ use num_dual::Dual64;
 
 use super::checks::finite;
 use super::jacobian::{dual_columns, state_names};
-use crate::model::{check_len, Model, ModelError};
-use crate::scalar::Scalar;
+use crate::Scalar;
+use crate::{check_len, Model, ModelError};
 
 /// A fixed-step method of a controller loop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,12 +1,12 @@
 //! [`LinearizeError`]: why a linearization or a holonomic solve failed.
 
-use crate::model::ModelError;
+use crate::ModelError;
 
 // Items the documentation links to.
 #[cfg(doc)]
 use super::{check_holonomic, eigenvalues, minimal_linearization};
 #[cfg(doc)]
-use crate::model::ModelInfo;
+use crate::ModelInfo;
 
 /// Why a linearization, an eigenvalue computation or a constraint solve
 /// failed.

@@ -4,14 +4,14 @@
 
 use super::checks::{check_configuration, finite, indices};
 use super::error::LinearizeError;
-use crate::model::{check_len, Model, ModelError};
-use crate::scalar::Scalar;
+use crate::Scalar;
+use crate::{check_len, Model, ModelError};
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::model::ModelInfo;
+use crate::ModelInfo;
 
 /// Singular values below this fraction of the largest entry of the full
 /// holonomic Jacobian count as zero.

@@ -2,8 +2,8 @@
 //! [`Dual64`] evaluation per column.
 
 use super::checks::finite;
-use crate::model::ModelError;
-use crate::model::{check_len, Model, ModelInfo};
+use crate::ModelError;
+use crate::{check_len, Model, ModelInfo};
 use nalgebra::DMatrix;
 use num_dual::Dual64;
 

@@ -5,7 +5,7 @@
 //! line holds, with the Jacobian read from the holonomic rows of D.
 
 use crate::dynamic::DynModel;
-use crate::model::{ModelError, ModelInfo, RowSource};
+use crate::{ModelError, ModelInfo, RowSource};
 use nalgebra::{DMatrix, DVector};
 
 /// Converged when every holonomic residual is at most this × (1 + max |q|).

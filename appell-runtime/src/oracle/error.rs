@@ -1,10 +1,10 @@
 //! [`OracleError`]: why the oracle could not produce accelerations.
 
-use crate::model::ModelError;
+use crate::ModelError;
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::model::ModelInfo;
+use crate::ModelInfo;
 
 /// Why the oracle could not produce accelerations.
 #[derive(Clone, Debug, PartialEq)]

@@ -5,7 +5,7 @@ use super::assembly::{full_dynamics_with, FullDynamics};
 use super::error::OracleError;
 use super::layout::{finite_all, Layout};
 use crate::dynamic::DynModel;
-use crate::model::Model;
+use crate::Model;
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
 
@@ -13,7 +13,7 @@ use num_dual::Dual64;
 #[cfg(doc)]
 use super::full_dynamics;
 #[cfg(doc)]
-use crate::model::ModelInfo;
+use crate::ModelInfo;
 
 /// Relative size (in units of `dim · ε · scale`) below which an LU pivot
 /// counts as zero: a little above the rounding noise of the elimination.

@@ -4,8 +4,8 @@
 
 use super::error::OracleError;
 use crate::dynamic::DynModel;
-use crate::model::{ModelError, ModelInfo};
-use crate::scalar::Scalar;
+use crate::Scalar;
+use crate::{ModelError, ModelInfo};
 use num_dual::Dual64;
 
 /// Coordinate index sets derived from a validated [`ModelInfo`].

@@ -5,14 +5,14 @@ use super::error::OracleError;
 use super::kkt::{accelerations_with, lu_solve_checked};
 use super::layout::{finite_all, Layout};
 use crate::dynamic::DynModel;
-use crate::model::{check_len, Model};
+use crate::{check_len, Model};
 use nalgebra::{DMatrix, DVector};
 
 // Items the documentation links to.
 #[cfg(doc)]
 use super::accelerations;
 #[cfg(doc)]
-use crate::model::ModelInfo;
+use crate::ModelInfo;
 
 /// All coordinate rates q̇ from the privileged speeds `u` (one per
 /// [`ModelInfo::speeds`], in that order): the privileged rates are `u` and

@@ -4,8 +4,8 @@
 use super::pair::{all_finite, EmbeddedPair};
 use super::settings::Settings;
 use crate::integrate::solution::{IntegrateError, Stats};
-use crate::model::ModelError;
-use crate::scalar::Scalar;
+use crate::ModelError;
+use crate::Scalar;
 
 /// Safety factor of the step-size controller.
 const SAFETY: f64 = 0.9;

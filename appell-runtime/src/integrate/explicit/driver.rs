@@ -7,8 +7,8 @@ use super::pair::{all_finite, DenseOutput, EmbeddedPair};
 use super::settings::Settings;
 use super::sink::Sink;
 use crate::integrate::solution::{EventFn, IntegrateError, ProjectFn, Solution, Stats};
-use crate::model::ModelError;
-use crate::scalar::Scalar;
+use crate::ModelError;
+use crate::Scalar;
 
 /// Factor of the retry after a non-finite stage.
 const FAC_NON_FINITE: f64 = 0.2;

@@ -3,8 +3,8 @@
 
 use super::settings::Settings;
 use crate::integrate::solution::{IntegrateError, Stats};
-use crate::model::ModelError;
-use crate::scalar::Scalar;
+use crate::ModelError;
+use crate::Scalar;
 
 pub(in crate::integrate) fn all_finite<T: Scalar, const S: usize>(x: &[T; S]) -> bool {
     x.iter().all(|v| v.re().is_finite())

@@ -11,7 +11,7 @@ use super::shared::{
 use super::stages::Stages;
 use super::stats::{TrBdf2Solution, TrBdf2Stats};
 use crate::integrate::solution::IntegrateError;
-use crate::model::ModelError;
+use crate::ModelError;
 
 impl TrBdf2 {
     /// The integration loop behind every `solve*`: `f` and its Jacobian

@@ -5,7 +5,7 @@ use super::coefficients::D;
 use super::control::{all_finite, wrms, FAC_NEWTON};
 use super::stats::TrBdf2Stats;
 use crate::integrate::solution::IntegrateError;
-use crate::model::ModelError;
+use crate::ModelError;
 use nalgebra::{DMatrix, DVector};
 
 const NEWTON_KAPPA: f64 = 0.01;

@@ -8,7 +8,7 @@ use super::stats::TrBdf2Solution;
 use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
 use crate::integrate::solution::{IntegrateError, ProjectionFailed};
 use crate::integrate::watch::watched_slices;
-use crate::model::{check_len, Model, ModelError};
+use crate::{check_len, Model, ModelError};
 
 // Items the documentation links to.
 #[cfg(doc)]

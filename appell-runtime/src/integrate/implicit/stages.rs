@@ -5,7 +5,7 @@ use super::coefficients::{D, E1, E2, E3, GAMMA, W};
 use super::control::wrms;
 use super::newton::{Iteration, Newton};
 use super::stats::TrBdf2Stats;
-use crate::model::ModelError;
+use crate::ModelError;
 
 /// The work vectors of one step: the Newton right-hand side `psi`, the
 /// stages `y2` (at `t + γh`) and `y3` (at `t + h`, the new state) with

@@ -13,7 +13,7 @@ use crate::integrate::implicit::{
     project_state, EventG, ProjectG,
 };
 use crate::integrate::solution::IntegrateError;
-use crate::model::ModelError;
+use crate::ModelError;
 
 impl Radau5 {
     /// The integration loop behind every `solve*`: `f` and its Jacobian

@@ -6,7 +6,7 @@ use super::linear::{factor_pair, solve_pair, Lu, C64};
 use super::stats::Radau5Stats;
 use crate::integrate::implicit::all_finite;
 use crate::integrate::solution::IntegrateError;
-use crate::model::ModelError;
+use crate::ModelError;
 
 /// The Jacobian, its age and the LU factors of both iteration matrices.
 pub(super) struct Iteration {

@@ -7,7 +7,7 @@ use super::iteration::Iteration;
 use super::linear::C64;
 use super::stats::Radau5Stats;
 use crate::integrate::implicit::{all_finite, wrms};
-use crate::model::ModelError;
+use crate::ModelError;
 
 /// A contraction rate at or above this is divergence.
 const THETA_DIVERGE: f64 = 0.99;

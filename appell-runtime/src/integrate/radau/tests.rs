@@ -3,7 +3,7 @@
 
 use super::{Radau5, Radau5Solution};
 use crate::integrate::{IntegrateError, ProjectionFailed, TrBdf2};
-use crate::model::ModelError;
+use crate::ModelError;
 
 type R = Result<(), ModelError>;
 

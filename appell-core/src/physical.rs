@@ -14,44 +14,15 @@
 //! of real bodies and pass.
 //!
 //! ```
-//! use appell_runtime::physical::{check_inertia, BodyRule};
+//! use appell_core::physical::{check_inertia, BodyRule};
 //! let diag = |a: f64, b: f64, c: f64| [[a, 0.0, 0.0], [0.0, b, 0.0], [0.0, 0.0, c]];
 //! assert_eq!(check_inertia(&diag(0.0, 1.0, 1.0)), Ok(()));
 //! assert_eq!(check_inertia(&diag(1.0, 1.0, 5.0)), Err(BodyRule::Triangle));
 //! assert_eq!(check_inertia(&diag(1.0, -1.0, 1.0)), Err(BodyRule::NotSemidefinite));
 //! ```
 
-use crate::model::ModelError;
-
-/// The rule a body's mass or inertia breaks.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum BodyRule {
-    /// The mass is zero, negative or not a number.
-    NonPositiveMass,
-    /// An entry of the inertia is NaN or infinite.
-    NonFiniteInertia,
-    /// The inertia has a negative principal moment.
-    NotSemidefinite,
-    /// A principal moment exceeds the sum of the other two.
-    Triangle,
-}
-
-impl BodyRule {
-    /// What the rule says, as a sentence's predicate ("its mass is not
-    /// positive").
-    pub fn describe(self) -> &'static str {
-        match self {
-            BodyRule::NonPositiveMass => "its mass is not positive",
-            BodyRule::NonFiniteInertia => "its inertia is not finite",
-            BodyRule::NotSemidefinite => {
-                "its inertia is not positive semidefinite (a principal moment is negative)"
-            }
-            BodyRule::Triangle => {
-                "its inertia violates the triangle inequality: a principal moment exceeds the sum of the other two"
-            }
-        }
-    }
-}
+pub use crate::error::BodyRule;
+use crate::error::ModelError;
 
 /// Checks a central inertia matrix; a zero one (a point mass) passes. The
 /// tolerance is relative, 1e-9 of the largest entry's scale, for rounding
@@ -91,8 +62,8 @@ pub fn check_inertia(m: &[[f64; 3]; 3]) -> Result<(), BodyRule> {
 /// (`of_mass` for the mass, `of_inertia` for the inertia).
 ///
 /// ```
-/// use appell_runtime::physical::{check_body, BodyRule};
-/// use appell_runtime::ModelError;
+/// use appell_core::physical::{check_body, BodyRule};
+/// use appell_core::ModelError;
 /// let rod = [0.0, 0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0, 1.0];
 /// assert_eq!(check_body("rod", &["m"], &["m", "l"], 2.0, &rod), Ok(()));
 /// assert_eq!(

@@ -28,7 +28,7 @@ use crate::{Model, ModelError, OpCounts, Scalar};
 /// directional derivatives.
 ///
 /// ```
-/// use appell_runtime::{dual::DualVec, Scalar};
+/// use appell_core::{dual::DualVec, Scalar};
 /// // x = 0.5 along the first direction, y = 2 along the second.
 /// let x = DualVec::<f64, 2>::variable(0.5, 0);
 /// let y = DualVec::<f64, 2>::variable(2.0, 1);
@@ -353,10 +353,10 @@ fn scatter<T: Scalar, const W: usize>(
 /// of stack in a debug build.
 ///
 /// ```
-/// use appell_runtime::dual::rhs_jacobian_by_duals;
-/// use appell_runtime::ModelError;
+/// use appell_core::dual::rhs_jacobian_by_duals;
+/// use appell_core::ModelError;
 /// // θ̈ = −(g/l) sin θ + τ, written by hand.
-/// use appell_runtime::__doc_model::Pendulum;
+/// use appell_core::__doc_model::Pendulum;
 ///
 /// let model = Pendulum { g_over_l: 9.81 };
 /// let (mut ds, mut a, mut b) = ([0.0; 2], [0.0; 4], [0.0; 2]);
@@ -433,10 +433,10 @@ pub fn rhs_jacobian_by_duals<
 /// its size bound).
 ///
 /// ```
-/// use appell_runtime::dual::inverse_dynamics_derivatives_by_duals;
-/// use appell_runtime::ModelError;
+/// use appell_core::dual::inverse_dynamics_derivatives_by_duals;
+/// use appell_core::ModelError;
 /// // θ̈ = −(g/l) sin θ + τ: Q = θ̈ + (g/l) sin θ.
-/// use appell_runtime::__doc_model::Pendulum;
+/// use appell_core::__doc_model::Pendulum;
 ///
 /// let model = Pendulum { g_over_l: 9.81 };
 /// let (mut q_force, mut dq, mut du, mut m) = ([0.0; 1], [0.0; 1], [0.0; 1], [0.0; 1]);
@@ -512,7 +512,7 @@ pub fn inverse_dynamics_derivatives_by_duals<
 /// numeric solves, negations) 1 + 2W operations each.
 ///
 /// ```
-/// use appell_runtime::{dual::pass_costs, OpCounts};
+/// use appell_core::{dual::pass_costs, OpCounts};
 /// let rhs = OpCounts { add: 10, mul: 10, div: 1, calls: 2, total: 25 };
 /// let c = pass_costs(rhs, 4, 2);
 /// assert_eq!(c.add, 2 * (10 * 5 + 10 * 4 + 4));

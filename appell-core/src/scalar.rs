@@ -12,7 +12,7 @@ use core::ops::{Add, AddAssign, Div, DivAssign, Mul, MulAssign, Neg, Sub, SubAss
 /// scope there; the derive takes care of that.
 ///
 /// ```
-/// use appell_runtime::Scalar;
+/// use appell_core::Scalar;
 ///
 /// fn pendulum_accel<T: Scalar>(theta: T, g_over_l: T) -> T {
 ///     -(g_over_l * theta.sin())
@@ -65,7 +65,7 @@ pub trait Scalar:
     /// of `self * a + b` to the bit.
     ///
     /// ```
-    /// use appell_runtime::Scalar;
+    /// use appell_core::Scalar;
     /// let x = 0.1_f64.fused_mul_add(3.0, -0.3);
     /// assert!(x.abs() < 1e-16);
     /// assert_eq!(2.0_f32.fused_mul_add(3.0, 1.0), 7.0);
@@ -80,7 +80,7 @@ pub trait Scalar:
     /// `fused_mul_add`, not this.
     ///
     /// ```
-    /// use appell_runtime::Scalar;
+    /// use appell_core::Scalar;
     /// assert_eq!(2.0_f64.fma(3.0, 1.0), 7.0);
     /// ```
     #[inline(always)]
@@ -131,7 +131,7 @@ pub trait Scalar:
     /// is zero.
     ///
     /// ```
-    /// use appell_runtime::Scalar;
+    /// use appell_core::Scalar;
     /// assert_eq!([(-2.0_f64).sign(), 0.0.sign(), 3.0.sign()], [-1.0, 0.0, 1.0]);
     /// ```
     fn sign(self) -> Self {
@@ -149,7 +149,7 @@ pub trait Scalar:
     /// derivative is that of the branch taken.
     ///
     /// ```
-    /// use appell_runtime::Scalar;
+    /// use appell_core::Scalar;
     /// assert_eq!(0.5_f64.select(1.0, 2.0), 1.0);
     /// assert_eq!(0.0_f64.select(1.0, 2.0), 2.0);
     /// ```

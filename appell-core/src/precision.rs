@@ -14,8 +14,8 @@
 //! `f64` and in double-double measures the round-off of the `f64` run.
 //!
 //! ```
-//! use appell_runtime::precision::DoubleDouble;
-//! use appell_runtime::Scalar;
+//! use appell_core::precision::DoubleDouble;
+//! use appell_core::Scalar;
 //!
 //! // 0.1 + 0.2 - 0.3 is 5.55e-17 in f64; the exact value of the three
 //! // f64 literals is 2.78e-17, which double-double gets right.
@@ -97,8 +97,8 @@ pub(crate) mod fp {
 /// `lo`).
 ///
 /// ```
-/// use appell_runtime::precision::DoubleDouble;
-/// use appell_runtime::Scalar;
+/// use appell_core::precision::DoubleDouble;
+/// use appell_core::Scalar;
 ///
 /// let x = DoubleDouble::from_f64(2.0);
 /// let r = x.sqrt();
@@ -144,7 +144,7 @@ impl DoubleDouble {
     /// π = 3.14159265358979323846264338327950288…
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert_eq!(DoubleDouble::PI.to_f64(), std::f64::consts::PI);
     /// ```
     pub const PI: DoubleDouble = DoubleDouble {
@@ -154,7 +154,7 @@ impl DoubleDouble {
     /// π/2 = 1.57079632679489661923132169163975144…
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert_eq!(DoubleDouble::FRAC_PI_2 * DoubleDouble::from(2.0), DoubleDouble::PI);
     /// ```
     pub const FRAC_PI_2: DoubleDouble = DoubleDouble {
@@ -164,7 +164,7 @@ impl DoubleDouble {
     /// e = 2.71828182845904523536028747135266250…
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert_eq!(DoubleDouble::E.to_f64(), std::f64::consts::E);
     /// ```
     pub const E: DoubleDouble = DoubleDouble {
@@ -174,7 +174,7 @@ impl DoubleDouble {
     /// ln 2 = 0.693147180559945309417232121458176568…
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert_eq!(DoubleDouble::LN_2.to_f64(), std::f64::consts::LN_2);
     /// ```
     pub const LN_2: DoubleDouble = DoubleDouble {
@@ -185,7 +185,7 @@ impl DoubleDouble {
     /// the next double-double with a full 106-bit significand).
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert_eq!(DoubleDouble::EPSILON, 2f64.powi(-106));
     /// ```
     pub const EPSILON: f64 = 1.232595164407831e-32;
@@ -194,7 +194,7 @@ impl DoubleDouble {
     /// is held exactly).
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// let x = DoubleDouble::new(1.0, 1e-20);
     /// assert_eq!((x.hi(), x.lo()), (1.0, 1e-20));
     /// let y = DoubleDouble::new(1e-20, 1.0); // swapped: renormalized
@@ -208,7 +208,7 @@ impl DoubleDouble {
     /// The high word: the value rounded to the nearest `f64`.
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert_eq!(DoubleDouble::PI.hi(), std::f64::consts::PI);
     /// ```
     pub fn hi(self) -> f64 {
@@ -218,7 +218,7 @@ impl DoubleDouble {
     /// The low word: what the high word leaves out.
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// let third = DoubleDouble::from(1.0) / DoubleDouble::from(3.0);
     /// assert!(third.lo() != 0.0 && third.lo().abs() < 1e-16 * third.hi());
     /// ```
@@ -230,7 +230,7 @@ impl DoubleDouble {
     /// rounded sum by construction).
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// let x = DoubleDouble::from(1.0) / DoubleDouble::from(10.0);
     /// assert_eq!(x.to_f64(), 0.1);
     /// ```
@@ -241,7 +241,7 @@ impl DoubleDouble {
     /// Whether both words are finite.
     ///
     /// ```
-    /// use appell_runtime::precision::DoubleDouble;
+    /// use appell_core::precision::DoubleDouble;
     /// assert!(DoubleDouble::PI.is_finite());
     /// assert!(!(DoubleDouble::from(1.0) / DoubleDouble::from(0.0)).is_finite());
     /// ```
@@ -403,7 +403,7 @@ assign_op! {
 /// Why a string is not a double-double.
 ///
 /// ```
-/// use appell_runtime::precision::{DoubleDouble, ParseDoubleDoubleError};
+/// use appell_core::precision::{DoubleDouble, ParseDoubleDoubleError};
 /// assert_eq!("1.2.3".parse::<DoubleDouble>(), Err(ParseDoubleDoubleError));
 /// ```
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

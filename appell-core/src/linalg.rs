@@ -9,8 +9,8 @@
 // pivots); iterator chains would hide which entry is which.
 #![allow(clippy::needless_range_loop)]
 
-use crate::model::ModelError;
 use crate::scalar::Scalar;
+use crate::ModelError;
 
 /// Solves `A X = B` in place by LU with partial pivoting: on success `b`
 /// holds `X`. A pivot smaller than `1e-12 ×` the largest entry of `A` and `B`
@@ -21,7 +21,7 @@ use crate::scalar::Scalar;
 /// arithmetic.
 ///
 /// ```
-/// use appell_runtime::linalg::lu_solve;
+/// use appell_core::linalg::lu_solve;
 /// let mut a = [[0.0, 2.0], [1.0, 1.0]];
 /// let mut b = [[4.0], [3.0]];
 /// lu_solve(&mut a, &mut b).unwrap();
@@ -46,7 +46,7 @@ pub fn lu_solve<T: Scalar, const N: usize, const M: usize>(
 /// none): the right side's share of [`lu_factor`]'s pivot tolerance.
 ///
 /// ```
-/// use appell_runtime::linalg::max_abs;
+/// use appell_core::linalg::max_abs;
 /// assert_eq!(max_abs(&[[1.0, -3.0], [f64::NAN, 2.0]]), 3.0);
 /// ```
 #[inline]
@@ -86,7 +86,7 @@ fn pairwise(v: &mut [f64], op: impl Fn(f64, f64) -> f64) -> f64 {
 /// [`ModelError::NonFinite`].
 ///
 /// ```
-/// use appell_runtime::linalg::constraint_scale;
+/// use appell_core::linalg::constraint_scale;
 /// assert_eq!(constraint_scale(&[[1.0, -3.0], [0.5, 2.0]], 2.0), Ok(3.0));
 /// assert_eq!(constraint_scale(&[[1.0]], 7.0), Ok(7.0));
 /// assert!(constraint_scale(&[[f64::NAN]], 1.0).is_err());
@@ -126,7 +126,7 @@ pub fn constraint_scale<T: Scalar, const N: usize, const M: usize>(
 /// one by one (a row of the block with a single entry).
 ///
 /// ```
-/// use appell_runtime::linalg::check_pivot;
+/// use appell_core::linalg::check_pivot;
 /// assert!(check_pivot(1e-3, 1.0, 0).is_ok());
 /// assert!(check_pivot(1e-13, 1.0, 2).is_err());
 /// assert!(check_pivot(0.0, 0.0, 0).is_err());
@@ -150,7 +150,7 @@ pub fn check_pivot<T: Scalar>(pivot: T, scale: f64, column: usize) -> Result<(),
 /// [`lu_factor_ops`] counts its arithmetic.
 ///
 /// ```
-/// use appell_runtime::linalg::{lu_factor, lu_substitute};
+/// use appell_core::linalg::{lu_factor, lu_substitute};
 /// let mut a = [[0.0, 2.0], [1.0, 1.0]];
 /// let swaps = lu_factor(&mut a, 4.0).unwrap();
 /// let mut b = [[4.0], [3.0]];
@@ -210,7 +210,7 @@ pub fn lu_factor<T: Scalar, const N: usize>(
 /// [`ModelError::NonFinite`].
 ///
 /// ```
-/// use appell_runtime::linalg::pivot_margin;
+/// use appell_core::linalg::pivot_margin;
 /// assert_eq!(pivot_margin(&[[2.0, 0.0], [0.0, 2.0]]).unwrap(), 1.0);
 /// // A four-bar-like block near a dead centre: 1/margin grows as 1/ε.
 /// let eps = 1e-6;
@@ -273,7 +273,7 @@ fn swap_rows<T: Copy, const N: usize, const M: usize>(a: &mut [[T; M]; N], i: us
 /// arithmetic.
 ///
 /// ```
-/// use appell_runtime::linalg::{lu_factor, lu_substitute};
+/// use appell_core::linalg::{lu_factor, lu_substitute};
 /// let mut a = [[4.0, 0.0], [0.0, 2.0]];
 /// let swaps = lu_factor(&mut a, 0.0).unwrap();
 /// let mut b = [[8.0, 4.0], [2.0, 6.0]];
@@ -325,7 +325,7 @@ pub fn lu_substitute<T: Scalar, const N: usize, const M: usize>(
 /// multipliers and an upper bound otherwise.
 ///
 /// ```
-/// use appell_runtime::linalg::lu_factor_ops;
+/// use appell_core::linalg::lu_factor_ops;
 /// assert_eq!(lu_factor_ops(0), 0);
 /// assert_eq!(lu_factor_ops(1), 1); // the reciprocal of the pivot
 /// assert_eq!(lu_factor_ops(2), 5); // 2 reciprocals, 1 multiplier, 1 multiply-subtract
@@ -352,7 +352,7 @@ pub const fn lu_factor_ops(n: usize) -> usize {
 /// multiplier are skipped, as in [`lu_factor_ops`].
 ///
 /// ```
-/// use appell_runtime::linalg::lu_substitute_ops;
+/// use appell_core::linalg::lu_substitute_ops;
 /// assert_eq!(lu_substitute_ops(1, 1), 1); // one multiplication by 1/a
 /// assert_eq!(lu_substitute_ops(3, 2), 2 * (2 * 9 - 3));
 /// assert_eq!(lu_substitute_ops(4, 0), 0);
@@ -367,7 +367,7 @@ pub const fn lu_substitute_ops(n: usize, columns: usize) -> usize {
 /// on `f64` magnitudes and not counted).
 ///
 /// ```
-/// use appell_runtime::linalg::{lu_factor_ops, lu_solve_ops, lu_substitute_ops};
+/// use appell_core::linalg::{lu_factor_ops, lu_solve_ops, lu_substitute_ops};
 /// assert_eq!(lu_solve_ops(3, 2), lu_factor_ops(3) + lu_substitute_ops(3, 2));
 /// assert_eq!(lu_solve_ops(2, 1), 5 + 6);
 /// ```
@@ -380,7 +380,7 @@ pub const fn lu_solve_ops(n: usize, columns: usize) -> usize {
 /// scale) is reported as [`ModelError::SingularMassMatrix`].
 ///
 /// ```
-/// use appell_runtime::linalg::ldlt_solve;
+/// use appell_core::linalg::ldlt_solve;
 /// let m = [[4.0f64, 2.0], [2.0, 3.0]];
 /// let x = ldlt_solve(&m, &[6.0, 5.0]).unwrap();
 /// assert!((x[0] - 1.0).abs() < 1e-15 && (x[1] - 1.0).abs() < 1e-15);
