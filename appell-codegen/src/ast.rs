@@ -37,6 +37,30 @@ impl Expr {
             | Expr::Neg(_, s) => *s,
         }
     }
+
+    /// `a + b`, where `a` stands.
+    pub fn sum(a: Expr, b: Expr) -> Expr {
+        let span = a.span();
+        Expr::Binary(BinOp::Add, Box::new(a), Box::new(b), span)
+    }
+
+    /// `a - b`, where `a` stands.
+    pub fn difference(a: Expr, b: Expr) -> Expr {
+        let span = a.span();
+        Expr::Binary(BinOp::Sub, Box::new(a), Box::new(b), span)
+    }
+
+    /// `a * b`, where `a` stands.
+    pub fn product(a: Expr, b: Expr) -> Expr {
+        let span = a.span();
+        Expr::Binary(BinOp::Mul, Box::new(a), Box::new(b), span)
+    }
+
+    /// `-e`, where `e` stands.
+    pub fn negated(e: Expr) -> Expr {
+        let span = e.span();
+        Expr::Neg(Box::new(e), span)
+    }
 }
 
 /// `+ - * /`.
@@ -274,7 +298,7 @@ pub struct ModelAst {
     pub origins: Vec<(Ident, Ident)>,
     /// The joints as written (also lowered into frames, points,
     /// coordinates and loads above), for the kinematic tree.
-    pub joints: Vec<crate::parse::joints::JointDef>,
+    pub joints: Vec<JointDef>,
     /// The coordinates whose rates joints make privileged speeds, added
     /// after those of `speeds(...)` that are not among them (when parsing
     /// ends; kept for error messages).
@@ -296,4 +320,112 @@ pub struct ModelAst {
     /// checked the rigid body each is part of (links fixed together), or
     /// `unchecked_inertia(...)` named it.
     pub unchecked_inertia: Vec<String>,
+}
+
+/// The direction a joint moves along or about, in the joint frame.
+#[derive(Clone, Debug)]
+pub enum JointAxis {
+    /// `x`, `y`, `z` (0, 1, 2), negated with `-z`.
+    Unit(usize, bool),
+    /// `[ax, ay, az]`: components in the joint frame, any length.
+    Components([Expr; 3]),
+}
+
+/// What a joint lets the child do relative to the joint frame.
+#[derive(Clone, Debug)]
+pub enum JointKind {
+    /// Turn about the axis: one coordinate, the joint's name.
+    Revolute(JointAxis),
+    /// Slide along the axis: one coordinate, the joint's name.
+    Prismatic(JointAxis),
+    /// Turn about and slide along the axis: `{name}_angle`, `{name}_slide`.
+    Cylindrical(JointAxis),
+    /// Slide in the plane normal to a unit axis and turn about it:
+    /// `{name}_x`, `{name}_y` (along the next two axes in cyclic order)
+    /// and `{name}_angle`.
+    Planar(usize),
+    /// No motion: the child is fixed in the parent.
+    Weld,
+    /// Any rotation about the joint origin, by a unit quaternion
+    /// `{name}_qw, _qx, _qy, _qz`; its speeds are the child's angular
+    /// velocity relative to the joint frame, in the child's axes,
+    /// `{name}_wx, _wy, _wz` (Method III); the unit norm is a holonomic
+    /// constraint.
+    Spherical,
+    /// A spherical joint whose centre also moves: `{name}_x, _y, _z` along
+    /// the joint frame's axes, their rates speeds too.
+    Free,
+}
+
+/// `joint(...)` as written.
+#[derive(Clone, Debug)]
+pub struct JointDef {
+    /// The joint's name (its coordinate's, for one degree of freedom).
+    pub name: Ident,
+    /// Its kind.
+    pub kind: JointKind,
+    /// The parent frame (`N` or a frame declared above).
+    pub parent: Ident,
+    /// The child frame it declares.
+    pub child: Ident,
+    /// The joint frame's origin before `xyz`: the parent's origin unless
+    /// given.
+    pub at: Option<Ident>,
+    /// Offset of the joint frame in the parent frame.
+    pub xyz: Option<[Expr; 3]>,
+    /// Fixed-axis roll, pitch, yaw of the joint frame in the parent frame.
+    pub rpy: Option<[Expr; 3]>,
+    /// Declares the input `tau_{name}` and applies it (a torque about, or a
+    /// force along, the axis, on the child, and its reaction on the parent).
+    pub actuated: bool,
+    /// The joint's rates are not privileged speeds (a joint a loop closure
+    /// makes dependent, or a locked one).
+    pub dependent: bool,
+    /// `lock = effect`: the joint held still where `effect` acts.
+    pub lock: Option<JointLock>,
+    /// Springs, dampers, friction and the motor's saturation on the joint.
+    pub elements: JointElements,
+    /// The whole item, for errors.
+    pub span: Span,
+}
+
+/// `lock = effect` on a one-axis joint: the velocity constraint
+/// `dt(q) == 0` on its coordinate, belonging to `effect`, so only the
+/// scenes that name the effect hold the joint still (a brake, a clutch).
+#[derive(Clone, Debug)]
+pub struct JointLock {
+    /// The effect the constraint belongs to.
+    pub effect: Ident,
+    /// `lock = effect` as written, for errors about the constraint.
+    pub at: proc_macro2::TokenStream,
+}
+
+/// The elements a revolute or prismatic joint may carry (`stiffness`,
+/// `rest`, `damping`, `friction`, `friction_smoothing`, `saturation`).
+#[derive(Clone, Debug, Default)]
+pub struct JointElements {
+    /// k of the spring torque (force) −k (q − rest).
+    pub stiffness: Option<Expr>,
+    /// The spring's rest position (0 when absent).
+    pub rest: Option<Expr>,
+    /// c of the viscous torque (force) −c q̇.
+    pub damping: Option<Expr>,
+    /// The Coulomb friction torque (force) magnitude T of −T q̇ / √(q̇² + ε²).
+    pub friction: Option<Expr>,
+    /// ε of the friction's regularisation (default 1e-3, in the rate's units).
+    pub friction_smoothing: Option<Expr>,
+    /// The actuation input is clamped to ±saturation.
+    pub saturation: Option<Expr>,
+}
+
+impl JointElements {
+    /// Whether any element is given.
+    pub fn any(&self) -> bool {
+        self.stiffness.is_some()
+            || self.damping.is_some()
+            || self.friction.is_some()
+            || self.saturation.is_some()
+            || self.rest.is_some()
+            || self.friction_smoothing.is_some()
+    }
 }

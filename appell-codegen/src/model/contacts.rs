@@ -9,8 +9,8 @@ use appell_symbolic::{Graph, Symbol, Tape};
 use super::bodies::Side;
 use super::builder::{hint, Builder};
 use super::{Constraint, SpeedSpec, Vec3};
+use crate::ast::JointKind;
 use crate::ast::*;
-use crate::parse::joints::JointKind;
 use crate::probe::{pseudo_value, Basis};
 
 /// A resolved contact.

@@ -13,7 +13,7 @@
 use std::collections::HashMap;
 
 use crate::ast::{BinOp, Expr, Inertia, ModelAst, RotationAxis};
-use crate::parse::joints::{JointAxis, JointDef, JointKind};
+use crate::ast::{JointAxis, JointDef, JointKind};
 
 /// Constant rotations from a link's axes to a frame fixed in it: each
 /// about the current frame's axis 0, 1 or 2 by the angle.

@@ -8,27 +8,8 @@ use syn::{Ident, Token};
 
 use super::expr::convert;
 use super::items::{expr_ident, key_values};
-use super::joints::{add, times};
 use crate::ast::*;
 use crate::parse::keywords as kw;
-
-/// The elements a revolute or prismatic joint may carry (`stiffness`,
-/// `rest`, `damping`, `friction`, `friction_smoothing`, `saturation`).
-#[derive(Clone, Debug, Default)]
-pub struct JointElements {
-    /// k of the spring torque (force) −k (q − rest).
-    pub stiffness: Option<Expr>,
-    /// The spring's rest position (0 when absent).
-    pub rest: Option<Expr>,
-    /// c of the viscous torque (force) −c q̇.
-    pub damping: Option<Expr>,
-    /// The Coulomb friction torque (force) magnitude T of −T q̇ / √(q̇² + ε²).
-    pub friction: Option<Expr>,
-    /// ε of the friction's regularisation (default 1e-3, in the rate's units).
-    pub friction_smoothing: Option<Expr>,
-    /// The actuation input is clamped to ±saturation.
-    pub saturation: Option<Expr>,
-}
 
 impl JointElements {
     /// Takes `key = value` when it names an element.
@@ -46,16 +27,6 @@ impl JointElements {
         Ok(true)
     }
 
-    /// Whether any element is given.
-    pub fn any(&self) -> bool {
-        self.stiffness.is_some()
-            || self.damping.is_some()
-            || self.friction.is_some()
-            || self.saturation.is_some()
-            || self.rest.is_some()
-            || self.friction_smoothing.is_some()
-    }
-
     /// The joint's generalized torques (forces), each with its effect: the
     /// spring `springs`, the damper `dampers`, the friction `friction`.
     pub(super) fn torques(&self, coordinate: &Ident) -> Vec<(Expr, Ident)> {
@@ -65,14 +36,17 @@ impl JointElements {
         let mut out = Vec::new();
         if let Some(k) = &self.stiffness {
             let stretch = match &self.rest {
-                Some(r) => sub(q.clone(), r.clone()),
+                Some(r) => Expr::difference(q.clone(), r.clone()),
                 None => q.clone(),
             };
-            out.push((neg(times(k.clone(), stretch)), Ident::new("springs", span)));
+            out.push((
+                Expr::negated(Expr::product(k.clone(), stretch)),
+                Ident::new("springs", span),
+            ));
         }
         if let Some(c) = &self.damping {
             out.push((
-                neg(times(c.clone(), rate.clone())),
+                Expr::negated(Expr::product(c.clone(), rate.clone())),
                 Ident::new("dampers", span),
             ));
         }
@@ -82,7 +56,7 @@ impl JointElements {
                 .clone()
                 .unwrap_or(Expr::Float(1e-3, span));
             out.push((
-                neg(times(t.clone(), smoothed_sign(rate, eps))),
+                Expr::negated(Expr::product(t.clone(), smoothed_sign(rate, eps))),
                 Ident::new("friction", span),
             ));
         }
@@ -93,23 +67,13 @@ impl JointElements {
 /// v / √(v² + ε²): Coulomb's sign(v), regularised over |v| ≲ ε.
 fn smoothed_sign(v: Expr, eps: Expr) -> Expr {
     let span = v.span();
-    let sq = |e: Expr| times(e.clone(), e);
+    let sq = |e: Expr| Expr::product(e.clone(), e);
     let root = Expr::Call(
         Ident::new("sqrt", span),
-        vec![add(sq(v.clone()), sq(eps))],
+        vec![Expr::sum(sq(v.clone()), sq(eps))],
         span,
     );
     Expr::Binary(BinOp::Div, Box::new(v), Box::new(root), span)
-}
-
-fn neg(e: Expr) -> Expr {
-    let span = e.span();
-    Expr::Neg(Box::new(e), span)
-}
-
-fn sub(a: Expr, b: Expr) -> Expr {
-    let span = a.span();
-    Expr::Binary(BinOp::Sub, Box::new(a), Box::new(b), span)
 }
 
 fn call(name: &str, args: Vec<Expr>, span: proc_macro2::Span) -> Expr {
@@ -152,15 +116,15 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
             ),
         ));
     }
-    let d = sub(Expr::Name(q.clone()), Expr::Name(p.clone()));
+    let d = Expr::difference(Expr::Name(q.clone()), Expr::Name(p.clone()));
     let direction = call("unit", vec![d.clone()], span);
     let tension = match kind {
         kw::SPRING => match (values.remove("tension"), values.remove("stiffness"), values.remove("length")) {
             (Some((t, _)), None, None) => t,
             (None, Some((k, _)), Some((l0, _))) => {
-                times(k, sub(call("norm", vec![d], span), l0))
+                Expr::product(k, Expr::difference(call("norm", vec![d], span), l0))
             }
-            (None, Some((k, _)), None) => times(k, call("norm", vec![d], span)),
+            (None, Some((k, _)), None) => Expr::product(k, call("norm", vec![d], span)),
             _ => {
                 return Err(syn::Error::new(
                     span,
@@ -172,11 +136,11 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
             let (c, _) = values.remove("damping").ok_or_else(|| {
                 syn::Error::new(span, "a damper needs `damping = c`")
             })?;
-            let rate = sub(
+            let rate = Expr::difference(
                 call("velocity", vec![Expr::Name(q.clone())], span),
                 call("velocity", vec![Expr::Name(p.clone())], span),
             );
-            times(c, call("dot", vec![rate, direction.clone()], span))
+            Expr::product(c, call("dot", vec![rate, direction.clone()], span))
         }
     };
     let effect = effect.unwrap_or_else(|| {
@@ -189,7 +153,7 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
             span,
         )
     });
-    let pull = times(tension, direction);
+    let pull = Expr::product(tension, direction);
     Ok(vec![
         LoadDef {
             target: p,
@@ -198,7 +162,7 @@ pub(super) fn parse_two_point(s: ParseStream, kind: &str) -> syn::Result<Vec<Loa
         },
         LoadDef {
             target: q,
-            vector: neg(pull),
+            vector: Expr::negated(pull),
             effect,
         },
     ])
@@ -271,19 +235,22 @@ pub(super) fn friction_loads(
     let v = match &on_body {
         None => call("velocity", vec![Expr::Name(p.clone())], span),
         Some((frame, center)) => {
-            let arm = sub(Expr::Name(p.clone()), Expr::Name(center.clone()));
+            let arm = Expr::difference(Expr::Name(p.clone()), Expr::Name(center.clone()));
             let spin = call(
                 "cross",
                 vec![call("omega", vec![Expr::Name(frame.clone())], span), arm],
                 span,
             );
-            add(
+            Expr::sum(
                 call("velocity", vec![Expr::Name(center.clone())], span),
                 spin,
             )
         }
     };
-    let v_t = sub(v.clone(), times(call("dot", vec![v, n.clone()], span), n));
+    let v_t = Expr::difference(
+        v.clone(),
+        Expr::product(call("dot", vec![v, n.clone()], span), n),
+    );
     let mut force = None;
     match (values.remove("mu"), values.remove("normal")) {
         (Some(mu), Some(normal)) => {
@@ -291,14 +258,18 @@ pub(super) fn friction_loads(
                 .remove("smoothing")
                 .unwrap_or(Expr::Float(1e-3, span));
             let speed2 = call("dot", vec![v_t.clone(), v_t.clone()], span);
-            let root = call("sqrt", vec![add(speed2, times(eps.clone(), eps))], span);
+            let root = call(
+                "sqrt",
+                vec![Expr::sum(speed2, Expr::product(eps.clone(), eps))],
+                span,
+            );
             let scale = Expr::Binary(
                 BinOp::Div,
-                Box::new(times(mu, normal)),
+                Box::new(Expr::product(mu, normal)),
                 Box::new(root),
                 span,
             );
-            force = Some(neg(times(scale, v_t.clone())));
+            force = Some(Expr::negated(Expr::product(scale, v_t.clone())));
         }
         (None, None) => {}
         _ => {
@@ -309,9 +280,9 @@ pub(super) fn friction_loads(
         }
     }
     if let Some(b) = values.remove("viscous") {
-        let viscous = neg(times(b, v_t));
+        let viscous = Expr::negated(Expr::product(b, v_t));
         force = Some(match force {
-            Some(f) => add(f, viscous),
+            Some(f) => Expr::sum(f, viscous),
             None => viscous,
         });
     }
@@ -328,7 +299,7 @@ pub(super) fn friction_loads(
             None,
         ),
         Some((frame, center)) => {
-            let arm = sub(Expr::Name(p), Expr::Name(center.clone()));
+            let arm = Expr::difference(Expr::Name(p), Expr::Name(center.clone()));
             let moment = call("cross", vec![arm, vector.clone()], span);
             (
                 LoadDef {

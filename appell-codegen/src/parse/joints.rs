@@ -17,84 +17,6 @@ use super::expr::convert;
 use crate::ast::*;
 use crate::parse::keywords as kw;
 
-/// The direction a joint moves along or about, in the joint frame.
-#[derive(Clone, Debug)]
-pub enum JointAxis {
-    /// `x`, `y`, `z` (0, 1, 2), negated with `-z`.
-    Unit(usize, bool),
-    /// `[ax, ay, az]`: components in the joint frame, any length.
-    Components([Expr; 3]),
-}
-
-/// What a joint lets the child do relative to the joint frame.
-#[derive(Clone, Debug)]
-pub enum JointKind {
-    /// Turn about the axis: one coordinate, the joint's name.
-    Revolute(JointAxis),
-    /// Slide along the axis: one coordinate, the joint's name.
-    Prismatic(JointAxis),
-    /// Turn about and slide along the axis: `{name}_angle`, `{name}_slide`.
-    Cylindrical(JointAxis),
-    /// Slide in the plane normal to a unit axis and turn about it:
-    /// `{name}_x`, `{name}_y` (along the next two axes in cyclic order)
-    /// and `{name}_angle`.
-    Planar(usize),
-    /// No motion: the child is fixed in the parent.
-    Weld,
-    /// Any rotation about the joint origin, by a unit quaternion
-    /// `{name}_qw, _qx, _qy, _qz`; its speeds are the child's angular
-    /// velocity relative to the joint frame, in the child's axes,
-    /// `{name}_wx, _wy, _wz` (Method III); the unit norm is a holonomic
-    /// constraint.
-    Spherical,
-    /// A spherical joint whose centre also moves: `{name}_x, _y, _z` along
-    /// the joint frame's axes, their rates speeds too.
-    Free,
-}
-
-/// `joint(...)` as written.
-#[derive(Clone, Debug)]
-pub struct JointDef {
-    /// The joint's name (its coordinate's, for one degree of freedom).
-    pub name: Ident,
-    /// Its kind.
-    pub kind: JointKind,
-    /// The parent frame (`N` or a frame declared above).
-    pub parent: Ident,
-    /// The child frame it declares.
-    pub child: Ident,
-    /// The joint frame's origin before `xyz`: the parent's origin unless
-    /// given.
-    pub at: Option<Ident>,
-    /// Offset of the joint frame in the parent frame.
-    pub xyz: Option<[Expr; 3]>,
-    /// Fixed-axis roll, pitch, yaw of the joint frame in the parent frame.
-    pub rpy: Option<[Expr; 3]>,
-    /// Declares the input `tau_{name}` and applies it (a torque about, or a
-    /// force along, the axis, on the child, and its reaction on the parent).
-    pub actuated: bool,
-    /// The joint's rates are not privileged speeds (a joint a loop closure
-    /// makes dependent, or a locked one).
-    pub dependent: bool,
-    /// `lock = effect`: the joint held still where `effect` acts.
-    pub lock: Option<JointLock>,
-    /// Springs, dampers, friction and the motor's saturation on the joint.
-    pub elements: super::elements::JointElements,
-    /// The whole item, for errors.
-    pub span: Span,
-}
-
-/// `lock = effect` on a one-axis joint: the velocity constraint
-/// `dt(q) == 0` on its coordinate, belonging to `effect`, so only the
-/// scenes that name the effect hold the joint still (a brake, a clutch).
-#[derive(Clone, Debug)]
-pub struct JointLock {
-    /// The effect the constraint belongs to.
-    pub effect: Ident,
-    /// `lock = effect` as written, for errors about the constraint.
-    pub at: proc_macro2::TokenStream,
-}
-
 const KINDS: &str =
     "revolute(axis), prismatic(axis), cylindrical(axis), planar(normal), spherical, free, weld";
 
@@ -404,14 +326,17 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
         ),
         JointKind::Prismatic(axis) => {
             let q = coordinate("", &mut out);
-            (Vec::new(), Some(times(q, unit_vector(axis, &j.child))))
+            (
+                Vec::new(),
+                Some(Expr::product(q, unit_vector(axis, &j.child))),
+            )
         }
         JointKind::Cylindrical(axis) => {
             let angle = coordinate("_angle", &mut out);
             let s = coordinate("_slide", &mut out);
             (
                 vec![turn(axis, &joint_frame, angle)],
-                Some(times(s, unit_vector(axis, &j.child))),
+                Some(Expr::product(s, unit_vector(axis, &j.child))),
             )
         }
         JointKind::Planar(k) => {
@@ -419,7 +344,7 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
             let angle = coordinate("_angle", &mut out);
             let span = j.name.span();
             let along = |i: usize| Expr::Axis(joint_frame.clone(), (k + i) % 3, span);
-            let slide = add(times(x, along(1)), times(y, along(2)));
+            let slide = Expr::sum(Expr::product(x, along(1)), Expr::product(y, along(2)));
             (vec![(RotationAxis::Parent(*k), angle)], Some(slide))
         }
         JointKind::Weld => (Vec::new(), None),
@@ -433,9 +358,9 @@ pub(super) fn lower(j: &JointDef, parent_origin: Option<Ident>) -> syn::Result<L
             let mut slide = None;
             for (k, axis) in ["_x", "_y", "_z"].into_iter().enumerate() {
                 let x = coordinate(axis, &mut out);
-                let term = times(x, Expr::Axis(joint_frame.clone(), k, span));
+                let term = Expr::product(x, Expr::Axis(joint_frame.clone(), k, span));
                 slide = Some(match slide {
-                    Some(s) => add(s, term),
+                    Some(s) => Expr::sum(s, term),
                     None => term,
                 });
             }
@@ -530,14 +455,14 @@ fn ball(j: &JointDef, out: &mut Lowered) -> Box<[Expr; 4]> {
     for (k, w) in ["_wx", "_wy", "_wz"].into_iter().enumerate() {
         let (i, a, b) = (k + 1, (k + 1) % 3 + 1, (k + 2) % 3 + 1);
         let linear = sub(
-            times(name(&e[0]), rate(&e[i])),
-            times(rate(&e[0]), name(&e[i])),
+            Expr::product(name(&e[0]), rate(&e[i])),
+            Expr::product(rate(&e[0]), name(&e[i])),
         );
         let cross = sub(
-            times(name(&e[a]), rate(&e[b])),
-            times(name(&e[b]), rate(&e[a])),
+            Expr::product(name(&e[a]), rate(&e[b])),
+            Expr::product(name(&e[b]), rate(&e[a])),
         );
-        let definition = times(Expr::Int(2, span), sub(linear, cross));
+        let definition = Expr::product(Expr::Int(2, span), sub(linear, cross));
         out.speed_definitions.push(SpeedDef {
             name: named(w),
             definition: Some(definition),
@@ -545,8 +470,8 @@ fn ball(j: &JointDef, out: &mut Lowered) -> Box<[Expr; 4]> {
     }
     let norm = e
         .iter()
-        .map(|x| times(name(x), name(x)))
-        .reduce(add)
+        .map(|x| Expr::product(name(x), name(x)))
+        .reduce(Expr::sum)
         .expect("four");
     out.holonomic.push(ConstraintDef {
         lhs: norm,
@@ -581,7 +506,7 @@ fn along_axis(
     };
     match &j.kind {
         JointKind::Revolute(axis) => {
-            let v = times(magnitude, unit_vector(axis, &j.child));
+            let v = Expr::product(magnitude, unit_vector(axis, &j.child));
             out.torques.push(load(j.child.clone(), v.clone()));
             if on_parent {
                 out.torques
@@ -589,7 +514,7 @@ fn along_axis(
             }
         }
         JointKind::Prismatic(axis) => {
-            let v = times(magnitude, unit_vector(axis, &j.child));
+            let v = Expr::product(magnitude, unit_vector(axis, &j.child));
             out.forces.push(load(child_origin.clone(), v.clone()));
             if on_parent {
                 out.points.push(PointDef {
@@ -651,12 +576,12 @@ pub(super) fn in_frame(frame: &Ident, c: &[Expr; 3]) -> Expr {
         .iter()
         .enumerate()
         .filter(|(_, e)| !is_zero(e))
-        .map(|(k, e)| times(e.clone(), Expr::Axis(frame.clone(), k, span)))
+        .map(|(k, e)| Expr::product(e.clone(), Expr::Axis(frame.clone(), k, span)))
         .collect();
     terms
         .into_iter()
-        .reduce(add)
-        .unwrap_or_else(|| times(Expr::Int(0, span), Expr::Axis(frame.clone(), 0, span)))
+        .reduce(Expr::sum)
+        .unwrap_or_else(|| Expr::product(Expr::Int(0, span), Expr::Axis(frame.clone(), 0, span)))
 }
 
 pub(super) fn is_zero(e: &Expr) -> bool {
@@ -670,17 +595,7 @@ pub(super) fn is_zero(e: &Expr) -> bool {
 
 fn plus(point: Expr, offset: Option<Expr>) -> Expr {
     match offset {
-        Some(v) => add(point, v),
+        Some(v) => Expr::sum(point, v),
         None => point,
     }
-}
-
-pub(super) fn add(a: Expr, b: Expr) -> Expr {
-    let span = a.span();
-    Expr::Binary(BinOp::Add, Box::new(a), Box::new(b), span)
-}
-
-pub(super) fn times(a: Expr, b: Expr) -> Expr {
-    let span = a.span();
-    Expr::Binary(BinOp::Mul, Box::new(a), Box::new(b), span)
 }

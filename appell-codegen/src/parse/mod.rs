@@ -220,7 +220,7 @@ pub(super) fn unknown_parent(ast: &ModelAst, parent: &Ident) -> Option<syn::Erro
 
 /// Adds a joint's frames, points, coordinates, speeds, inputs, loads and
 /// constraints.
-pub(super) fn add_joint(ast: &mut ModelAst, joint: &joints::JointDef) -> syn::Result<()> {
+pub(super) fn add_joint(ast: &mut ModelAst, joint: &JointDef) -> syn::Result<()> {
     let parent_origin = if joint.parent == "N" {
         Some(Ident::new("O", joint.parent.span()))
     } else {

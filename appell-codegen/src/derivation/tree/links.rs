@@ -5,10 +5,10 @@
 use appell_symbolic::{Func, Graph, Id, SymbolicError};
 
 use super::spatial::{Algebra, Transform, M3, M6, V3, V6};
+use crate::ast::JointAxis;
 use crate::ast::{BinOp, Expr, Inertia};
 use crate::model::tree::{Motion, Term, TreeSpec, Turns};
 use crate::model::Model;
-use crate::parse::joints::JointAxis;
 
 type R<T> = Result<T, SymbolicError>;
 

@@ -24,14 +24,16 @@
 //! inertial, a fixed joint's origin) is checked link by link, its numbers
 //! that are expressions by nobody at compile time.
 
+use proc_macro2::Span;
+
 use super::inertia::{self, from_six, merged, part, turned, Mass, Part, Pose};
-use super::lower::{is_body, LinkNumbers};
-use super::options::{Base, Spec};
+use super::numbers::LinkNumbers;
+use super::options::{Base, Promotion, Spec};
 use super::read::Read;
 use super::tree::Tree;
 use crate::ast::Expr;
+use crate::ast::JointKind;
 use crate::ctxt::Ctxt;
-use crate::parse::joints::JointKind;
 
 /// The links that are bodies, and those the model must take as they are.
 pub(super) struct Bodies {
@@ -286,4 +288,52 @@ pub(super) fn bodies(
         }
     }
     out
+}
+
+/// The links' inertials checked when the joints do not make a tree, so
+/// that one build reports what is wrong with both; a number `parameters`
+/// names is promoted as `lower` would promote it.
+pub(super) fn check_links(cx: &Ctxt, read: &Read, spec: &Spec, span: Span) {
+    for l in &read.robot.links {
+        let name = super::tree::model_name(&l.name);
+        let promoted: Vec<String> = spec
+            .parameters
+            .iter()
+            .filter(|p| p.element == name)
+            .map(Promotion::field_text)
+            .collect();
+        if let Err(e) = is_body(&l.inertial, &promoted) {
+            let at = read.lines.describe("link", &l.name);
+            cx.error_at(span, format!("URDF {at}: {e}"));
+        }
+    }
+}
+
+/// Whether an inertial is a body's, its numbers checked where they are the
+/// file's (a parameter is checked by nobody at compile time).
+pub(super) fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, String> {
+    let mass_promoted = promoted.iter().any(|f| f == "mass");
+    let inertia_promoted = promoted.iter().any(|f| f.starts_with('i'));
+    let (mass, i) = (inertial.mass.value, &inertial.inertia);
+    let matrix = [
+        [i.ixx, i.ixy, i.ixz],
+        [i.ixy, i.iyy, i.iyz],
+        [i.ixz, i.iyz, i.izz],
+    ];
+    if mass_promoted || mass > 0.0 {
+        if !inertia_promoted {
+            if mass_promoted {
+                inertia::check_matrix(&matrix)?;
+            } else {
+                inertia::check(mass, i)?;
+            }
+        }
+        return Ok(true);
+    }
+    if let (Some(f), true) = (promoted.first(), mass == 0.0) {
+        return Err(format!(
+            "it has no mass, so it is no body and its `{f}` cannot be a parameter; make its `mass` one too"
+        ));
+    }
+    Ok(inertia::check(mass, i)? == Mass::Body)
 }

@@ -5,87 +5,13 @@
 use proc_macro2::Span;
 use syn::Ident;
 
-use super::inertia::{self, Mass};
+use super::numbers::{floats, slot, JointNumbers, LinkNumbers, JOINT_FIELDS, LINK_FIELDS};
 use super::options::{Base, Promotion, Spec};
 use super::read::Read;
 use super::tree::Tree;
 use crate::ast::*;
 use crate::ctxt::{did_you_mean, suggest, Ctxt};
-use crate::parse::joints::{
-    add, in_frame, is_zero, rpy_rotations, times, JointAxis, JointDef, JointKind,
-};
-
-/// A joint's numbers the model uses: its origin.
-struct JointNumbers {
-    xyz: [Expr; 3],
-    rpy: [Expr; 3],
-}
-
-/// A link's numbers: its inertial. `inertia` is ixx, iyy, izz, ixy, iyz,
-/// ixz.
-pub(super) struct LinkNumbers {
-    pub mass: Expr,
-    pub xyz: [Expr; 3],
-    pub rpy: [Expr; 3],
-    pub inertia: [Expr; 6],
-    /// The fields `parameters(...)` replaced.
-    pub promoted: Vec<String>,
-}
-
-/// The fields `parameters(...)` may name, on a joint and on a link.
-const JOINT_FIELDS: &[&str] = &[
-    "xyz.x",
-    "xyz.y",
-    "xyz.z",
-    "rpy.roll",
-    "rpy.pitch",
-    "rpy.yaw",
-];
-const LINK_FIELDS: &[&str] = &[
-    "mass",
-    "ixx",
-    "iyy",
-    "izz",
-    "ixy",
-    "iyz",
-    "ixz",
-    "xyz.x",
-    "xyz.y",
-    "xyz.z",
-    "rpy.roll",
-    "rpy.pitch",
-    "rpy.yaw",
-];
-
-fn slot<'a>(xyz: &'a mut [Expr; 3], rpy: &'a mut [Expr; 3], field: &str) -> Option<&'a mut Expr> {
-    Some(match field {
-        "xyz.x" => &mut xyz[0],
-        "xyz.y" => &mut xyz[1],
-        "xyz.z" => &mut xyz[2],
-        "rpy.roll" => &mut rpy[0],
-        "rpy.pitch" => &mut rpy[1],
-        "rpy.yaw" => &mut rpy[2],
-        _ => return None,
-    })
-}
-
-impl LinkNumbers {
-    fn slot(&mut self, field: &str) -> Option<&mut Expr> {
-        let inertia = ["ixx", "iyy", "izz", "ixy", "iyz", "ixz"];
-        if field == "mass" {
-            return Some(&mut self.mass);
-        }
-        match inertia.iter().position(|f| *f == field) {
-            Some(k) => Some(&mut self.inertia[k]),
-            None => slot(&mut self.xyz, &mut self.rpy, field),
-        }
-    }
-}
-
-/// Three numbers of the file as float constants.
-fn floats(v: &[f64; 3], span: Span) -> [Expr; 3] {
-    v.map(|x| Expr::Float(x, span))
-}
+use crate::parse::joints::{in_frame, is_zero, rpy_rotations};
 
 /// Writes the robot into `ast`. Errors about elements go to `cx` (all of
 /// them); the result's error is one that stops the lowering.
@@ -327,54 +253,6 @@ fn welds(cx: &Ctxt, robot: &urdf_rs::Robot, tree: &Tree, names: &[Ident]) -> Vec
     welded
 }
 
-/// The links' inertials checked when the joints do not make a tree, so
-/// that one build reports what is wrong with both; a number `parameters`
-/// names is promoted as [`lower`] would promote it.
-pub(super) fn check_links(cx: &Ctxt, read: &Read, spec: &Spec, span: Span) {
-    for l in &read.robot.links {
-        let name = super::tree::model_name(&l.name);
-        let promoted: Vec<String> = spec
-            .parameters
-            .iter()
-            .filter(|p| p.element == name)
-            .map(Promotion::field_text)
-            .collect();
-        if let Err(e) = is_body(&l.inertial, &promoted) {
-            let at = read.lines.describe("link", &l.name);
-            cx.error_at(span, format!("URDF {at}: {e}"));
-        }
-    }
-}
-
-/// Whether an inertial is a body's, its numbers checked where they are the
-/// file's (a parameter is checked by nobody at compile time).
-pub(super) fn is_body(inertial: &urdf_rs::Inertial, promoted: &[String]) -> Result<bool, String> {
-    let mass_promoted = promoted.iter().any(|f| f == "mass");
-    let inertia_promoted = promoted.iter().any(|f| f.starts_with('i'));
-    let (mass, i) = (inertial.mass.value, &inertial.inertia);
-    let matrix = [
-        [i.ixx, i.ixy, i.ixz],
-        [i.ixy, i.iyy, i.iyz],
-        [i.ixz, i.iyz, i.izz],
-    ];
-    if mass_promoted || mass > 0.0 {
-        if !inertia_promoted {
-            if mass_promoted {
-                inertia::check_matrix(&matrix)?;
-            } else {
-                inertia::check(mass, i)?;
-            }
-        }
-        return Ok(true);
-    }
-    if let (Some(f), true) = (promoted.first(), mass == 0.0) {
-        return Err(format!(
-            "it has no mass, so it is no body and its `{f}` cannot be a parameter; make its `mass` one too"
-        ));
-    }
-    Ok(inertia::check(mass, i)? == Mass::Body)
-}
-
 /// Each joint's kind in the model (`None` where it has none, reported).
 fn kinds(cx: &Ctxt, read: &Read, welded: &[bool], span: Span) -> Vec<Option<JointKind>> {
     let mut out = Vec::new();
@@ -521,7 +399,7 @@ fn body(ast: &mut ModelAst, link: &Ident, n: &LinkNumbers, span: Span) {
         let c = named("_center");
         ast.points.push(PointDef {
             name: c.clone(),
-            location: add(Expr::Name(origin), in_frame(link, &n.xyz)),
+            location: Expr::sum(Expr::Name(origin), in_frame(link, &n.xyz)),
         });
         c
     };
@@ -586,14 +464,14 @@ fn mimics(cx: &Ctxt, ast: &mut ModelAst, read: &Read, tree: &Tree, spec: &Spec, 
         let rhs = if still(other) {
             offset
         } else {
-            let scaled = times(
+            let scaled = Expr::product(
                 Expr::Float(mimic.multiplier.unwrap_or(1.0), span),
                 Expr::Name(tree.joints[other].clone()),
             );
             if is_zero(&offset) {
                 scaled
             } else {
-                add(scaled, offset)
+                Expr::sum(scaled, offset)
             }
         };
         ast.holonomic.push(ConstraintDef {

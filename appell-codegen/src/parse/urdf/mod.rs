@@ -59,11 +59,13 @@
 //! | `tree` | model names, the root, the joints from the root |
 //! | `inertia` | the mass and inertia checks, inertias merged |
 //! | `bodies` | which links are bodies, checked as the rigid bodies links fixed together make |
+//! | `numbers` | the file's numbers as expressions, the fields `parameters(...)` may name |
 //! | `lower` | the items |
 
 mod bodies;
 mod inertia;
 mod lower;
+mod numbers;
 mod options;
 mod read;
 mod tree;
@@ -110,7 +112,7 @@ pub(super) fn add(
             for e in errors {
                 cx.error_at(span, e);
             }
-            lower::check_links(cx, &read, &spec, span);
+            bodies::check_links(cx, &read, &spec, span);
             return Ok(());
         }
     };
