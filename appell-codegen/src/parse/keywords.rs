@@ -118,6 +118,8 @@ pub const PRISMATIC: &str = "prismatic";
 pub const REST: &str = "rest";
 /// `revolute`.
 pub const REVOLUTE: &str = "revolute";
+/// `right_angles`.
+pub const RIGHT_ANGLES: &str = "right_angles";
 /// `rpy`.
 pub const RPY: &str = "rpy";
 /// `saturation`.

@@ -5,7 +5,7 @@
 use proc_macro2::Span;
 use syn::Ident;
 
-use super::numbers::{floats, slot, JointNumbers, LinkNumbers, JOINT_FIELDS, LINK_FIELDS};
+use super::numbers::{angles, floats, slot, JointNumbers, LinkNumbers, JOINT_FIELDS, LINK_FIELDS};
 use super::options::{Base, Promotion, Spec};
 use super::read::Read;
 use super::tree::Tree;
@@ -29,7 +29,7 @@ pub(super) fn lower(
         .iter()
         .map(|j| JointNumbers {
             xyz: floats(&j.origin.xyz.0, span),
-            rpy: floats(&j.origin.rpy.0, span),
+            rpy: angles(&j.origin.rpy.0, span, spec.right_angles),
         })
         .collect();
     let mut links: Vec<LinkNumbers> = robot
@@ -40,7 +40,7 @@ pub(super) fn lower(
             LinkNumbers {
                 mass: Expr::Float(l.inertial.mass.value, span),
                 xyz: floats(&o.xyz.0, span),
-                rpy: floats(&o.rpy.0, span),
+                rpy: angles(&o.rpy.0, span, spec.right_angles),
                 inertia: [i.ixx, i.iyy, i.izz, i.ixy, i.iyz, i.ixz].map(|x| Expr::Float(x, span)),
                 promoted: Vec::new(),
             }

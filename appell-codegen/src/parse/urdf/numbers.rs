@@ -80,7 +80,55 @@ impl LinkNumbers {
     }
 }
 
+/// Three angles of the file (an rpy) as float constants; with a
+/// `right_angles` tolerance, one within it of a multiple k of π/2 is k π/2
+/// in floating point, which the symbolic engine turns into an exact turn (a
+/// permutation of axes, sines and cosines 0 and ±1).
+pub(super) fn angles(v: &[f64; 3], span: Span, right_angles: Option<f64>) -> [Expr; 3] {
+    v.map(|x| Expr::Float(right_angle(x, right_angles), span))
+}
+
+/// `x`, or the multiple of π/2 within `tolerance` of it.
+fn right_angle(x: f64, tolerance: Option<f64>) -> f64 {
+    let Some(tolerance) = tolerance else {
+        return x;
+    };
+    let k = (x / std::f64::consts::FRAC_PI_2).round();
+    let nearest = k * std::f64::consts::FRAC_PI_2;
+    if (nearest - x).abs() <= tolerance {
+        nearest
+    } else {
+        x
+    }
+}
+
 /// Three numbers of the file as float constants.
 pub(super) fn floats(v: &[f64; 3], span: Span) -> [Expr; 3] {
     v.map(|x| Expr::Float(x, span))
+}
+
+#[cfg(test)]
+#[allow(clippy::approx_constant)] // π/2 and π as URDF files write them
+mod tests {
+    use super::right_angle;
+    use std::f64::consts::{FRAC_PI_2, PI};
+
+    #[test]
+    fn right_angles_within_the_tolerance_are_exact() {
+        let tol = Some(1e-10);
+        assert_eq!(right_angle(1.57079632679, tol), FRAC_PI_2);
+        assert_eq!(right_angle(-1.57079632679, tol), -FRAC_PI_2);
+        assert_eq!(right_angle(3.14159265359, tol), PI);
+        assert_eq!(right_angle(-3.14159265359, tol), -PI);
+        assert_eq!(right_angle(4.71238898038, tol), 3.0 * FRAC_PI_2);
+        assert_eq!(right_angle(1e-12, tol), 0.0);
+    }
+
+    #[test]
+    fn other_angles_are_kept() {
+        assert_eq!(right_angle(1.5708, Some(1e-10)), 1.5708);
+        assert_eq!(right_angle(0.3, Some(1e-3)), 0.3);
+        assert_eq!(right_angle(1.57079632679, None), 1.57079632679);
+        assert_eq!(right_angle(1.5708, Some(1e-3)), FRAC_PI_2);
+    }
 }

@@ -1,6 +1,7 @@
 //! What `urdf(...)` says beside the path: `weld(...)`, `parameters(...)`,
 //! `parent = A`, `at = P`, `base = free | planar | fixed`,
-//! `unchecked_inertia(link, ...)` and `mimic = true | false`.
+//! `unchecked_inertia(link, ...)`, `mimic = true | false` and
+//! `right_angles = tolerance`.
 
 use syn::parse::ParseStream;
 use syn::punctuated::Punctuated;
@@ -21,6 +22,7 @@ const OPTIONS: &[&str] = &[
     "base",
     "unchecked_inertia",
     "mimic",
+    "right_angles",
 ];
 
 /// The kinds of `base = ...`.
@@ -59,6 +61,9 @@ pub(super) struct Spec {
     /// default) or independent joints (`mimic = false`, Pinocchio's
     /// default).
     pub mimic: bool,
+    /// `right_angles = tolerance`: every rpy angle of the file within
+    /// `tolerance` radians of a multiple of π/2 is read as that multiple.
+    pub right_angles: Option<f64>,
 }
 
 /// `element.field = expression` or `element.field.component = expression`
@@ -97,6 +102,7 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
         base: Base::Fixed,
         unchecked_inertia: Vec::new(),
         mimic: true,
+        right_angles: None,
     };
     while !s.is_empty() {
         s.parse::<Token![,]>()?;
@@ -124,6 +130,10 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     )
                 })?;
                 spec.mimic = value.value;
+            }
+            kw::RIGHT_ANGLES => {
+                s.parse::<Token![=]>()?;
+                spec.right_angles = Some(right_angles(s)?);
             }
             kw::PARAMETERS => {
                 let content;
@@ -166,12 +176,33 @@ pub(super) fn parse_spec(s: ParseStream) -> syn::Result<Spec> {
                     .unwrap_or_default();
                 return Err(syn::Error::new(
                     key.span(),
-                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A`, `at = P`, `base = free | planar | fixed`, `unchecked_inertia(link, ...)` and `mimic = true | false`"),
+                    format!("unknown `urdf` option `{other}`{hint}; the options are `weld(joint, ...)`, `parameters(element.field = name, ...)`, `parent = A`, `at = P`, `base = free | planar | fixed`, `unchecked_inertia(link, ...)`, `mimic = true | false` and `right_angles = 1e-10`"),
                 ));
             }
         }
     }
     Ok(spec)
+}
+
+/// The largest tolerance `right_angles` takes: a file's right angles are
+/// written to 5 digits or more, 3.7e-6 rad off at 5.
+const MAX_RIGHT_ANGLE_TOLERANCE: f64 = 1e-3;
+
+/// The tolerance of `right_angles = 1e-10`: a positive number, at most
+/// [`MAX_RIGHT_ANGLE_TOLERANCE`].
+fn right_angles(s: ParseStream) -> syn::Result<f64> {
+    let form = "`right_angles = 1e-10` reads every rpy angle of the file within 1e-10 rad of a multiple of π/2 as that multiple (files write π/2 as 1.57079632679 or 1.5708); the tolerance is a positive number of radians, at most 1e-3";
+    let value: syn::Lit = s.parse().map_err(|e| syn::Error::new(e.span(), form))?;
+    let x = match &value {
+        syn::Lit::Float(f) => f.base10_parse::<f64>()?,
+        syn::Lit::Int(i) => i.base10_parse::<f64>()?,
+        other => return Err(syn::Error::new(other.span(), form)),
+    };
+    if x > 0.0 && x <= MAX_RIGHT_ANGLE_TOLERANCE {
+        Ok(x)
+    } else {
+        Err(syn::Error::new(value.span(), form))
+    }
 }
 
 /// `wrist_3_link.mass = payload`.
