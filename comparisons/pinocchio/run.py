@@ -89,9 +89,12 @@ FREE_MODELS = [
     ("anymal_b", os.path.join(TEST_ROBOTS, "anymal_b_simple", "anymal.urdf"), [], True),
     ("go1", os.path.join(TEST_ROBOTS, "go1", "go1.urdf"), [], True),
     ("hyq", os.path.join(TEST_ROBOTS, "hyq", "hyq_no_sensors.urdf"), [], True),
+    # The same file, appell reading its right angles as exact
+    # (`right_angles = 1e-10`); Pinocchio reads it as written.
+    ("hyq_right_angles", os.path.join(TEST_ROBOTS, "hyq", "hyq_no_sensors.urdf"), [], True),
     ("g1", os.path.join(TEST_ROBOTS, "g1", "g1_29dof_rev_1_0.urdf"), [], True),
 ]
-FREE_REFERENCE = {"solo12": "solo12", "anymal_b": "anymal", "go1": "go1", "hyq": "hyq", "g1": "g1"}
+FREE_REFERENCE = {"solo12": "solo12", "anymal_b": "anymal", "go1": "go1", "hyq": "hyq", "hyq_right_angles": "hyq", "g1": "g1"}
 FREE = {name for name, _, _, _ in FREE_MODELS}
 
 # Chains without a URDF in examples/robots, written into build/urdf by

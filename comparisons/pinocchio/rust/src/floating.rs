@@ -39,6 +39,20 @@ pub struct Go1;
 )]
 pub struct Hyq;
 
+/// HyQ with its right angles read as exact (`right_angles = 1e-10`; the
+/// file writes π/2 as 1.57079632679): the same robot to 4.9e-12, with
+/// frames turned by permutations.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(
+    urdf(
+        "../../../tests/robots/hyq/hyq_no_sensors.urdf",
+        base = free,
+        right_angles = 1e-10
+    ),
+    gravity(-9.81 * N.z)
+)]
+pub struct HyqRightAngles;
+
 /// Unitree G1, the 29-joint humanoid (`g1_29dof_rev_1_0`): 35 speeds.
 #[derive(Appell, Clone, Debug, Default)]
 #[appell(

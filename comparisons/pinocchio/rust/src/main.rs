@@ -10,7 +10,7 @@
 //!
 //! MODEL is `ur5`, `panda`, `spatial_chain_2`, `_4`, `_8`, `_16`, `_32` (and
 //! `_64` with `--features large-models`), or a floating-base robot:
-//! `solo12`, `anymal_b`, `go1`, `hyq`, `g1` (`floating.rs`). `--joints` gives the
+//! `solo12`, `anymal_b`, `go1`, `hyq`, `hyq_right_angles`, `g1` (`floating.rs`). `--joints` gives the
 //! joint order in which the random numbers are drawn (Pinocchio's, which
 //! `run.py` passes on); without it the model's speed order is used.
 //!
@@ -90,6 +90,7 @@ const MODELS: &[&str] = &[
     "anymal_b",
     "go1",
     "hyq",
+    "hyq_right_angles",
     "g1",
 ];
 
@@ -911,6 +912,7 @@ fn main() -> ExitCode {
         "anymal_b" => bench(&floating::AnymalB, &opts),
         "go1" => bench(&floating::Go1, &opts),
         "hyq" => bench(&floating::Hyq, &opts),
+        "hyq_right_angles" => bench(&floating::HyqRightAngles, &opts),
         "g1" => bench(&floating::G1, &opts),
         other => Err(format!(
             "unknown model {other}; this build has {}",
