@@ -1,5 +1,8 @@
-//! How a model call fails: [`ModelError`](crate::ModelError), and the contact events a
+//! How a model call fails: [`ModelError`], and the contact events a
 //! simulation reports through it.
+
+#[cfg(doc)]
+use crate::{Model, ModelInfo};
 
 /// The rule a body's mass or inertia breaks.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,7 +62,7 @@ pub enum ContactViolation {
 }
 
 /// A contact lost at time `t`: the contact (its index in
-/// [`ModelInfo::contacts`](crate::ModelInfo::contacts), its body's and its point's names) and how.
+/// [`ModelInfo::contacts`], its body's and its point's names) and how.
 ///
 /// ```
 /// use appell_core::{ContactEvent, ContactViolation};
@@ -81,7 +84,7 @@ pub struct ContactEvent {
     /// When: where an integrator's event location put it, or the end of
     /// the accepted step or the frame where it was seen.
     pub t: f64,
-    /// Index in [`ModelInfo::contacts`](crate::ModelInfo::contacts).
+    /// Index in [`ModelInfo::contacts`].
     pub contact: usize,
     /// The rolling body's name.
     pub body: &'static str,
@@ -153,7 +156,7 @@ pub enum ModelError {
         index: usize,
     },
     /// A privileged speed that is not a coordinate's rate, in a model that
-    /// does not define it (see [`Model::speed_definitions`](crate::Model::speed_definitions)).
+    /// does not define it (see [`Model::speed_definitions`]).
     UnknownSpeed {
         /// The speed's name.
         name: &'static str,
@@ -178,7 +181,7 @@ pub enum ModelError {
         what: &'static str,
     },
     /// A body's mass or inertia, made of parameters, is one no body can
-    /// have (see [`Model::validate`](crate::Model::validate) and [`physical`](crate::physical)).
+    /// have (see [`Model::validate`] and [`physical`](crate::physical)).
     ImpossibleBody {
         /// The body's name.
         body: &'static str,
@@ -188,7 +191,7 @@ pub enum ModelError {
         parameters: &'static [&'static str],
     },
     /// A divisor made of parameters (`1 / k`) is zero (see
-    /// [`Model::validate`](crate::Model::validate)).
+    /// [`Model::validate`]).
     ZeroDivisor {
         /// Where the division is written (`point `P``, `body `rod``).
         place: &'static str,

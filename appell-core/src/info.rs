@@ -1,5 +1,8 @@
-//! What a generated model says about itself: [`ModelInfo`](crate::ModelInfo) (names, state
+//! What a generated model says about itself: [`ModelInfo`] (names, state
 //! layout, scenes, operation counts) and the descriptions it is made of.
+
+#[cfg(doc)]
+use crate::Model;
 
 /// Operation counts of a generated function.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -16,7 +19,7 @@ pub struct OpCounts {
     pub total: usize,
 }
 
-/// How a model's generated Jacobian ([`Model::rhs_jacobian`](crate::Model::rhs_jacobian)) is computed.
+/// How a model's generated Jacobian ([`Model::rhs_jacobian`]) is computed.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct JacobianInfo {
     /// What is differentiated: `closed form: ...` (∂M and ∂f, and
@@ -72,9 +75,9 @@ pub enum RowSource {
         index: usize,
     },
     /// The velocity component e·v of the body's material point at a rolling
-    /// contact along one direction e ([`Model::contact_geometry`](crate::Model::contact_geometry) gives e).
+    /// contact along one direction e ([`Model::contact_geometry`] gives e).
     Rolling {
-        /// Index into [`ModelInfo::contacts`](crate::ModelInfo::contacts).
+        /// Index into [`ModelInfo::contacts`].
         contact: usize,
         /// 0, 1, 2 for N.x, N.y, N.z (a contact without `along`), or the
         /// index into the contact's `along = [...]` list.
@@ -82,7 +85,7 @@ pub enum RowSource {
     },
     /// A row of a `contact(link, point | flat)` that a scene holds.
     Contact {
-        /// Index into [`Model::contact_links`](crate::Model::contact_links) (declaration order).
+        /// Index into [`Model::contact_links`] (declaration order).
         contact: usize,
         /// 0, 1, 2: the link origin's velocity along N.x, N.y, N.z (its
         /// multiplier is the ground's force on the link along that axis);
@@ -112,7 +115,7 @@ pub struct JointLimit {
 /// A `rolls(...)` contact of the model.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ContactInfo {
-    /// Index of the rolling body in [`ModelInfo::bodies`](crate::ModelInfo::bodies).
+    /// Index of the rolling body in [`ModelInfo::bodies`].
     pub body: usize,
     /// The name of the contact point.
     pub point: &'static str,
@@ -134,7 +137,7 @@ pub struct ModelInfo {
     /// The privileged speeds ẏ_k, in order: a coordinate's name when the
     /// speed is that coordinate's rate (Method II), else the name of a
     /// quasi-velocity (Method III, defined by
-    /// [`Model::speed_definitions`](crate::Model::speed_definitions)).
+    /// [`Model::speed_definitions`]).
     pub speeds: &'static [&'static str],
     /// Coordinates whose rates are dependent (solved from the constraints).
     pub dependent: &'static [&'static str],
@@ -182,7 +185,7 @@ pub struct ModelInfo {
     /// Operations per call of the generated reduced rhs.
     pub rhs_ops: OpCounts,
     /// The generated Jacobian of the reduced rhs
-    /// ([`Model::rhs_jacobian`](crate::Model::rhs_jacobian)): how it is computed and what it costs;
+    /// ([`Model::rhs_jacobian`]): how it is computed and what it costs;
     /// `None` where the model has none (`jacobian(off)`, or written by
     /// hand: tools then run the rhs in dual numbers, one evaluation per
     /// column).
