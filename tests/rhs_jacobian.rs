@@ -1,8 +1,8 @@
 //! The generated `rhs_jacobian` (∂rhs/∂state and ∂rhs/∂inputs in one
 //! call) against dual numbers through the generated rhs and against central
-//! differences, at random states: trees (the double pendulum, UR5, and
-//! Panda with `jacobian(on)`: the closed form's and the structured form's
-//! derivatives), rolling contacts (the wheel-axle and two of its scenes)
+//! differences, at random states: trees (the double pendulum and UR5: the
+//! closed form's derivatives; Panda, an 8-link chain and a leg on a free
+//! base with `jacobian(on)`: inverse dynamics differentiated), rolling contacts (the wheel-axle and two of its scenes)
 //! and numeric eliminations of the dependent speeds (the four-bar, the
 //! Chaplygin sleigh, the Whipple bicycle); and the rhs in dual numbers
 //! where the derive writes no symbolic derivatives (the mobile manipulator,
@@ -51,6 +51,24 @@ struct Panda;
     inertia = matrix(0.02 + 0.001 * k, 0.03 + 0.001 * k, 0.01 + 0.001 * k, 0.001, 0.0015, -0.002))))]
 #[appell(gravity(-9.81 * N.z))]
 struct SpatialChain8;
+
+/// The 8-link chain with its Jacobian written.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(joint(j[1], revolute(z), parent = N, child = link[1], actuated))]
+#[appell(repeat(k in 2..=8,
+    repeat(even in 0..1 - k % 2, joint(j[k], revolute(y), parent = link[k - 1], child = link[k], xyz = [0, 0, 0.5], actuated)),
+    repeat(odd in 0..k % 2, joint(j[k], revolute(z), parent = link[k - 1], child = link[k], xyz = [0, 0, 0.5], actuated))))]
+#[appell(repeat(k in 1..=8, body(link[k], frame = link[k], mass = 1 + 0.1 * k,
+    center = origin(link[k]) + 0.05 * link[k].x + 0.02 * link[k].y + 0.25 * link[k].z,
+    inertia = matrix(0.02 + 0.001 * k, 0.03 + 0.001 * k, 0.01 + 0.001 * k, 0.001, 0.0015, -0.002))))]
+#[appell(gravity(-9.81 * N.z), jacobian(on))]
+struct SpatialChain8Derived;
+
+/// A body on one leg of three joints on a free base (a unit quaternion
+/// among the coordinates), its Jacobian written.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(urdf("tests/data/one_leg.urdf", base = free), gravity(-9.81 * N.z), jacobian(on))]
+struct OneLeg;
 
 /// A planar base carrying an arm: a tree small enough for the symbolic
 /// inverse dynamics derivatives, whose rows mix a three-coordinate joint
@@ -201,11 +219,12 @@ fn trees_agree_with_dual_numbers_and_differences() {
     assert_agrees(&double_pendulum::DoublePendulum::default(), 1);
     assert_agrees(&ur5::Ur5, 2);
     assert_agrees(&Panda, 4);
-    assert!(Panda::info()
-        .jacobian
-        .unwrap()
-        .form
-        .starts_with("structured"));
+    assert_agrees(&SpatialChain8Derived, 5);
+    assert_agrees(&OneLeg, 9);
+    for info in [Panda::info(), SpatialChain8Derived::info(), OneLeg::info()] {
+        let j = info.jacobian.unwrap();
+        assert!(j.form.starts_with("inverse dynamics"), "{}", j.form);
+    }
     assert!(ur5::Ur5::info()
         .jacobian
         .unwrap()

@@ -331,6 +331,10 @@ pub struct Graph {
     pub(crate) limits: Limits,
     pub(crate) stats: Stats,
     pub(crate) diff_memo: FxHashMap<(Id, Symbol), Id>,
+    /// [`Graph::diff_held`]'s memo.
+    pub(crate) held_diff_memo: FxHashMap<(Id, Symbol), Id>,
+    /// Whether the derivative being taken holds held factors' derivatives.
+    pub(crate) hold_derivatives: bool,
     pub(crate) derivative_symbol: FxHashMap<Symbol, Symbol>,
 }
 
@@ -357,6 +361,8 @@ impl Graph {
             limits,
             stats: Stats::default(),
             diff_memo: FxHashMap::default(),
+            held_diff_memo: FxHashMap::default(),
+            hold_derivatives: false,
             derivative_symbol: FxHashMap::default(),
         }
     }

@@ -15,6 +15,13 @@
 //! - **structured**: ∂ÿ/∂x and ∂ÿ/∂w of the unrolled articulated-body
 //!   algorithm's accelerations (a plain tree of joints), whose
 //!   constants are folded where they are built.
+//! - **inverse dynamics** (a plain tree; the shape of Carpentier and
+//!   Mansard's analytical derivatives): the residual R = M ÿ + h − τ of
+//!   recursive Newton–Euler differentiated with ÿ held, then evaluated at
+//!   the articulated-body algorithm's ÿ; at run time
+//!   ∂ÿ/∂x_j = −M⁻¹ ∂R/∂x_j with M by the composite-rigid-body algorithm,
+//!   factored once. No ∂M appears: the recursion's held accelerations
+//!   carry it.
 //!
 //! Each derivative is [`Graph::diff`](appell_symbolic::Graph::diff), which
 //! visits only the subexpressions that depend on the symbol: a joint's
@@ -104,6 +111,22 @@ pub struct NumericPartials {
     pub values_w: Vec<Id>,
 }
 
+/// The inverse-dynamics candidate's values and derivatives, one entry per
+/// column of [`Columns`] in each row.
+#[derive(Clone, Debug)]
+pub struct RecursiveJacobian {
+    /// M by the composite-rigid-body algorithm: its lower triangle (row i,
+    /// j ≤ i) in row order.
+    pub mass: Vec<Id>,
+    /// ÿ by the articulated-body algorithm.
+    pub accelerations: Vec<Id>,
+    /// −∂R/∂c = ∂τ/∂c − ∂(M ÿ + h)/∂c at those ÿ, l rows, row-major over
+    /// the columns.
+    pub forcing: Vec<Id>,
+    /// ∂q̇_r/∂c for each retained coordinate r, row-major over the columns.
+    pub rates: Vec<Id>,
+}
+
 /// The derivatives of the reduced rhs (stage 14), and why a candidate is
 /// missing.
 #[derive(Clone, Debug)]
@@ -115,6 +138,8 @@ pub struct Jacobians {
     /// The structured form's candidate (rows: the retained coordinates'
     /// rates, then ÿ; row-major over the columns), or why there is none.
     pub structured: Result<Vec<Id>, String>,
+    /// The inverse-dynamics candidate, or why there is none.
+    pub recursive: Result<RecursiveJacobian, String>,
     /// For a tree's recursive Newton–Euler inverse dynamics Q(q, u, ÿ):
     /// ∂Q/∂q (l rows, one column per coordinate) then ∂Q/∂u (l × l), each
     /// row-major; or why there is none (set by [`inverse_dynamics`]).
@@ -128,6 +153,7 @@ impl Jacobians {
             columns,
             closed: Err(reason.to_string()),
             structured: Err(reason.to_string()),
+            recursive: Err(reason.to_string()),
             inverse: Err(reason.to_string()),
         }
     }
@@ -171,12 +197,75 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
         }
         Err(_) => Err("no structured form".to_string()),
     };
+    let recursive = match &d.structured {
+        Ok(s) => recursive(model, d, &s.accelerations, &columns, forced),
+        Err(_) => Err("no structured form".to_string()),
+    };
     Jacobians {
         columns,
         closed,
         structured,
+        recursive,
         inverse: Err("not asked for".to_string()),
     }
+}
+
+/// The inverse-dynamics candidate: the residual's derivatives with ÿ held
+/// ([`Graph::diff_held`]), then ÿ put in as the articulated-body
+/// algorithm's `accelerations` (held, so that no product multiplies them
+/// out).
+fn recursive(
+    model: &mut Model,
+    d: &Derivation,
+    accelerations: &[Id],
+    columns: &Columns,
+    forced: bool,
+) -> Result<RecursiveJacobian, String> {
+    let spec = model.tree.clone()?;
+    let residual = super::tree::residual(model, &spec, &d.reduction.ignorable)
+        .map_err(|e| format!("the residual failed: {e}"))?;
+    let accels: Vec<Symbol> = model.speed_specs.iter().map(|s| s.accel).collect();
+    let rates: Vec<Id> = d
+        .reduction
+        .retained
+        .iter()
+        .map(|&r| d.map.qdot[r])
+        .collect();
+    let l = d.l;
+    let mass: Vec<Id> = (0..l)
+        .flat_map(|i| (0..=i).map(move |j| (i, j)))
+        .map(|(i, j)| residual.mass[i * l + j])
+        .collect();
+    let g = &mut model.g;
+    let mut values = residual.inverse.clone();
+    values.extend(&mass);
+    let allowed = budget(g, &values, forced);
+    within_budget(g, allowed, |g| {
+        let forcing: Vec<Id> = residual
+            .inputs
+            .iter()
+            .zip(&residual.inverse)
+            .map(|(&tau, &id)| g.sub(tau, id))
+            .collect::<Result<_, _>>()?;
+        // Held derivatives: the recursion's velocities, accelerations and
+        // forces stay single factors in their derivatives too.
+        let mut partials = Vec::with_capacity(forcing.len() * columns.len());
+        for &root in &forcing {
+            for c in columns.all() {
+                partials.push(g.diff_held(root, c)?);
+            }
+        }
+        let mut at = appell_symbolic::Substitution::new();
+        for (&s, &a) in accels.iter().zip(accelerations) {
+            at.insert(s, g.hold(a)?);
+        }
+        Ok(RecursiveJacobian {
+            mass,
+            accelerations: accelerations.to_vec(),
+            forcing: at.apply_all(g, &partials)?,
+            rates: derivatives(g, &rates, columns)?,
+        })
+    })
 }
 
 /// The derivatives of a tree's inverse dynamics Q(q, u, ÿ) by every
@@ -406,6 +495,48 @@ mod tests {
         assert!((value(closed.rates[2]) - 1.0).abs() < 1e-15);
         assert!(g.is_zero(closed.rates[1]));
         assert!(closed.numeric.is_none());
+    }
+
+    /// Two links on revolute joints, each driven.
+    const ARM: &str = r#"
+        #[appell(joint(j_1, revolute(z), parent = N, child = l_1, actuated))]
+        #[appell(joint(j_2, revolute(y), parent = l_1, child = l_2, xyz = [0, 0, 0.5], actuated))]
+        #[appell(body(b_1, frame = l_1, mass = 1.2, center = origin(l_1) + 0.2 * l_1.z,
+                      inertia = principal(0.02, 0.03, 0.01)))]
+        #[appell(body(b_2, frame = l_2, mass = 0.8, center = origin(l_2) + 0.1 * l_2.x + 0.2 * l_2.z,
+                      inertia = principal(0.01, 0.01, 0.02)))]
+        #[appell(gravity(-9.81 * N.z))]
+        struct Arm;
+    "#;
+
+    #[test]
+    fn a_tree_gets_the_inverse_dynamics_candidate() {
+        let mut derived = derive_source(ARM);
+        let j = differentiate(&mut derived.model, &derived.full);
+        let r = j.recursive.expect("a plain tree's candidate");
+        // j_1 is ignorable: the state is (j_2, j_1', j_2'), two inputs.
+        let n = j.columns.len();
+        assert_eq!((j.columns.state.len(), n), (3, 5));
+        assert_eq!((r.mass.len(), r.accelerations.len()), (3, 2));
+        let g = &derived.model.g;
+        let at = [("j_2", 0.4), ("j_1_dot", 0.3), ("j_2_dot", -0.7)];
+        let value = |e| g.eval_named(e, &at).unwrap();
+        // −∂R/∂τ_k = ∂τ/∂τ_k: one on row k.
+        for (k, col) in [(0, 3), (1, 4)] {
+            for row in 0..2 {
+                let expected = if row == k { 1.0 } else { 0.0 };
+                assert_eq!(value(r.forcing[row * n + col]), expected, "row {row}");
+            }
+        }
+        // ∂q̇_2/∂j_2' = 1: the retained coordinate's rate is its speed.
+        assert_eq!(value(r.rates[2]), 1.0);
+        // The derivatives read ÿ as the articulated-body algorithm's, not
+        // as symbols.
+        let accels: Vec<Symbol> = derived.model.speed_specs.iter().map(|s| s.accel).collect();
+        for &e in &r.forcing {
+            let deps = g.dependencies(e);
+            assert!(accels.iter().all(|&s| !deps.contains(s)));
+        }
     }
 
     #[test]

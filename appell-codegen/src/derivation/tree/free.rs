@@ -104,6 +104,30 @@ pub fn forces_out(a: &mut Algebra, links: &[Link], forces: &[Id]) -> R<Vec<Id>> 
     Ok(out)
 }
 
+/// `links` with each free joint's rotation R replaced by R⁻ᵀ = R / c,
+/// c = |R e₁|²: a quaternion's rotation is a homogeneous quadratic form
+/// with RᵀR = |e|⁴ I, so R⁻¹ = Rᵀ / c off the unit sphere too. Through
+/// [`accelerations_in`] it inverts [`accelerations_out`] exactly; through
+/// [`forces_out`] and [`mass_out`] it writes the generalized forces and M
+/// those accelerations imply.
+pub fn exact_inverses(a: &mut Algebra, links: &[Link]) -> R<Vec<Link>> {
+    let mut out = links.to_vec();
+    for link in &mut out {
+        let Some(turn) = link.free else { continue };
+        let column = [turn[0][0], turn[1][0], turn[2][0]];
+        let c = a.dot((0..3).map(|k| (column[k], column[k])))?;
+        let over = a.g.recip(c)?;
+        let mut scaled = turn;
+        for row in &mut scaled {
+            for entry in row.iter_mut() {
+                *entry = a.g.mul(*entry, over)?;
+            }
+        }
+        link.free = Some(scaled);
+    }
+    Ok(out)
+}
+
 /// The model's M (size × size, row-major) from the recursions': R on the
 /// slides' rows and columns.
 pub fn mass_out(a: &mut Algebra, links: &[Link], mass: &[Id], size: usize) -> R<Vec<Id>> {

@@ -25,6 +25,8 @@ pub mod spatial;
 
 use appell_symbolic::{Id, SymbolicError};
 
+type R<T> = Result<T, SymbolicError>;
+
 use crate::model::tree::TreeSpec;
 use crate::model::Model;
 use spatial::Algebra;
@@ -129,6 +131,50 @@ pub fn controller(model: &mut Model, spec: &TreeSpec) -> Result<Structured, Symb
         gravity: free::forces_out(&mut a, &tree, &gravity_term)?,
         inputs,
         kinetic,
+    })
+}
+
+/// A tree's equations as a residual, for the derivatives of ÿ by inverse
+/// dynamics (Carpentier and Mansard's shape): with R(q, ẏ, ÿ) = M ÿ + h,
+/// M ÿ = τ gives ∂ÿ/∂x = M⁻¹ (∂τ/∂x − ∂R/∂x) at the accelerations of the
+/// articulated-body algorithm.
+pub struct Residual {
+    /// M, l×l row-major, by the composite-rigid-body algorithm.
+    pub mass: Vec<Id>,
+    /// M ÿ + h by recursive Newton–Euler, in the acceleration symbols.
+    pub inverse: Vec<Id>,
+    /// The joints' inputs as generalized forces τ, in speed order.
+    pub inputs: Vec<Id>,
+}
+
+/// The [`Residual`] of `model`'s tree, the coordinates `fixed` (indices)
+/// at zero as in [`structured`]'s accelerations. A free joint's
+/// accelerations come in by the exact inverse of the way
+/// [`structured`]'s go out (see [`free::exact_inverses`]), so that the
+/// residual vanishes at the articulated-body ÿ at every state, a
+/// quaternion off the unit sphere included, and its derivatives are the
+/// rhs's.
+pub fn residual(model: &mut Model, spec: &TreeSpec, fixed: &[usize]) -> R<Residual> {
+    let parts = links::Parts::new(model)?;
+    let tree = links::links(&mut model.g, spec, &parts, fixed, links::Index::Speeds)?;
+    let gravity = links::gravity(&mut model.g, spec)?;
+    let size = parts.speeds.len();
+    let (body, body_accels, exact) = {
+        let mut a = Algebra::new(&mut model.g)?;
+        let body = free::speeds_in(&mut a, &tree, &parts.speeds)?;
+        let exact = free::exact_inverses(&mut a, &tree)?;
+        let accels = free::accelerations_in(&mut a, &exact, &body, &parts.accels)?;
+        (body, accels, exact)
+    };
+    let mut r = recursions::Recursions::new(&mut model.g, &tree, gravity, size)?;
+    let inverse = r.newton_euler(&body, Some(&body_accels), true)?;
+    let mass = r.composite_rigid_body()?;
+    let inputs = r.inputs();
+    let mut a = Algebra::new(&mut model.g)?;
+    Ok(Residual {
+        mass: free::mass_out(&mut a, &exact, &mass, size)?,
+        inverse: free::forces_out(&mut a, &exact, &inverse)?,
+        inputs,
     })
 }
 

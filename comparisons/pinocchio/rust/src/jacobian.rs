@@ -9,8 +9,7 @@
 use appell::Appell;
 
 /// The Panda as `examples/models/panda.rs` has it (fingers welded), with
-/// its Jacobian written (the structured form: the unrolled ABA
-/// differentiated).
+/// its Jacobian written.
 #[derive(Appell, Clone, Debug, Default)]
 #[appell(urdf(
     "examples/robots/panda/panda.urdf",
@@ -31,3 +30,15 @@ pub struct PandaJacobian;
     inertia = matrix(0.02 + 0.001 * k, 0.03 + 0.001 * k, 0.01 + 0.001 * k, 0.001, 0.0015, -0.002))))]
 #[appell(gravity(-9.81 * N.z), jacobian(on))]
 pub struct SpatialChain8Jacobian;
+
+/// Solo12 on a free base as `floating.rs` has it, with its Jacobian
+/// written. Its A and B differentiate by the quaternion's four components
+/// and the base's rates in the joint frame, not along Pinocchio's tangent:
+/// timed, but their checksum is not compared with Pinocchio's.
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(
+    urdf("../../../tests/robots/solo/solo12.urdf", base = free),
+    gravity(-9.81 * N.z),
+    jacobian(on)
+)]
+pub struct Solo12Jacobian;

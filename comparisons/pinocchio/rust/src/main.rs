@@ -908,7 +908,7 @@ fn main() -> ExitCode {
         "spatial_chain_32" => bench(&spatial_chain::SpatialChain32, &opts),
         #[cfg(feature = "large-models")]
         "spatial_chain_64" => bench(&spatial_chain::SpatialChain64, &opts),
-        "solo12" => bench(&floating::Solo12, &opts),
+        "solo12" => with_twin(&floating::Solo12, &jacobian::Solo12Jacobian, &opts),
         "anymal_b" => bench(&floating::AnymalB, &opts),
         "go1" => bench(&floating::Go1, &opts),
         "hyq" => bench(&floating::Hyq, &opts),
