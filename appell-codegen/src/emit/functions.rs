@@ -66,6 +66,18 @@ pub(super) struct Common {
     solve_x: TokenStream,
 }
 
+/// The programs of the equations' functions, lowered: each one's
+/// statements with its stores, or (the energies) its statements and value.
+struct EquationPrograms {
+    speed_transform: TokenStream,
+    coordinate_rates: TokenStream,
+    residuals: TokenStream,
+    speed_definitions: TokenStream,
+    input_power: (TokenStream, TokenStream),
+    potential: (TokenStream, TokenStream),
+    kinetic: (TokenStream, TokenStream),
+}
+
 impl Emitter<'_> {
     /// The `ModelInfo` static and the `Model` implementation.
     pub(super) fn implementation(&self) -> TokenStream {
@@ -153,21 +165,74 @@ impl Emitter<'_> {
     fn equations_functions(&self, c: &Common) -> TokenStream {
         let p = p();
         let d = self.d;
-        let (n, m, l) = (d.n, d.m, d.l);
+        let lowered = self.lowered_equations();
+        let (n, l) = (d.n, d.l);
         let Common {
             params_t,
             positivity: pos,
             bind_q,
-            bind_qdot,
             bind_u,
-            bind_inputs,
             solve_x,
             ..
         } = c;
-        let ni = self.inputs().len();
-        let nh = d.constraints.holonomic.len();
         let chk = |arg: &str, len: usize| self.check(arg, len);
-        let (chk_q, chk_u, chk_inputs) = (chk("__q", n), chk("__u", l), chk("__inputs", ni));
+        let (chk_q, chk_u) = (chk("__q", n), chk("__u", l));
+        let ke_fn = match (&d.structured, d.closed_form) {
+            (Ok(_), false) => self.kinetic_through_mass(),
+            _ => {
+                let (ke_body, ke_out) = &lowered.kinetic;
+                braced([
+                    quote!(#chk_q #chk_u #pos #params_t #bind_q #bind_u #solve_x #ke_body),
+                    quote!(#p::Ok(#ke_out)),
+                ])
+            }
+        };
+        let mf_fn = self.mass_and_forcing_fn(c);
+        let mf_item = quote! {
+            fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
+        };
+        let sd_ip_pe = self.speeds_power_potential(c, &lowered);
+        if !self.model.input_rates.is_empty() {
+            return self.driven_equations_functions(c, &lowered, mf_item, sd_ip_pe);
+        }
+        let checks_ct = [chk("__c", n * l), chk("__c0", n)];
+        let chk_qdot = chk("__qdot", n);
+        let checks_res = [
+            chk("__holonomic", d.constraints.holonomic.len()),
+            chk("__velocity", d.m),
+        ];
+        let bind_qdot = &c.bind_qdot;
+        let EquationPrograms {
+            speed_transform: ct,
+            coordinate_rates: cr,
+            residuals: res,
+            ..
+        } = &lowered;
+        quote! {
+            #mf_item
+            fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #(#checks_ct)* #pos #params_t #bind_q #solve_x #ct
+                #p::Ok(())
+            }
+            fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #solve_x #cr
+                #p::Ok(())
+            }
+            fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_qdot #(#checks_res)* #params_t #bind_q #bind_qdot #res
+                #p::Ok(())
+            }
+            #sd_ip_pe
+            fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #ke_fn
+        }
+    }
+
+    /// The programs of `equations_functions`, lowered: each function's
+    /// statements with its stores after them.
+    fn lowered_equations(&self) -> EquationPrograms {
+        let d = self.d;
+        let (n, m, l) = (d.n, d.m, d.l);
+        let nh = d.constraints.holonomic.len();
         let generic = Target::Generic { hoist: false };
         let mut ct_roots = d.map.c.clone();
         ct_roots.extend(&d.map.c0);
@@ -199,31 +264,44 @@ impl Emitter<'_> {
             let mut c = code(&self.model.g, &[e], generic);
             (c.take_statements(), c.outputs[0].clone())
         };
-        let (ip_body, ip_out) = single(d.energies.input_power);
-        let (pe_body, pe_out) = single(d.energies.potential);
-        let ke_fn = match (&d.structured, d.closed_form) {
-            (Ok(_), false) => self.kinetic_through_mass(),
-            _ => {
-                let (ke_body, ke_out) = single(d.energies.kinetic);
-                braced([
-                    quote!(#chk_q #chk_u #pos #params_t #bind_q #bind_u #solve_x #ke_body),
-                    quote!(#p::Ok(#ke_out)),
-                ])
-            }
-        };
-        let mf_fn = self.mass_and_forcing_fn(c);
-        let checks_ct = [chk("__c", n * l), chk("__c0", n)];
-        let chk_qdot = chk("__qdot", n);
-        let checks_res = [chk("__holonomic", nh), chk("__velocity", m)];
+        EquationPrograms {
+            speed_transform: quote!(#ct_body #ct_c #ct_c0),
+            coordinate_rates: quote!(#cr_body #cr_out),
+            residuals: quote!(#res_body #res_h #res_v),
+            speed_definitions: quote!(#sd_body #sd_w #sd_w0),
+            input_power: single(d.energies.input_power),
+            potential: single(d.energies.potential),
+            kinetic: single(d.energies.kinetic),
+        }
+    }
+
+    /// W and w, the input power and V: the same whether or not the
+    /// constraints read inputs.
+    fn speeds_power_potential(&self, c: &Common, lowered: &EquationPrograms) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let (n, l) = (d.n, d.l);
+        let chk = |arg: &str, len: usize| self.check(arg, len);
+        let (chk_q, chk_u, chk_inputs) = (
+            chk("__q", n),
+            chk("__u", l),
+            chk("__inputs", self.inputs().len()),
+        );
         let checks_sd = [chk("__w", l * n), chk("__w0", l)];
-        let mf_item = quote! {
-            fn mass_matrix_and_forcing<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __m: &mut [__T], __f: &mut [__T]) -> #p::Result<(), #p::ModelError> #mf_fn
-        };
-        // W and w, the input power and V: the same whether or not the
-        // constraints read inputs.
-        let sd_ip_pe = quote! {
+        let Common {
+            params_t,
+            bind_q,
+            bind_u,
+            bind_inputs,
+            solve_x,
+            ..
+        } = c;
+        let sd = &lowered.speed_definitions;
+        let (ip_body, ip_out) = &lowered.input_power;
+        let (pe_body, pe_out) = &lowered.potential;
+        quote! {
             fn speed_definitions<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __w: &mut [__T], __w0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_sd)* #params_t #bind_q #sd_body #sd_w #sd_w0
+                #chk_q #(#checks_sd)* #params_t #bind_q #sd
                 #p::Ok(())
             }
             fn input_power<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
@@ -234,60 +312,81 @@ impl Emitter<'_> {
                 #chk_q #params_t #bind_q #pe_body
                 #p::Ok(#pe_out)
             }
-        };
-        if !self.model.input_rates.is_empty() {
-            // Driven coordinates: C, c, q̇, the residuals and T read the
-            // inputs; only the `driven_` forms take them. T is always the
-            // symbolic one: ½ uᵀ M u leaves out the commanded rates.
-            let (ke_body, ke_out) = single(d.energies.kinetic);
-            let needs = |f: &str| quote!({ #p::Err(#p::ModelError::NeedsInputs { function: #f }) });
-            let (ns, nc, nr, nk) = (
-                needs("speed_transform"),
-                needs("coordinate_rates"),
-                needs("constraint_residuals"),
-                needs("kinetic_energy"),
-            );
-            return quote! {
-                #mf_item
-                fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> #ns
-                fn driven_speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __inputs: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                    #chk_q #chk_inputs #(#checks_ct)* #pos #params_t #bind_q #bind_inputs #solve_x #ct_body #ct_c #ct_c0
-                    #p::Ok(())
-                }
-                fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> #nc
-                fn driven_coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                    #chk_q #chk_u #chk_inputs #chk_qdot #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #cr_body #cr_out
-                    #p::Ok(())
-                }
-                fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> #nr
-                fn driven_constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __inputs: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                    #chk_q #chk_qdot #chk_inputs #(#checks_res)* #params_t #bind_q #bind_qdot #bind_inputs #res_body #res_h #res_v
-                    #p::Ok(())
-                }
-                #sd_ip_pe
-                fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #nk
-                fn driven_kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
-                    #chk_q #chk_u #chk_inputs #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #ke_body
-                    #p::Ok(#ke_out)
-                }
-            };
         }
+    }
+
+    /// Driven coordinates: C, c, q̇, the residuals and T read the inputs;
+    /// only the `driven_` forms take them. T is always the symbolic one:
+    /// ½ uᵀ M u leaves out the commanded rates.
+    fn driven_equations_functions(
+        &self,
+        c: &Common,
+        lowered: &EquationPrograms,
+        mf_item: TokenStream,
+        sd_ip_pe: TokenStream,
+    ) -> TokenStream {
+        let p = p();
+        let d = self.d;
+        let (n, l) = (d.n, d.l);
+        let chk = |arg: &str, len: usize| self.check(arg, len);
+        let (chk_q, chk_u, chk_inputs) = (
+            chk("__q", n),
+            chk("__u", l),
+            chk("__inputs", self.inputs().len()),
+        );
+        let checks_ct = [chk("__c", n * l), chk("__c0", n)];
+        let chk_qdot = chk("__qdot", n);
+        let checks_res = [
+            chk("__holonomic", d.constraints.holonomic.len()),
+            chk("__velocity", d.m),
+        ];
+        let Common {
+            params_t,
+            positivity: pos,
+            bind_q,
+            bind_qdot,
+            bind_u,
+            bind_inputs,
+            solve_x,
+            ..
+        } = c;
+        let EquationPrograms {
+            speed_transform: ct,
+            coordinate_rates: cr,
+            residuals: res,
+            kinetic: (ke_body, ke_out),
+            ..
+        } = lowered;
+        let needs = |f: &str| quote!({ #p::Err(#p::ModelError::NeedsInputs { function: #f }) });
+        let (ns, nc, nr, nk) = (
+            needs("speed_transform"),
+            needs("coordinate_rates"),
+            needs("constraint_residuals"),
+            needs("kinetic_energy"),
+        );
         quote! {
             #mf_item
-            fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #(#checks_ct)* #pos #params_t #bind_q #solve_x #ct_body #ct_c #ct_c0
+            fn speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> #ns
+            fn driven_speed_transform<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __inputs: &[__T], __c: &mut [__T], __c0: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_inputs #(#checks_ct)* #pos #params_t #bind_q #bind_inputs #solve_x #ct
                 #p::Ok(())
             }
-            fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #chk_u #chk_qdot #pos #params_t #bind_q #bind_u #solve_x #cr_body #cr_out
+            fn coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> #nc
+            fn driven_coordinate_rates<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T], __qdot: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_u #chk_inputs #chk_qdot #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #cr
                 #p::Ok(())
             }
-            fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
-                #chk_q #chk_qdot #(#checks_res)* #params_t #bind_q #bind_qdot #res_body #res_h #res_v
+            fn constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> #nr
+            fn driven_constraint_residuals<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __qdot: &[__T], __inputs: &[__T], __holonomic: &mut [__T], __velocity: &mut [__T]) -> #p::Result<(), #p::ModelError> {
+                #chk_q #chk_qdot #chk_inputs #(#checks_res)* #params_t #bind_q #bind_qdot #bind_inputs #res
                 #p::Ok(())
             }
             #sd_ip_pe
-            fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #ke_fn
+            fn kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T]) -> #p::Result<__T, #p::ModelError> #nk
+            fn driven_kinetic_energy<__T: #p::Scalar>(&self, t: __T, __q: &[__T], __u: &[__T], __inputs: &[__T]) -> #p::Result<__T, #p::ModelError> {
+                #chk_q #chk_u #chk_inputs #pos #params_t #bind_q #bind_u #bind_inputs #solve_x #ke_body
+                #p::Ok(#ke_out)
+            }
         }
     }
 
