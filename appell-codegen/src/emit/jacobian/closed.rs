@@ -213,89 +213,148 @@ impl Emitter<'_> {
         ne: &NumericElimination,
         column: Column,
     ) -> (TokenStream, Vec<Option<TokenStream>>, usize) {
-        let Column { base, w, l, nr } = column;
-        let (k, width, cols) = (ne.k, ne.columns.len(), &ne.columns);
         let g = &self.model.g;
+        let k = ne.k;
         let entry = |i: usize, j: usize| !g.is_zero(ne.s[i * k + j]);
-        let solver = Solver {
-            order: singleton_rows(k, entry),
-            entry: &entry,
+        let t = Totals {
+            value,
+            at,
+            ne,
+            column,
+            solver: Solver {
+                order: singleton_rows(k, entry),
+                entry: &entry,
+            },
         };
         let (mut out, mut ops) = (TokenStream::new(), 0);
-        // ∂X: its right side, then the solve (skipped where all vanish).
-        let x_name = |j: usize, kk: usize| format_ident!("__x_{}_{}", j, cols[kk]);
-        let dx_name = |j: usize, kk: usize| format_ident!("__jx{}_{}_{}", w, j, kk);
-        let mut dx_any = false;
+        let dx_any = t.dx(&mut out, &mut ops);
+        let dw_any = t.dw(dx_any, &mut out, &mut ops);
+        let entries = t.values(dx_any, dw_any, &mut out, &mut ops);
+        (out, entries, ops)
+    }
+}
+
+/// What one column's total derivatives read (see `total_derivatives`).
+struct Totals<'a> {
+    value: &'a dyn Fn(usize) -> Option<TokenStream>,
+    at: &'a NumericAt,
+    ne: &'a NumericElimination,
+    column: Column,
+    solver: Solver<'a>,
+}
+
+impl Totals<'_> {
+    /// X's entry (j, kk).
+    fn x_name(&self, j: usize, kk: usize) -> syn::Ident {
+        format_ident!("__x_{}_{}", j, self.ne.columns[kk])
+    }
+
+    /// ∂X's entry (j, kk).
+    fn dx_name(&self, j: usize, kk: usize) -> syn::Ident {
+        format_ident!("__jx{}_{}_{}", self.column.w, j, kk)
+    }
+
+    /// ∂w's entry j.
+    fn dw_name(&self, j: usize) -> syn::Ident {
+        format_ident!("__jw{}_{}", self.column.w, j)
+    }
+
+    /// ∂X: its right side, then the solve (skipped where all vanish).
+    /// Whether there is one.
+    fn dx(&self, out: &mut TokenStream, ops: &mut usize) -> bool {
+        let (k, width, w) = (self.ne.k, self.ne.columns.len(), self.column.w);
+        let mut any = false;
         let mut rows = Vec::new();
         for i in 0..k {
             let mut row = Vec::with_capacity(width);
             for kk in 0..width {
                 let mut terms = Vec::new();
-                if let Some(v) = value(at.r(w, i, kk)) {
+                if let Some(v) = (self.value)(self.at.r(w, i, kk)) {
                     terms.push(v);
                 }
                 for j in 0..k {
-                    if let Some(v) = value(at.s(w, i, j)) {
-                        let x = x_name(j, kk);
+                    if let Some(v) = (self.value)(self.at.s(w, i, j)) {
+                        let x = self.x_name(j, kk);
                         terms.push(quote!(-(#v) * #x));
-                        ops += 2;
+                        *ops += 2;
                     }
                 }
-                dx_any |= !terms.is_empty();
+                any |= !terms.is_empty();
                 row.push(sum(terms));
             }
             rows.push(quote!([#(#row),*]));
         }
-        let (ki, wi) = (int(k), int(width));
-        if dx_any {
+        if any {
+            let (ki, wi) = (int(k), int(width));
             let name = format!("__jdx{w}");
             let ident = format_ident!("{}", name);
             out.extend(quote!(let #ident: [[__T; #wi]; #ki] = [#(#rows),*];));
-            let (solve, n) = solver.solve(&name, width, &dx_name, &|_, _| false, false);
+            let dx_name = |j: usize, kk: usize| self.dx_name(j, kk);
+            let (solve, n) = self
+                .solver
+                .solve(&name, width, &dx_name, &|_, _| false, false);
             out.extend(solve);
-            ops += n;
+            *ops += n;
         }
-        // ∂w.
-        let mut dw_any = false;
-        let mut w_rows = Vec::with_capacity(k);
+        any
+    }
+
+    /// ∂w, after ∂X (`dx_any`). Whether there is one.
+    fn dw(&self, dx_any: bool, out: &mut TokenStream, ops: &mut usize) -> bool {
+        let (k, width, w) = (self.ne.k, self.ne.columns.len(), self.column.w);
+        let mut any = false;
+        let mut rows = Vec::with_capacity(k);
         for i in 0..k {
             let mut terms = Vec::new();
-            if let Some(v) = value(at.rate(w, i)) {
+            if let Some(v) = (self.value)(self.at.rate(w, i)) {
                 terms.push(v);
             }
             if dx_any {
                 for j in 0..k {
                     for kk in 0..width {
-                        if let Some(v) = value(at.rate_x(i, j * width + kk)) {
-                            let d = dx_name(j, kk);
+                        if let Some(v) = (self.value)(self.at.rate_x(i, j * width + kk)) {
+                            let d = self.dx_name(j, kk);
                             terms.push(quote!((#v) * #d));
-                            ops += 2;
+                            *ops += 2;
                         }
                     }
                 }
             }
             for j in 0..k {
-                if let Some(v) = value(at.s(w, i, j)) {
+                if let Some(v) = (self.value)(self.at.s(w, i, j)) {
                     let wj = format_ident!("__w_{}", j);
                     terms.push(quote!(-(#v) * #wj));
-                    ops += 2;
+                    *ops += 2;
                 }
             }
-            dw_any |= !terms.is_empty();
+            any |= !terms.is_empty();
             let e = sum(terms);
-            w_rows.push(quote!([#e]));
+            rows.push(quote!([#e]));
         }
-        let dw_name = |j: usize, _: usize| format_ident!("__jw{}_{}", w, j);
-        if dw_any {
+        if any {
+            let ki = int(k);
             let name = format!("__jdw{w}");
             let ident = format_ident!("{}", name);
-            out.extend(quote!(let #ident: [[__T; 1]; #ki] = [#(#w_rows),*];));
-            let (solve, n) = solver.solve(&name, 1, &dw_name, &|_, _| false, false);
+            out.extend(quote!(let #ident: [[__T; 1]; #ki] = [#(#rows),*];));
+            let dw_name = |j: usize, _: usize| self.dw_name(j);
+            let (solve, n) = self.solver.solve(&name, 1, &dw_name, &|_, _| false, false);
             out.extend(solve);
-            ops += n;
+            *ops += n;
         }
-        // The values' total derivatives, in closed_column's order: ∂f (l),
-        // ∂q̇ (nr), ∂M's triangle; the values' own order is M, f, q̇.
+        any
+    }
+
+    /// The values' total derivatives, in closed_column's order: ∂f (l),
+    /// ∂q̇ (nr), ∂M's triangle; the values' own order is M, f, q̇.
+    fn values(
+        &self,
+        dx_any: bool,
+        dw_any: bool,
+        out: &mut TokenStream,
+        ops: &mut usize,
+    ) -> Vec<Option<TokenStream>> {
+        let Column { base, w, l, nr } = self.column;
+        let (k, width) = (self.ne.k, self.ne.columns.len());
         let tri = l * (l + 1) / 2;
         let value_index = |e: usize| {
             if e < l + nr {
@@ -308,26 +367,26 @@ impl Emitter<'_> {
         for e in 0..l + nr + tri {
             let v = value_index(e);
             let mut terms = Vec::new();
-            if let Some(p) = value(base + e) {
+            if let Some(p) = (self.value)(base + e) {
                 terms.push(p);
             }
             if dx_any {
                 for j in 0..k {
                     for kk in 0..width {
-                        if let Some(p) = value(at.value_x(v, j * width + kk)) {
-                            let d = dx_name(j, kk);
+                        if let Some(p) = (self.value)(self.at.value_x(v, j * width + kk)) {
+                            let d = self.dx_name(j, kk);
                             terms.push(quote!((#p) * #d));
-                            ops += 2;
+                            *ops += 2;
                         }
                     }
                 }
             }
             if dw_any {
                 for j in 0..k {
-                    if let Some(p) = value(at.value_w(v, j)) {
-                        let d = dw_name(j, 0);
+                    if let Some(p) = (self.value)(self.at.value_w(v, j)) {
+                        let d = self.dw_name(j);
                         terms.push(quote!((#p) * #d));
-                        ops += 2;
+                        *ops += 2;
                     }
                 }
             }
@@ -340,7 +399,7 @@ impl Emitter<'_> {
                 entries.push(Some(quote!(#name)));
             }
         }
-        (out, entries, ops)
+        entries
     }
 }
 
