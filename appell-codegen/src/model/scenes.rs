@@ -19,85 +19,8 @@ impl Builder<'_> {
         let cx = self.cx;
         let mut scenes = Vec::new();
         for sc in &ast.scenes {
-            let mut ok = true;
-            for e in &sc.effects {
-                if !effects.contains(&e.to_string()) {
-                    let h = hint(&e.to_string(), effects.iter().cloned());
-                    cx.error_spanned_by(
-                        e,
-                        format!(
-                            "scene `{}` names the effect `{e}`, which no load declares{h}",
-                            sc.name
-                        ),
-                    );
-                    ok = false;
-                }
-            }
-            let mut quadrature = Vec::new();
-            let mut outputs: Vec<String> = Vec::new();
-            for (kind, args) in &sc.outputs {
-                let k = kind.to_string();
-                if outputs.contains(&k) {
-                    cx.error_spanned_by(kind, format!("scene output `{k}` is listed twice"));
-                    ok = false;
-                    continue;
-                }
-                outputs.push(k.clone());
-                if k == "energies" || k == "contact_forces" {
-                    if let Some(a) = args.first() {
-                        cx.error_spanned_by(a, format!("`{k}` takes no arguments"));
-                        ok = false;
-                    }
-                    if k == "contact_forces"
-                        && ast.holonomic.is_empty()
-                        && ast.nonholonomic.is_empty()
-                        && ast.rolls.is_empty()
-                        && ast.contacts.is_empty()
-                    {
-                        cx.error_spanned_by(
-                            kind,
-                            "`contact_forces` needs constraints (`rolls`, `holonomic` or `nonholonomic`), and the model has none",
-                        );
-                        ok = false;
-                    }
-                } else if k == "quadrature" {
-                    if args.is_empty() {
-                        cx.error_spanned_by(
-                            kind,
-                            "`quadrature(...)` needs the coordinates to keep",
-                        );
-                        ok = false;
-                    }
-                    for a in args {
-                        match self.coords.iter().position(|(c, _)| c == a) {
-                            Some(i) => quadrature.push(i),
-                            None => {
-                                let h = hint(
-                                    &a.to_string(),
-                                    self.coords.iter().map(|(c, _)| c.to_string()),
-                                );
-                                cx.error_spanned_by(
-                                    a,
-                                    format!(
-                                        "`quadrature` takes coordinates, and `{a}` is not one{h}"
-                                    ),
-                                );
-                                ok = false;
-                            }
-                        }
-                    }
-                } else {
-                    let h = hint(
-                        &k,
-                        ["quadrature", "energies", "contact_forces"].map(String::from),
-                    );
-                    cx.error_spanned_by(
-                        kind,
-                        format!("unknown scene output `{kind}`; available: quadrature(coordinates...), energies, contact_forces{h}"),
-                    );
-                    ok = false;
-                }
-            }
+            let mut ok = self.scene_effects(sc, effects);
+            let (quadrature, outputs) = self.scene_outputs(ast, sc, &mut ok);
             if scenes.iter().any(|s: &Scene| s.name == sc.name) {
                 cx.error_spanned_by(&sc.name, format!("duplicate scene `{}`", sc.name));
                 ok = false;
@@ -105,22 +28,7 @@ impl Builder<'_> {
             if !not_raw(cx, &sc.name, "scene") {
                 ok = false;
             }
-            let left_out: Vec<&String> = constraint_effects
-                .iter()
-                .filter(|e| !sc.effects.iter().any(|s| s == *e))
-                .collect();
-            if !left_out.is_empty() && sc.speeds.is_none() {
-                let names: Vec<String> = left_out.iter().map(|e| format!("`{e}`")).collect();
-                cx.error_spanned_by(
-                    &sc.name,
-                    format!(
-                        "scene `{}` leaves out the constraints of {}, so it moves with more degrees of freedom than the model: name all its privileged speeds with `speeds(...)` in the scene (or name the effect in `effects(...)` to keep the constraints)",
-                        sc.name,
-                        names.join(", ")
-                    ),
-                );
-                ok = false;
-            }
+            ok &= self.keeps_constraints(sc, constraint_effects);
             let speeds = match &sc.speeds {
                 Some((list, at)) => match self.scene_speeds(list, model_speeds) {
                     Some(specs) => Some((specs, at.clone())),
@@ -142,6 +50,134 @@ impl Builder<'_> {
             }
         }
         scenes
+    }
+
+    /// Whether every effect the scene names is a load's; an error for each
+    /// that is not.
+    fn scene_effects(&self, sc: &SceneDef, effects: &[String]) -> bool {
+        let mut ok = true;
+        for e in &sc.effects {
+            if !effects.contains(&e.to_string()) {
+                let h = hint(&e.to_string(), effects.iter().cloned());
+                self.cx.error_spanned_by(
+                    e,
+                    format!(
+                        "scene `{}` names the effect `{e}`, which no load declares{h}",
+                        sc.name
+                    ),
+                );
+                ok = false;
+            }
+        }
+        ok
+    }
+
+    /// The scene's quadrature coordinates (indices) and its outputs' names;
+    /// `ok` turns false at an output that does not check out.
+    fn scene_outputs(
+        &self,
+        ast: &ModelAst,
+        sc: &SceneDef,
+        ok: &mut bool,
+    ) -> (Vec<usize>, Vec<String>) {
+        let cx = self.cx;
+        let mut quadrature = Vec::new();
+        let mut outputs: Vec<String> = Vec::new();
+        for (kind, args) in &sc.outputs {
+            let k = kind.to_string();
+            if outputs.contains(&k) {
+                cx.error_spanned_by(kind, format!("scene output `{k}` is listed twice"));
+                *ok = false;
+                continue;
+            }
+            outputs.push(k.clone());
+            if k == "energies" || k == "contact_forces" {
+                if let Some(a) = args.first() {
+                    cx.error_spanned_by(a, format!("`{k}` takes no arguments"));
+                    *ok = false;
+                }
+                if k == "contact_forces"
+                    && ast.holonomic.is_empty()
+                    && ast.nonholonomic.is_empty()
+                    && ast.rolls.is_empty()
+                    && ast.contacts.is_empty()
+                {
+                    cx.error_spanned_by(
+                        kind,
+                        "`contact_forces` needs constraints (`rolls`, `holonomic` or `nonholonomic`), and the model has none",
+                    );
+                    *ok = false;
+                }
+            } else if k == "quadrature" {
+                *ok &= self.quadrature(kind, args, &mut quadrature);
+            } else {
+                let h = hint(
+                    &k,
+                    ["quadrature", "energies", "contact_forces"].map(String::from),
+                );
+                cx.error_spanned_by(
+                    kind,
+                    format!("unknown scene output `{kind}`; available: quadrature(coordinates...), energies, contact_forces{h}"),
+                );
+                *ok = false;
+            }
+        }
+        (quadrature, outputs)
+    }
+
+    /// `quadrature(...)`'s coordinates, pushed on `quadrature` by index;
+    /// whether every argument is one.
+    fn quadrature(
+        &self,
+        kind: &syn::Ident,
+        args: &[syn::Ident],
+        quadrature: &mut Vec<usize>,
+    ) -> bool {
+        let cx = self.cx;
+        let mut ok = true;
+        if args.is_empty() {
+            cx.error_spanned_by(kind, "`quadrature(...)` needs the coordinates to keep");
+            ok = false;
+        }
+        for a in args {
+            match self.coords.iter().position(|(c, _)| c == a) {
+                Some(i) => quadrature.push(i),
+                None => {
+                    let h = hint(
+                        &a.to_string(),
+                        self.coords.iter().map(|(c, _)| c.to_string()),
+                    );
+                    cx.error_spanned_by(
+                        a,
+                        format!("`quadrature` takes coordinates, and `{a}` is not one{h}"),
+                    );
+                    ok = false;
+                }
+            }
+        }
+        ok
+    }
+
+    /// Whether a scene that leaves out constraint effects names its own
+    /// speeds; an error where it does not.
+    fn keeps_constraints(&self, sc: &SceneDef, constraint_effects: &[String]) -> bool {
+        let left_out: Vec<&String> = constraint_effects
+            .iter()
+            .filter(|e| !sc.effects.iter().any(|s| s == *e))
+            .collect();
+        if left_out.is_empty() || sc.speeds.is_some() {
+            return true;
+        }
+        let names: Vec<String> = left_out.iter().map(|e| format!("`{e}`")).collect();
+        self.cx.error_spanned_by(
+            &sc.name,
+            format!(
+                "scene `{}` leaves out the constraints of {}, so it moves with more degrees of freedom than the model: name all its privileged speeds with `speeds(...)` in the scene (or name the effect in `effects(...)` to keep the constraints)",
+                sc.name,
+                names.join(", ")
+            ),
+        );
+        false
     }
 
     /// The speeds of a scene that names no speeds: the model's, less the
