@@ -4,7 +4,7 @@
 
 use std::fmt::Write;
 
-use appell_symbolic::Id;
+use appell_symbolic::{Graph, Id};
 
 use super::{Derivation, Elimination};
 use crate::model::Model;
@@ -37,19 +37,7 @@ fn written_size(g: &appell_symbolic::Graph, e: Id, cap: usize) -> usize {
 pub fn equations_text(model: &Model, d: &Derivation) -> String {
     let g = &model.g;
     let name = |i: usize| model.coords[i].0.to_string();
-    // A small graph can still print as a long tree (its shared parts
-    // written out each time they occur): an expression whose text passes
-    // MAX_TEXT characters is named by its size too.
-    let printed = |e: Id| -> Result<String, usize> {
-        let nodes = g.dag_size(&[e]);
-        let small = nodes <= 400 && written_size(g, e, MAX_TEXT) < MAX_TEXT;
-        let text = small.then(|| g.display(e).to_string());
-        match text {
-            Some(text) if text.len() <= MAX_TEXT => Ok(text),
-            _ => Err(nodes),
-        }
-    };
-    let show = |e: Id| printed(e).unwrap_or_else(too_long);
+    let show = |e: Id| printed(g, e).unwrap_or_else(too_long);
     let mut s = String::new();
     let _ = writeln!(
         s,
@@ -72,31 +60,7 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
             let _ = writeln!(s, "  {} = {} (quasi-velocity)", speeds[k], show(def));
         }
     }
-    if !d.speeds.dependent.is_empty() {
-        let how = match d.elimination {
-            Elimination::Symbolic => "solved symbolically",
-            Elimination::Numeric(_) => {
-                "solved numerically at run time (no provably non-zero pivot)"
-            }
-        };
-        let _ = writeln!(s, "dependent speeds (q_dot = C y_dot + c, {how}):");
-        for &r in &d.speeds.dependent {
-            let mut terms = Vec::new();
-            for k in 0..d.l {
-                let c = d.map.c[r * d.l + k];
-                if !g.is_zero(c) {
-                    terms.push(format!("({}) * {}", show(c), speeds[k]));
-                }
-            }
-            if !g.is_zero(d.map.c0[r]) {
-                terms.push(show(d.map.c0[r]));
-            }
-            if terms.is_empty() {
-                terms.push("0".into());
-            }
-            let _ = writeln!(s, "  {}_dot = {}", name(r), terms.join(" + "));
-        }
-    }
+    dependent_speeds(&mut s, model, d, &speeds);
     let list = |v: &[usize]| {
         if v.is_empty() {
             "none".to_string()
@@ -116,6 +80,58 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
     let mut state: Vec<String> = d.reduction.retained.iter().map(|&i| name(i)).collect();
     state.extend(speeds.iter().cloned());
     let _ = writeln!(s, "reduced state: ({})", state.join(", "));
+    mass_and_forcing(&mut s, model, d, &speeds);
+    s
+}
+
+/// An expression's text, or its node count where it is too long to print.
+/// A small graph can still print as a long tree (its shared parts written
+/// out each time they occur): an expression whose text passes MAX_TEXT
+/// characters is named by its size too.
+fn printed(g: &Graph, e: Id) -> Result<String, usize> {
+    let nodes = g.dag_size(&[e]);
+    let small = nodes <= 400 && written_size(g, e, MAX_TEXT) < MAX_TEXT;
+    let text = small.then(|| g.display(e).to_string());
+    match text {
+        Some(text) if text.len() <= MAX_TEXT => Ok(text),
+        _ => Err(nodes),
+    }
+}
+
+/// The dependent speeds' lines, q̇_r = C ẏ + c.
+fn dependent_speeds(s: &mut String, model: &Model, d: &Derivation, speeds: &[String]) {
+    if d.speeds.dependent.is_empty() {
+        return;
+    }
+    let g = &model.g;
+    let show = |e: Id| printed(g, e).unwrap_or_else(too_long);
+    let how = match d.elimination {
+        Elimination::Symbolic => "solved symbolically",
+        Elimination::Numeric(_) => "solved numerically at run time (no provably non-zero pivot)",
+    };
+    let _ = writeln!(s, "dependent speeds (q_dot = C y_dot + c, {how}):");
+    for &r in &d.speeds.dependent {
+        let mut terms = Vec::new();
+        for k in 0..d.l {
+            let c = d.map.c[r * d.l + k];
+            if !g.is_zero(c) {
+                terms.push(format!("({}) * {}", show(c), speeds[k]));
+            }
+        }
+        if !g.is_zero(d.map.c0[r]) {
+            terms.push(show(d.map.c0[r]));
+        }
+        if terms.is_empty() {
+            terms.push("0".into());
+        }
+        let _ = writeln!(s, "  {}_dot = {}", model.coords[r].0, terms.join(" + "));
+    }
+}
+
+/// M's upper triangle and f, entry by entry. Entries too long to print are
+/// counted on one line, not listed: a large tree's M has hundreds of them.
+fn mass_and_forcing(s: &mut String, model: &Model, d: &Derivation, speeds: &[String]) {
+    let g = &model.g;
     let accels: Vec<String> = model
         .speed_specs
         .iter()
@@ -126,8 +142,6 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
         "M(q) y_ddot = f(q, y_dot, t) with y_ddot = ({}):",
         accels.join(", ")
     );
-    // Entries too long to print are counted on one line, not listed: a
-    // large tree's M has hundreds of them.
     let mut entries = Vec::new();
     for k in 0..d.l {
         for j in k..d.l {
@@ -142,7 +156,7 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
     let budget = s.len() + MAX_LISTING;
     for (label, e) in entries {
         let fits = s.len() < budget;
-        match printed(e) {
+        match printed(g, e) {
             Ok(text) if fits => {
                 let _ = writeln!(s, "  {label} = {text}");
             }
@@ -164,7 +178,6 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
             );
         }
     }
-    s
 }
 
 /// The placeholder for an expression too long to print.

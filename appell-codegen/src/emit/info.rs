@@ -32,49 +32,7 @@ impl Emitter<'_> {
             let (name, rigid) = (&b.name, b.frame.is_some());
             quote!(#p::BodyInfo { name: #name, rigid: #rigid })
         });
-        let driven = |e: appell_symbolic::Id| {
-            model
-                .input_rates
-                .iter()
-                .any(|(s, _)| model.g.depends_on(e, *s))
-        };
-        // `nonholonomic: dt(psi1) == w_cmd`, the tokens as written.
-        let label = |kind: &str, at: &proc_macro2::TokenStream| {
-            let mut text = at.to_string();
-            for (from, to) in [(" (", "("), ("( ", "("), (" )", ")"), (" ,", ",")] {
-                text = text.replace(from, to);
-            }
-            format!("{kind}: {text}")
-        };
-        let row_sources = d.constraints.sources.iter().zip(&d.constraints.at).map(
-            |(r, at)| match *r {
-                RowSource::Holonomic { index } if driven(model.holonomic[index].residual) => {
-                    let (i, c) = (int(index), label("holonomic", at));
-                    quote!(#p::RowSource::Driven { holonomic: true, index: #i, constraint: #c })
-                }
-                RowSource::Nonholonomic { index } if driven(model.nonholonomic[index].residual) => {
-                    let (i, c) = (int(index), label("nonholonomic", at));
-                    quote!(#p::RowSource::Driven { holonomic: false, index: #i, constraint: #c })
-                }
-                RowSource::Holonomic { index } => {
-                    let i = int(index);
-                    quote!(#p::RowSource::Holonomic { index: #i })
-                }
-                RowSource::Nonholonomic { index } => {
-                    let i = int(index);
-                    quote!(#p::RowSource::Nonholonomic { index: #i })
-                }
-                RowSource::Rolling { contact, direction } => {
-                    let (c, k) = (int(contact), int(direction));
-                    quote!(#p::RowSource::Rolling { contact: #c, direction: #k })
-                }
-                RowSource::Contact { contact, axis } => {
-                    let (c, k) = (int(contact), int(axis));
-                    quote!(#p::RowSource::Contact { contact: #c, axis: #k })
-                }
-                RowSource::Driven { .. } => unreachable!("the derivation labels no row driven"),
-            },
-        );
+        let row_sources = self.row_sources();
         let contacts = model.rolling.iter().map(|r| {
             let (body, point, along) = (int(r.body), &r.point, r.along.is_some());
             quote!(#p::ContactInfo { body: #body, point: #point, along: #along })
@@ -136,5 +94,58 @@ impl Emitter<'_> {
                 equations: #text,
             }
         }
+    }
+
+    /// Where each constraint row comes from, a row whose residual reads a
+    /// commanded rate as `Driven`.
+    fn row_sources(&self) -> Vec<TokenStream> {
+        let p = p();
+        let (d, model) = (self.d, self.model);
+        let driven = |e: appell_symbolic::Id| {
+            model
+                .input_rates
+                .iter()
+                .any(|(s, _)| model.g.depends_on(e, *s))
+        };
+        // `nonholonomic: dt(psi1) == w_cmd`, the tokens as written.
+        let label = |kind: &str, at: &proc_macro2::TokenStream| {
+            let mut text = at.to_string();
+            for (from, to) in [(" (", "("), ("( ", "("), (" )", ")"), (" ,", ",")] {
+                text = text.replace(from, to);
+            }
+            format!("{kind}: {text}")
+        };
+        d.constraints
+            .sources
+            .iter()
+            .zip(&d.constraints.at)
+            .map(|(r, at)| match *r {
+                RowSource::Holonomic { index } if driven(model.holonomic[index].residual) => {
+                    let (i, c) = (int(index), label("holonomic", at));
+                    quote!(#p::RowSource::Driven { holonomic: true, index: #i, constraint: #c })
+                }
+                RowSource::Nonholonomic { index } if driven(model.nonholonomic[index].residual) => {
+                    let (i, c) = (int(index), label("nonholonomic", at));
+                    quote!(#p::RowSource::Driven { holonomic: false, index: #i, constraint: #c })
+                }
+                RowSource::Holonomic { index } => {
+                    let i = int(index);
+                    quote!(#p::RowSource::Holonomic { index: #i })
+                }
+                RowSource::Nonholonomic { index } => {
+                    let i = int(index);
+                    quote!(#p::RowSource::Nonholonomic { index: #i })
+                }
+                RowSource::Rolling { contact, direction } => {
+                    let (c, k) = (int(contact), int(direction));
+                    quote!(#p::RowSource::Rolling { contact: #c, direction: #k })
+                }
+                RowSource::Contact { contact, axis } => {
+                    let (c, k) = (int(contact), int(axis));
+                    quote!(#p::RowSource::Contact { contact: #c, axis: #k })
+                }
+                RowSource::Driven { .. } => unreachable!("the derivation labels no row driven"),
+            })
+            .collect()
     }
 }
