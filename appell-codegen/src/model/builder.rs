@@ -53,35 +53,10 @@ pub(super) fn engine_error(cx: &Ctxt, span: proc_macro2::Span, e: SymbolicError)
 pub(super) fn build_in(
     cx: &Ctxt,
     ast: &ModelAst,
-    mut g: Graph,
+    g: Graph,
     cut_from: Option<Vec<Mat3>>,
 ) -> Option<(Model, Vec<Cut>)> {
-    let time = g.time().expect("fresh graph");
-    let mut b = Builder {
-        cx,
-        g,
-        params: Vec::new(),
-        coords: Vec::new(),
-        inputs: Vec::new(),
-        time,
-        frames: Vec::new(),
-        points: Vec::new(),
-        poisoned: Vec::new(),
-        context: String::new(),
-        norms: Vec::new(),
-        divisors: Vec::new(),
-        quaternions: Vec::new(),
-        cut_from,
-        cuts: Vec::new(),
-        rules: RateRules::coordinates(),
-        declared: ast
-            .frames
-            .iter()
-            .map(|f| f.name.clone())
-            .chain(ast.points.iter().map(|p| p.name.clone()))
-            .collect(),
-        origins: ast.origins.clone(),
-    };
+    let mut b = Builder::new(cx, ast, g, cut_from);
     b.declare_symbols(ast);
     if b.cut_from.is_none() {
         duplicate_bodies(cx, ast);
@@ -104,29 +79,12 @@ pub(super) fn build_in(
     let contacts = b.contacts(ast);
     let (speed_specs, speeds_at) = b.speeds(ast);
     let speeds: Vec<usize> = speed_specs.iter().filter_map(|s| s.coordinate).collect();
-    // Effects: the loads', then those only constraints name.
-    let mut effects = loads.effects.clone();
-    let mut constraint_effects: Vec<String> = Vec::new();
     let named = holonomic
         .iter()
         .chain(&nonholonomic)
         .map(|c| &c.effect)
         .chain(rolling.iter().map(|r| &r.effect));
-    for e in named.flatten() {
-        if !constraint_effects.contains(e) {
-            constraint_effects.push(e.clone());
-        }
-        if !effects.contains(e) {
-            effects.push(e.clone());
-        }
-    }
-    // A contact's effect adds its rows where named: leaving it out is the
-    // model as declared.
-    for c in &contacts {
-        if !effects.contains(&c.effect) {
-            effects.push(c.effect.clone());
-        }
-    }
+    let (effects, constraint_effects) = effects(&loads.effects, named.flatten(), &contacts);
     let scenes = b.scenes(ast, &effects, &constraint_effects, &speed_specs, &contacts);
     if bodies.is_empty() && !cx.has_errors() {
         cx.error_at(
@@ -172,6 +130,64 @@ pub(super) fn build_in(
         tree: super::tree::tree_spec(ast),
     };
     Some((model, b.cuts))
+}
+
+/// Every effect (the loads', then those only constraints name, then the
+/// contacts'), and those the constraints name. A contact's effect adds its
+/// rows where named: leaving it out is the model as declared.
+fn effects<'a>(
+    loads: &[String],
+    constraints: impl Iterator<Item = &'a String>,
+    contacts: &[super::Contact],
+) -> (Vec<String>, Vec<String>) {
+    let mut effects = loads.to_vec();
+    let mut constraint_effects: Vec<String> = Vec::new();
+    for e in constraints {
+        if !constraint_effects.contains(e) {
+            constraint_effects.push(e.clone());
+        }
+        if !effects.contains(e) {
+            effects.push(e.clone());
+        }
+    }
+    for c in contacts {
+        if !effects.contains(&c.effect) {
+            effects.push(c.effect.clone());
+        }
+    }
+    (effects, constraint_effects)
+}
+
+impl<'a> Builder<'a> {
+    /// A builder of `ast` in the fresh graph `g` (see [`build_in`]).
+    fn new(cx: &'a Ctxt, ast: &ModelAst, mut g: Graph, cut_from: Option<Vec<Mat3>>) -> Builder<'a> {
+        let time = g.time().expect("fresh graph");
+        Builder {
+            cx,
+            g,
+            params: Vec::new(),
+            coords: Vec::new(),
+            inputs: Vec::new(),
+            time,
+            frames: Vec::new(),
+            points: Vec::new(),
+            poisoned: Vec::new(),
+            context: String::new(),
+            norms: Vec::new(),
+            divisors: Vec::new(),
+            quaternions: Vec::new(),
+            cut_from,
+            cuts: Vec::new(),
+            rules: RateRules::coordinates(),
+            declared: ast
+                .frames
+                .iter()
+                .map(|f| f.name.clone())
+                .chain(ast.points.iter().map(|p| p.name.clone()))
+                .collect(),
+            origins: ast.origins.clone(),
+        }
+    }
 }
 
 /// Names every model has: the inertial frame, its origin, time.
