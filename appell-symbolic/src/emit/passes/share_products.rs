@@ -23,97 +23,14 @@ pub(super) fn share_products(
     // Parameter-only values are hoisted: they stay whole, and the
     // parameter-only factors of a product stay one (hoisted) product.
     let parameter_only = parameter_only_flags(graph, &insts);
-    let uses = use_counts(&insts, &outputs);
-    let is_mul = |i: u32| matches!(insts[i as usize], Inst::Mul(..));
-    // Interior: a multiplication used once, by a multiplication.
-    let mut interior = vec![false; n];
-    for inst in &insts {
-        if let Inst::Mul(a, b) = *inst {
-            for x in [a, b] {
-                if is_mul(x) && uses[x as usize] == 1 && !parameter_only[x as usize] {
-                    interior[x as usize] = true;
-                }
-            }
-        }
-    }
-    // Leaves of each tree root, as sorted lists; a leaf id >= n stands for
-    // a shared pair created below.
-    let mut roots: Vec<u32> = Vec::new();
-    let mut leaves: Vec<Vec<u32>> = Vec::new();
-    for (i, inst) in insts.iter().enumerate() {
-        if !matches!(inst, Inst::Mul(..)) || interior[i] || parameter_only[i] {
-            continue;
-        }
-        let mut list = Vec::new();
-        let mut stack = vec![i as u32];
-        while let Some(x) = stack.pop() {
-            match insts[x as usize] {
-                Inst::Mul(a, b) if x as usize == i || interior[x as usize] => {
-                    stack.push(a);
-                    stack.push(b);
-                }
-                _ => list.push(x),
-            }
-        }
-        list.sort_unstable();
-        roots.push(i as u32);
-        leaves.push(list);
-    }
-    let mut pairs: Vec<(u32, u32)> = Vec::new();
-    // The parameter-only factors of each tree, as one product.
-    let mut grouped: FxHashMap<Vec<u32>, u32> = FxHashMap::default();
-    for list in leaves.iter_mut() {
-        let (params, mut rest): (Vec<u32>, Vec<u32>) =
-            list.iter().partition(|&&x| parameter_only[x as usize]);
-        if params.len() < 2 {
-            continue;
-        }
-        let mut acc = params[0];
-        for (j, &x) in params.iter().enumerate().skip(1) {
-            let key = params[..=j].to_vec();
-            acc = *grouped.entry(key).or_insert_with(|| {
-                pairs.push((acc, x));
-                (n + pairs.len() - 1) as u32
-            });
-        }
-        rest.push(acc);
-        rest.sort_unstable();
-        *list = rest;
-    }
+    let Trees {
+        interior,
+        roots,
+        mut leaves,
+    } = trees(&insts, &outputs, &parameter_only);
+    let mut pairs = group_parameters(&mut leaves, &parameter_only, n);
     let first = n + pairs.len();
-    let shared = share_pairs(
-        &mut leaves,
-        first,
-        |list| {
-            let mut seen = Vec::new();
-            for x in 0..list.len() {
-                for y in x + 1..list.len() {
-                    seen.push((list[x], list[y]));
-                }
-            }
-            seen
-        },
-        |list, (a, b), id| {
-            let Some(ia) = list.iter().position(|&x| x == a) else {
-                return false;
-            };
-            let ib = if a == b {
-                list.iter()
-                    .skip(ia + 1)
-                    .position(|&x| x == b)
-                    .map(|j| j + ia + 1)
-            } else {
-                list.iter().position(|&x| x == b)
-            };
-            let Some(ib) = ib else { return false };
-            let (hi, lo) = (ia.max(ib), ia.min(ib));
-            list.remove(hi);
-            list.remove(lo);
-            list.push(id);
-            list.sort_unstable();
-            true
-        },
-    );
+    let shared = share_pairs(&mut leaves, first, pairs_of, take_pair);
     pairs.extend(shared);
     if pairs.is_empty() {
         return (insts, outputs);
@@ -146,6 +63,122 @@ pub(super) fn share_products(
             (out.len() - 1) as u32
         })
     })
+}
+
+/// The maximal trees of multiplications of a program.
+struct Trees {
+    /// Whether each instruction is inside a tree: a multiplication used
+    /// once, by a multiplication.
+    interior: Vec<bool>,
+    /// Each tree's root.
+    roots: Vec<u32>,
+    /// Each tree's factors, sorted; an id past the program stands for a
+    /// pair shared later.
+    leaves: Vec<Vec<u32>>,
+}
+
+/// The trees of multiplications of `insts`, parameter-only ones left out.
+fn trees(insts: &[Inst], outputs: &[u32], parameter_only: &[bool]) -> Trees {
+    let n = insts.len();
+    let uses = use_counts(insts, outputs);
+    let is_mul = |i: u32| matches!(insts[i as usize], Inst::Mul(..));
+    let mut interior = vec![false; n];
+    for inst in insts {
+        if let Inst::Mul(a, b) = *inst {
+            for x in [a, b] {
+                if is_mul(x) && uses[x as usize] == 1 && !parameter_only[x as usize] {
+                    interior[x as usize] = true;
+                }
+            }
+        }
+    }
+    let mut roots: Vec<u32> = Vec::new();
+    let mut leaves: Vec<Vec<u32>> = Vec::new();
+    for (i, inst) in insts.iter().enumerate() {
+        if !matches!(inst, Inst::Mul(..)) || interior[i] || parameter_only[i] {
+            continue;
+        }
+        let mut list = Vec::new();
+        let mut stack = vec![i as u32];
+        while let Some(x) = stack.pop() {
+            match insts[x as usize] {
+                Inst::Mul(a, b) if x as usize == i || interior[x as usize] => {
+                    stack.push(a);
+                    stack.push(b);
+                }
+                _ => list.push(x),
+            }
+        }
+        list.sort_unstable();
+        roots.push(i as u32);
+        leaves.push(list);
+    }
+    Trees {
+        interior,
+        roots,
+        leaves,
+    }
+}
+
+/// The parameter-only factors of each tree made one product, built pair
+/// by pair and shared between trees with the same ones: the pairs, each
+/// named `n + k`.
+fn group_parameters(leaves: &mut [Vec<u32>], parameter_only: &[bool], n: usize) -> Vec<(u32, u32)> {
+    let mut pairs: Vec<(u32, u32)> = Vec::new();
+    let mut grouped: FxHashMap<Vec<u32>, u32> = FxHashMap::default();
+    for list in leaves.iter_mut() {
+        let (params, mut rest): (Vec<u32>, Vec<u32>) =
+            list.iter().partition(|&&x| parameter_only[x as usize]);
+        if params.len() < 2 {
+            continue;
+        }
+        let mut acc = params[0];
+        for (j, &x) in params.iter().enumerate().skip(1) {
+            let key = params[..=j].to_vec();
+            acc = *grouped.entry(key).or_insert_with(|| {
+                pairs.push((acc, x));
+                (n + pairs.len() - 1) as u32
+            });
+        }
+        rest.push(acc);
+        rest.sort_unstable();
+        *list = rest;
+    }
+    pairs
+}
+
+/// Every pair of a tree's factors.
+fn pairs_of(list: &[u32]) -> Vec<(u32, u32)> {
+    let mut seen = Vec::new();
+    for x in 0..list.len() {
+        for y in x + 1..list.len() {
+            seen.push((list[x], list[y]));
+        }
+    }
+    seen
+}
+
+/// Replaces the factors `a` and `b` of a tree by the shared pair `id`;
+/// false where the tree does not hold both.
+fn take_pair(list: &mut Vec<u32>, (a, b): (u32, u32), id: u32) -> bool {
+    let Some(ia) = list.iter().position(|&x| x == a) else {
+        return false;
+    };
+    let ib = if a == b {
+        list.iter()
+            .skip(ia + 1)
+            .position(|&x| x == b)
+            .map(|j| j + ia + 1)
+    } else {
+        list.iter().position(|&x| x == b)
+    };
+    let Some(ib) = ib else { return false };
+    let (hi, lo) = (ia.max(ib), ia.min(ib));
+    list.remove(hi);
+    list.remove(lo);
+    list.push(id);
+    list.sort_unstable();
+    true
 }
 
 #[cfg(test)]
