@@ -249,12 +249,7 @@ fn recursive(
             .collect::<Result<_, _>>()?;
         // Held derivatives: the recursion's velocities, accelerations and
         // forces stay single factors in their derivatives too.
-        let mut partials = Vec::with_capacity(forcing.len() * columns.len());
-        for &root in &forcing {
-            for c in columns.all() {
-                partials.push(g.diff_held(root, c)?);
-            }
-        }
+        let partials = derivatives_by(g, &forcing, columns, Graph::diff_held)?;
         let mut at = appell_symbolic::Substitution::new();
         for (&s, &a) in accels.iter().zip(accelerations) {
             at.insert(s, g.hold(a)?);
@@ -393,10 +388,21 @@ fn numeric_partials(
 
 /// ∂root/∂c for every root and column, row-major (one row per root).
 fn derivatives(g: &mut Graph, roots: &[Id], columns: &Columns) -> Result<Vec<Id>, SymbolicError> {
+    derivatives_by(g, roots, columns, Graph::diff)
+}
+
+/// [`derivatives`] taken by `diff` ([`Graph::diff`] or
+/// [`Graph::diff_held`]).
+fn derivatives_by(
+    g: &mut Graph,
+    roots: &[Id],
+    columns: &Columns,
+    diff: fn(&mut Graph, Id, Symbol) -> Result<Id, SymbolicError>,
+) -> Result<Vec<Id>, SymbolicError> {
     let mut out = Vec::with_capacity(roots.len() * columns.len());
     for &root in roots {
         for s in columns.all() {
-            out.push(g.diff(root, s)?);
+            out.push(diff(g, root, s)?);
         }
     }
     Ok(out)

@@ -116,10 +116,7 @@ impl SparseLdlt {
             let mut terms = b[self.order[i]].clone().map(|v| quote!((#v)));
             for k in (0..i).filter(|&k| self.lower[i][k] && z[k]) {
                 let (lik, zk) = (lower_name(i, k), format_ident!("__sz_{}", k));
-                terms = Some(match terms {
-                    Some(t) => quote!(#t - #lik * #zk),
-                    None => quote!(-(#lik * #zk)),
-                });
+                terms = Some(minus(terms, quote!(#lik * #zk)));
                 ops += 2;
             }
             if let Some(t) = terms {
@@ -138,10 +135,7 @@ impl SparseLdlt {
             });
             for k in (i + 1..l).filter(|&k| self.lower[k][i] && y[k]) {
                 let (lki, yk) = (lower_name(k, i), format_ident!("__sy_{}", k));
-                terms = Some(match terms {
-                    Some(t) => quote!(#t - #lki * #yk),
-                    None => quote!(-(#lki * #yk)),
-                });
+                terms = Some(minus(terms, quote!(#lki * #yk)));
                 ops += 2;
             }
             if let Some(t) = terms {
@@ -158,6 +152,14 @@ impl SparseLdlt {
             }
         }
         (out, x, ops)
+    }
+}
+
+/// `terms − product`, or `−(product)` where there are none yet.
+fn minus(terms: Option<TokenStream>, product: TokenStream) -> TokenStream {
+    match terms {
+        Some(t) => quote!(#t - #product),
+        None => quote!(-(#product)),
     }
 }
 
