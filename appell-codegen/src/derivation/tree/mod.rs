@@ -149,11 +149,10 @@ pub struct Residual {
 
 /// The [`Residual`] of `model`'s tree, the coordinates `fixed` (indices)
 /// at zero as in [`structured`]'s accelerations. A free joint's
-/// accelerations come in by the exact inverse of the way
-/// [`structured`]'s go out (see [`free::exact_inverses`]), so that the
-/// residual vanishes at the articulated-body ÿ at every state, a
-/// quaternion off the unit sphere included, and its derivatives are the
-/// rhs's.
+/// accelerations come in by the exact inverse of the way [`structured`]'s
+/// go out (the `free` module's `exact_inverses`), so that the residual
+/// vanishes at the articulated-body ÿ at every state, a quaternion off the
+/// unit sphere included, and its derivatives are the rhs's.
 pub fn residual(model: &mut Model, spec: &TreeSpec, fixed: &[usize]) -> R<Residual> {
     let parts = links::Parts::new(model)?;
     let tree = links::links(&mut model.g, spec, &parts, fixed, links::Index::Speeds)?;
