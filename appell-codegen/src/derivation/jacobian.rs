@@ -159,6 +159,24 @@ impl Jacobians {
     }
 }
 
+/// The rates q̇_r of `d`'s retained coordinates, in state order: the rows
+/// of the Jacobian before ÿ's.
+pub fn retained_rates(d: &Derivation) -> Vec<Id> {
+    d.reduction
+        .retained
+        .iter()
+        .map(|&r| d.map.qdot[r])
+        .collect()
+}
+
+/// The lower triangle (row i, j ≤ i, in row order) of the l×l row-major
+/// `m`.
+pub fn lower_triangle(m: &[Id], l: usize) -> Vec<Id> {
+    (0..l)
+        .flat_map(|i| (0..=i).map(move |j| m[i * l + j]))
+        .collect()
+}
+
 /// The columns of `d`'s Jacobian in `model` as it stands (a scene's speeds
 /// in place).
 pub fn columns(model: &Model, d: &Derivation) -> Columns {
@@ -185,12 +203,7 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
     let closed = closed(g, d, &columns, forced);
     let structured = match &d.structured {
         Ok(s) => {
-            let mut roots: Vec<Id> = d
-                .reduction
-                .retained
-                .iter()
-                .map(|&r| d.map.qdot[r])
-                .collect();
+            let mut roots = retained_rates(d);
             roots.extend(&s.accelerations);
             let allowed = budget(g, &roots, forced);
             within_budget(g, allowed, |g| derivatives(g, &roots, &columns))
@@ -225,17 +238,8 @@ fn recursive(
     let residual = super::tree::residual(model, &spec, &d.reduction.ignorable)
         .map_err(|e| format!("the residual failed: {e}"))?;
     let accels: Vec<Symbol> = model.speed_specs.iter().map(|s| s.accel).collect();
-    let rates: Vec<Id> = d
-        .reduction
-        .retained
-        .iter()
-        .map(|&r| d.map.qdot[r])
-        .collect();
-    let l = d.l;
-    let mass: Vec<Id> = (0..l)
-        .flat_map(|i| (0..=i).map(move |j| (i, j)))
-        .map(|(i, j)| residual.mass[i * l + j])
-        .collect();
+    let rates = retained_rates(d);
+    let mass = lower_triangle(&residual.mass, d.l);
     let g = &mut model.g;
     let mut values = residual.inverse.clone();
     values.extend(&mass);
@@ -295,17 +299,8 @@ fn closed(
     columns: &Columns,
     forced: bool,
 ) -> Result<ClosedJacobian, String> {
-    let l = d.l;
-    let lower: Vec<Id> = (0..l)
-        .flat_map(|i| (0..=i).map(move |j| (i, j)))
-        .map(|(i, j)| d.equations.mass[i * l + j])
-        .collect();
-    let rates: Vec<Id> = d
-        .reduction
-        .retained
-        .iter()
-        .map(|&r| d.map.qdot[r])
-        .collect();
+    let lower = lower_triangle(&d.equations.mass, d.l);
+    let rates = retained_rates(d);
     let mut values: Vec<Id> = lower
         .iter()
         .chain(&d.equations.forcing)

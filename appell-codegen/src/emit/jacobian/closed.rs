@@ -2,12 +2,11 @@
 //! program, M factored once, each column M⁻¹ (∂f − ∂M ÿ); through a numeric
 //! elimination the partials become total derivatives first.
 
-use appell_symbolic::Id;
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
 use super::{Candidate, Layout, Roots};
-use crate::derivation::jacobian::{ClosedJacobian, Jacobians};
+use crate::derivation::jacobian::{lower_triangle, retained_rates, ClosedJacobian, Jacobians};
 use crate::derivation::{singleton_rows, Elimination, NumericElimination};
 use crate::emit::code::{code, Target};
 use crate::emit::solve::Solver;
@@ -18,18 +17,9 @@ impl Emitter<'_> {
     /// written column ∂f (l), ∂q̇ (retained) and ∂M's lower triangle.
     pub(super) fn closed_roots(&self, c: &ClosedJacobian, layout: &Layout, j: &Jacobians) -> Roots {
         let (l, nr, n) = (self.d.l, layout.retained, j.columns.len());
-        let mut roots: Vec<Id> = (0..l)
-            .flat_map(|i| (0..=i).map(move |k| (i, k)))
-            .map(|(i, k)| self.d.equations.mass[i * l + k])
-            .collect();
+        let mut roots = lower_triangle(&self.d.equations.mass, l);
         roots.extend(&self.d.equations.forcing);
-        roots.extend(
-            self.d
-                .reduction
-                .retained
-                .iter()
-                .map(|&r| self.d.map.qdot[r]),
-        );
+        roots.extend(retained_rates(self.d));
         let values = roots.len();
         for &col in &layout.columns {
             roots.extend((0..l).map(|k| c.forcing[k * n + col]));

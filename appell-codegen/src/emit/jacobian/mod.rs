@@ -25,7 +25,7 @@ use quote::quote;
 
 use super::code::{braced, code, Target};
 use super::{int, p, Emitter};
-use crate::derivation::jacobian::{Jacobians, SIZE_LIMIT};
+use crate::derivation::jacobian::{retained_rates, Jacobians, SIZE_LIMIT};
 use crate::derivation::Elimination;
 
 /// The generated `rhs_jacobian` and the `Option<JacobianInfo>` it is
@@ -390,13 +390,7 @@ impl Emitter<'_> {
     fn structured_roots(&self, jac: &[Id], layout: &Layout, j: &Jacobians) -> Roots {
         let n = j.columns.len();
         let s = self.d.structured.as_ref().expect("a structured candidate");
-        let mut roots: Vec<Id> = self
-            .d
-            .reduction
-            .retained
-            .iter()
-            .map(|&r| self.d.map.qdot[r])
-            .collect();
+        let mut roots = retained_rates(self.d);
         roots.extend(&s.accelerations);
         let values = roots.len();
         for row in 0..values {

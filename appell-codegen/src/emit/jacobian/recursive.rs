@@ -10,7 +10,7 @@ use quote::{format_ident, quote};
 
 use super::sparse::SparseLdlt;
 use super::{Candidate, Layout, Roots};
-use crate::derivation::jacobian::{Jacobians, RecursiveJacobian};
+use crate::derivation::jacobian::{retained_rates, Jacobians, RecursiveJacobian};
 use crate::emit::code::{code, Target};
 use crate::emit::{int, Emitter};
 
@@ -26,13 +26,7 @@ impl Emitter<'_> {
         let (l, nr, n) = (self.d.l, layout.retained, j.columns.len());
         let mut roots: Vec<Id> = r.mass.clone();
         roots.extend(&r.accelerations);
-        roots.extend(
-            self.d
-                .reduction
-                .retained
-                .iter()
-                .map(|&k| self.d.map.qdot[k]),
-        );
+        roots.extend(retained_rates(self.d));
         let values = roots.len();
         for &col in &layout.columns {
             roots.extend((0..l).map(|k| r.forcing[k * n + col]));
