@@ -229,7 +229,7 @@ fn trees_agree_with_dual_numbers_and_differences() {
         .jacobian
         .unwrap()
         .form
-        .starts_with("closed form"));
+        .starts_with("inverse dynamics in the world frame"));
 }
 
 #[test]

@@ -127,6 +127,18 @@ pub struct RecursiveJacobian {
     pub rates: Vec<Id>,
 }
 
+/// The world-frame candidate (a tree of one-axis joints; Carpentier and
+/// Mansard's derivatives of recursive Newton–Euler unrolled): ÿ solved by
+/// M's factors, and the reduced rhs's derivatives.
+#[derive(Clone, Debug)]
+pub struct WorldJacobian {
+    /// ÿ = M⁻¹ (τ − h), M by the subtrees' inertias.
+    pub accelerations: Vec<Id>,
+    /// Rows: the retained coordinates' rates, then ÿ; row-major over the
+    /// columns.
+    pub derivatives: Vec<Id>,
+}
+
 /// The derivatives of the reduced rhs (stage 14), and why a candidate is
 /// missing.
 #[derive(Clone, Debug)]
@@ -140,6 +152,9 @@ pub struct Jacobians {
     pub structured: Result<Vec<Id>, String>,
     /// The inverse-dynamics candidate, or why there is none.
     pub recursive: Result<RecursiveJacobian, String>,
+    /// The world frame's candidate (a tree of one-axis joints), or why
+    /// there is none.
+    pub world: Result<WorldJacobian, String>,
     /// For a tree's recursive Newton–Euler inverse dynamics Q(q, u, ÿ):
     /// ∂Q/∂q (l rows, one column per coordinate) then ∂Q/∂u (l × l), each
     /// row-major; or why there is none (set by [`inverse_dynamics`]).
@@ -154,6 +169,7 @@ impl Jacobians {
             closed: Err(reason.to_string()),
             structured: Err(reason.to_string()),
             recursive: Err(reason.to_string()),
+            world: Err(reason.to_string()),
             inverse: Err(reason.to_string()),
         }
     }
@@ -214,11 +230,16 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
         Ok(s) => recursive(model, d, &s.accelerations, &columns, forced),
         Err(_) => Err("no structured form".to_string()),
     };
+    let world = match &d.structured {
+        Ok(_) => world(model, d, &columns),
+        Err(_) => Err("no structured form".to_string()),
+    };
     Jacobians {
         columns,
         closed,
         structured,
         recursive,
+        world,
         inverse: Err("not asked for".to_string()),
     }
 }
@@ -264,6 +285,57 @@ fn recursive(
             forcing: at.apply_all(g, &partials)?,
             rates: derivatives(g, &rates, columns)?,
         })
+    })
+}
+
+/// The world-frame candidate: the tree's inverse-dynamics derivatives
+/// built directly ([`world_derivatives`](super::tree::world::world_derivatives)),
+/// with ÿ solved by M's factors in the same graph, and each column
+/// ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) by those factors. It grows with the
+/// (joint, descendant) pairs and the columns' solves, not by
+/// differentiating, so it has no budget of its own; the graph's limits
+/// still hold.
+fn world(model: &mut Model, d: &Derivation, columns: &Columns) -> Result<WorldJacobian, String> {
+    use super::tree::world::{self, Accelerations};
+    let spec = model.tree.clone()?;
+    world::single_axis(&spec)?;
+    let failed = |e: SymbolicError| format!("the world-frame derivatives failed: {e}");
+    let fixed = &d.reduction.ignorable;
+    let w = world::world_derivatives(model, &spec, fixed, Accelerations::Solved).map_err(failed)?;
+    let factor = w
+        .factor
+        .as_ref()
+        .expect("solved accelerations have M's factors");
+    let (l, n) = (d.l, columns.len());
+    let speeds: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
+    let rates = retained_rates(d);
+    let g = &mut model.g;
+    let mut derivatives = self::derivatives(g, &rates, columns).map_err(failed)?;
+    let mut solved = Vec::with_capacity(n);
+    for c in columns.all() {
+        let mut forcing = Vec::with_capacity(l);
+        for k in 0..l {
+            let entry = if let Some(j) = speeds.iter().position(|&s| s == c) {
+                g.neg(w.by_speeds[k * l + j])
+            } else if let Some(r) = model.coords.iter().position(|x| x.1.q == c) {
+                match w.coordinates.iter().position(|&x| x == r) {
+                    Some(j) => g.neg(w.by_coordinates[k * l + j]),
+                    None => return Err(format!("coordinate {r} is no joint's")),
+                }
+            } else {
+                g.diff(w.inputs[k], c)
+            };
+            forcing.push(entry.map_err(failed)?);
+        }
+        let mut a = super::tree::spatial::Algebra::new(g).map_err(failed)?;
+        solved.push(factor.solve(&mut a, &forcing).map_err(failed)?);
+    }
+    for k in 0..l {
+        derivatives.extend(solved.iter().map(|column| column[k]));
+    }
+    Ok(WorldJacobian {
+        accelerations: w.accelerations,
+        derivatives,
     })
 }
 

@@ -19,6 +19,11 @@ pub struct Link {
     pub parent: Option<usize>,
     /// From the parent link to this one.
     pub transform: Transform,
+    /// From the parent link to the joint frame: `transform` before the
+    /// joint moves.
+    pub frame: Transform,
+    /// A revolute joint's rotation of the child in the joint frame.
+    pub turn: Option<M3>,
     /// The joint's motion subspace in this link's axes: one column per
     /// speed (one for a revolute or prismatic joint, three for a ball).
     pub subspace: Vec<V6>,
@@ -94,7 +99,7 @@ impl Parts {
     }
 
     /// The index of the coordinate named `name`.
-    fn coordinate(&self, name: &str) -> R<usize> {
+    pub(super) fn coordinate(&self, name: &str) -> R<usize> {
         let found = self.coordinate_names.iter().position(|c| c == name);
         found.ok_or_else(|| SymbolicError::UnknownSymbol { name: name.into() })
     }
@@ -182,7 +187,7 @@ pub fn links(
             .iter()
             .map(|s| parts.speed(s, index))
             .collect::<R<Vec<_>>>()?;
-        let (transform, subspace, free) = joint(&mut a, &joint_frame, motion, &q)?;
+        let (transform, subspace, free, turn) = joint(&mut a, &joint_frame, motion, &q)?;
         let input = match parts
             .inputs
             .iter()
@@ -196,6 +201,8 @@ pub fn links(
         out.push(Link {
             parent: moving,
             transform,
+            frame: joint_frame,
+            turn,
             subspace,
             speeds,
             inertia,
@@ -217,8 +224,9 @@ pub fn gravity(g: &mut Graph, spec: &TreeSpec) -> R<V3> {
 }
 
 /// What a joint contributes: its transform from the parent link, its
-/// motion subspace's columns and, for a free joint, its rotation.
-type Joint = (Transform, Vec<V6>, Option<M3>);
+/// motion subspace's columns and, for a free joint, its rotation, for a
+/// revolute joint, its turn.
+type Joint = (Transform, Vec<V6>, Option<M3>, Option<M3>);
 
 /// The joint's transform, subspace and rotation at the coordinates `q`
 /// its motion reads.
@@ -231,7 +239,7 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<Joi
             let rot = a.mat_mul(&frame.rot, &turn)?;
             let s = [u[0], u[1], u[2], zero, zero, zero];
             let pos = frame.pos;
-            Ok((Transform { rot, pos }, vec![s], None))
+            Ok((Transform { rot, pos }, vec![s], None, Some(turn)))
         }
         Motion::Prismatic(axis) => {
             let u = unit_axis(a, axis)?;
@@ -240,20 +248,25 @@ fn joint(a: &mut Algebra, frame: &Transform, motion: &Motion, q: &[Id]) -> R<Joi
             let pos = a.add(frame.pos, slide)?;
             let s = [zero, zero, zero, u[0], u[1], u[2]];
             let rot = frame.rot;
-            Ok((Transform { rot, pos }, vec![s], None))
+            Ok((Transform { rot, pos }, vec![s], None, None))
         }
         Motion::Spherical => {
             let turn = quaternion_rotation(a, [q[0], q[1], q[2], q[3]])?;
             let rot = a.mat_mul(&frame.rot, &turn)?;
             let pos = frame.pos;
-            Ok((Transform { rot, pos }, unit_columns(a, 3)?, None))
+            Ok((Transform { rot, pos }, unit_columns(a, 3)?, None, None))
         }
         Motion::Free => {
             let turn = quaternion_rotation(a, [q[0], q[1], q[2], q[3]])?;
             let rot = a.mat_mul(&frame.rot, &turn)?;
             let slide = a.mat_vec(&frame.rot, [q[4], q[5], q[6]])?;
             let pos = a.add(frame.pos, slide)?;
-            Ok((Transform { rot, pos }, unit_columns(a, 6)?, Some(turn)))
+            Ok((
+                Transform { rot, pos },
+                unit_columns(a, 6)?,
+                Some(turn),
+                None,
+            ))
         }
     }
 }

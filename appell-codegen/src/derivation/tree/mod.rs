@@ -22,6 +22,7 @@ mod links;
 pub mod projected;
 mod recursions;
 pub mod spatial;
+pub mod world;
 
 use appell_symbolic::{Id, SymbolicError};
 

@@ -334,3 +334,95 @@ fn the_residual_vanishes_at_the_articulated_body_accelerations() {
         }
     }
 }
+
+/// A branching tree: two limbs on one base link, one ending in a slide.
+const BRANCHED: &str = r#"
+    #[appell(joint(j_1, revolute(z), parent = N, child = l_1, xyz = [0, 0, 0.3], actuated))]
+    #[appell(joint(j_2, revolute(x), parent = l_1, child = l_2, xyz = [0.2, 0.1, 0], actuated))]
+    #[appell(joint(j_3, revolute([0, 1, 1]), parent = l_2, child = l_3, xyz = [0, 0, 0.4], rpy = [0.2, 0, -0.4]))]
+    #[appell(joint(j_4, revolute(y), parent = l_1, child = l_4, xyz = [-0.2, 0, 0.1], actuated))]
+    #[appell(joint(s_5, prismatic(z), parent = l_4, child = l_5, xyz = [0, 0.1, 0.3]))]
+    #[appell(body(b_1, frame = l_1, mass = 2.0, center = origin(l_1) + 0.05 * l_1.z, inertia = principal(0.05, 0.06, 0.04)))]
+    #[appell(body(b_2, frame = l_2, mass = 1.1, center = origin(l_2) + 0.2 * l_2.z - 0.03 * l_2.y,
+                  inertia = matrix(0.02, 0.025, 0.01, 0.001, 0.0015, -0.002)))]
+    #[appell(body(b_3, frame = l_3, mass = 0.7, center = origin(l_3) + 0.1 * l_3.x, inertia = principal(0.01, 0.02, 0.02)))]
+    #[appell(body(b_4, frame = l_4, mass = m, center = origin(l_4) + 0.15 * l_4.z, inertia = principal(0.03, 0.03, 0.01)))]
+    #[appell(body(b_5, frame = l_5, mass = 0.4, center = origin(l_5) + 0.02 * l_5.x, inertia = principal(0.002, 0.003, 0.004)))]
+    #[appell(gravity(-9.81 * N.z + 0.5 * N.x))]
+    struct Branched { m: f64 }
+"#;
+
+/// The world-frame derivatives of inverse dynamics and its M agree with
+/// the recursive Newton–Euler residual's by differentiation, at random
+/// states and accelerations, on a chain and on a branching tree.
+#[test]
+fn the_world_frame_derivatives_agree_with_differentiation() {
+    for (src, seed) in [(MIXED, 7), (BRANCHED, 11)] {
+        let mut d = derived(src);
+        let spec = d.model.tree.clone().expect("a tree");
+        super::world::single_axis(&spec).expect("one-axis joints");
+        let r = super::residual(&mut d.model, &spec, &[]).expect("residual");
+        let accels: Vec<appell_symbolic::Id> = d
+            .model
+            .speed_specs
+            .iter()
+            .map(|s| d.model.g.sym(s.accel))
+            .collect::<Result<_, _>>()
+            .expect("symbols");
+        let at = super::world::Accelerations::At(&accels);
+        let w = super::world::world_derivatives(&mut d.model, &spec, &[], at)
+            .expect("world derivatives");
+        let solved = super::world::Accelerations::Solved;
+        let forward = super::world::world_derivatives(&mut d.model, &spec, &[], solved)
+            .expect("world derivatives at the forward dynamics' accelerations");
+        let s = structured(&mut d.model, &spec, &[]).expect("structured");
+        let l = d.full.l;
+        let speeds: Vec<_> = d.model.speed_specs.iter().map(|s| s.symbol).collect();
+        let coordinates: Vec<_> = w
+            .coordinates
+            .iter()
+            .map(|&r| d.model.coords[r].1.q)
+            .collect();
+        let mut expected = Vec::new();
+        for i in 0..l {
+            for j in 0..l {
+                let g = &mut d.model.g;
+                let dq = g.diff(r.inverse[i], coordinates[j]).expect("dq");
+                let dv = g.diff(r.inverse[i], speeds[j]).expect("dv");
+                expected.push((i, j, dq, dv));
+            }
+        }
+        let g = &d.model.g;
+        for k in 1..4 {
+            let values = state(&d, seed * 7919 * k);
+            let at: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
+            let value = |e| g.eval_named(e, &at).expect("evaluates");
+            // ÿ by M's factors is the articulated-body algorithm's.
+            for (i, (&ours, &theirs)) in forward
+                .accelerations
+                .iter()
+                .zip(&s.accelerations)
+                .enumerate()
+            {
+                let (a, b) = (value(ours), value(theirs));
+                assert!(
+                    (a - b).abs() < 1e-10 * (1.0 + b.abs()),
+                    "ÿ[{i}]: {a} vs {b}"
+                );
+            }
+            for &(i, j, dq, dv) in &expected {
+                for (what, ours, theirs) in [
+                    ("∂Q/∂q", w.by_coordinates[i * l + j], dq),
+                    ("∂Q/∂v", w.by_speeds[i * l + j], dv),
+                    ("M", w.mass[i * l + j], r.mass[i * l + j]),
+                ] {
+                    let (a, b) = (value(ours), value(theirs));
+                    assert!(
+                        (a - b).abs() < 1e-10 * (1.0 + b.abs()),
+                        "{what}[{i},{j}]: {a} vs {b} (seed {seed})"
+                    );
+                }
+            }
+        }
+    }
+}

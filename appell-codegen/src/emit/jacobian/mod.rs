@@ -143,6 +143,7 @@ enum Kind {
     Closed,
     Structured,
     Recursive,
+    World,
 }
 
 impl Kind {
@@ -156,6 +157,9 @@ impl Kind {
             Kind::Recursive => {
                 "inverse dynamics: recursive Newton–Euler differentiated at the articulated-body ÿ, each column −M⁻¹ ∂R by the factors of M (composite rigid bodies)"
             }
+            Kind::World => {
+                "inverse dynamics in the world frame: recursive Newton–Euler's derivatives by joint pairs (Carpentier and Mansard), ÿ and each column M⁻¹ (∂τ − ∂Q) by the factors of M (subtree inertias)"
+            }
         }
     }
 
@@ -165,6 +169,7 @@ impl Kind {
             Kind::Closed => "the closed form's",
             Kind::Structured => "the structured form's",
             Kind::Recursive => "inverse dynamics'",
+            Kind::World => "the world frame's",
         }
     }
 }
@@ -211,8 +216,9 @@ impl Emitter<'_> {
             let c = why(j.closed.as_ref().map(|_| ()));
             let s = why(j.structured.as_ref().map(|_| ()));
             let r = why(j.recursive.as_ref().map(|_| ()));
+            let w = why(j.world.as_ref().map(|_| ()));
             return self.dual_parts(format!(
-                "closed form: {c}; structured: {s}; inverse dynamics: {r}"
+                "closed form: {c}; structured: {s}; inverse dynamics: {r}; world frame: {w}"
             ));
         }
         // Past the size limits (unless asked for), the rhs in dual numbers:
@@ -246,6 +252,7 @@ impl Emitter<'_> {
                     }
                     Kind::Structured => self.structured_candidate(c.roots, &layout),
                     Kind::Recursive => self.recursive_candidate(c.roots, &layout),
+                    Kind::World => self.structured_candidate(c.roots, &layout),
                 };
                 (c.kind, candidate)
             })
@@ -311,8 +318,8 @@ impl Emitter<'_> {
                 values,
             });
         }
-        if let Ok(s) = &j.structured {
-            let roots = self.structured_roots(s, layout, j);
+        if let (Ok(s), Ok(form)) = (&j.structured, &self.d.structured) {
+            let roots = self.rows_roots(&form.accelerations, s, layout, j);
             let (total, values) = (size(&roots.all), size(&roots.all[..roots.values]));
             out.push(Sized {
                 kind: Kind::Structured,
@@ -327,6 +334,20 @@ impl Emitter<'_> {
             let (total, values) = (size(&roots.all), size(&roots.all[tri..roots.values]));
             out.push(Sized {
                 kind: Kind::Recursive,
+                roots,
+                total,
+                values,
+            });
+        }
+        if let (Ok(w), Ok(form)) = (&j.world, &self.d.structured) {
+            let roots = self.rows_roots(&w.accelerations, &w.derivatives, layout, j);
+            // Against the rhs's values (q̇ and the articulated-body ÿ), not
+            // its own ÿ by M's factors: the limit bounds the code's growth.
+            let mut rhs = retained_rates(self.d);
+            rhs.extend(&form.accelerations);
+            let (total, values) = (size(&roots.all), size(&rhs));
+            out.push(Sized {
+                kind: Kind::World,
                 roots,
                 total,
                 values,
@@ -385,13 +406,19 @@ impl Emitter<'_> {
         }
     }
 
-    /// The structured form's roots: q̇ and ÿ, then their derivatives row
-    /// by row over the written columns.
-    fn structured_roots(&self, jac: &[Id], layout: &Layout, j: &Jacobians) -> Roots {
+    /// The roots of a candidate that computes its rows in one program (the
+    /// structured form, the world frame): q̇ and `accelerations`, then
+    /// the rows of `jac` over the written columns.
+    fn rows_roots(
+        &self,
+        accelerations: &[Id],
+        jac: &[Id],
+        layout: &Layout,
+        j: &Jacobians,
+    ) -> Roots {
         let n = j.columns.len();
-        let s = self.d.structured.as_ref().expect("a structured candidate");
         let mut roots = retained_rates(self.d);
-        roots.extend(&s.accelerations);
+        roots.extend(accelerations);
         let values = roots.len();
         for row in 0..values {
             roots.extend(layout.columns.iter().map(|&col| jac[row * n + col]));
@@ -399,7 +426,8 @@ impl Emitter<'_> {
         Roots { all: roots, values }
     }
 
-    /// The structured form: one program for q̇, ÿ and their derivatives.
+    /// The structured form or the world frame: one program for q̇, ÿ and
+    /// their derivatives.
     fn structured_candidate(&self, roots: Roots, layout: &Layout) -> Candidate {
         let rows = roots.values;
         let mut program = code(&self.model.g, &roots.all, Target::Generic { hoist: false });

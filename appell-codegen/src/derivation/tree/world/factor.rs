@@ -1,0 +1,89 @@
+//! M = L D Lᵀ in the graph, the links taken leaves first so that a tree's
+//! M factors without fill (Featherstone's LTDL order), and solves by it:
+//! ÿ = M⁻¹ (τ − h), and the Jacobian's columns −M⁻¹ ∂R/∂c.
+
+use appell_symbolic::{Id, SymbolicError};
+
+use super::super::links::Link;
+use super::super::spatial::Algebra;
+
+type R<T> = Result<T, SymbolicError>;
+
+/// M's factors over the speeds in elimination order: a link after every
+/// descendant. Every entry is held, so a solve multiplies each once.
+pub struct MassFactor {
+    /// The speed at each position of the elimination order.
+    order: Vec<usize>,
+    /// L below the diagonal in that order, row-major; literal zeros where a
+    /// row's link is not an ancestor of the column's.
+    lower: Vec<Vec<Id>>,
+    /// 1 / dᵢ.
+    reciprocals: Vec<Id>,
+}
+
+impl MassFactor {
+    /// The factors of `mass` (l×l row-major over the speeds of `tree`'s
+    /// one-axis links).
+    pub fn new(a: &mut Algebra, tree: &[Link], mass: &[Id]) -> R<MassFactor> {
+        let l = tree.len();
+        let order: Vec<usize> = tree.iter().rev().map(|k| k.speeds[0]).collect();
+        let m = |i: usize, j: usize| mass[order[i] * l + order[j]];
+        let mut lower = vec![vec![a.zero(); l]; l];
+        let mut pivots = vec![a.zero(); l];
+        let mut reciprocals = vec![a.zero(); l];
+        for j in 0..l {
+            // dⱼ = Mⱼⱼ − Σ Lⱼₖ² dₖ; Lᵢⱼ = (Mᵢⱼ − Σ Lᵢₖ Lⱼₖ dₖ) / dⱼ, with
+            // Lⱼₖ dₖ formed once per k.
+            let mut scaled = vec![None; j];
+            for (k, slot) in scaled.iter_mut().enumerate() {
+                if !a.g.is_zero(lower[j][k]) {
+                    *slot = Some(a.g.mul(lower[j][k], pivots[k])?);
+                }
+            }
+            let taken = a.dot((0..j).filter_map(|k| scaled[k].map(|ld| (ld, lower[j][k]))))?;
+            let pivot = a.g.sub(m(j, j), taken)?;
+            pivots[j] = a.g.hold(pivot)?;
+            let recip = a.g.recip(pivots[j])?;
+            reciprocals[j] = a.g.hold(recip)?;
+            for i in j + 1..l {
+                let taken = a.dot((0..j).filter_map(|k| scaled[k].map(|ld| (ld, lower[i][k]))))?;
+                let rest = a.g.sub(m(i, j), taken)?;
+                if a.g.is_zero(rest) {
+                    continue;
+                }
+                let entry = a.g.mul(rest, reciprocals[j])?;
+                lower[i][j] = a.g.hold(entry)?;
+            }
+        }
+        Ok(MassFactor {
+            order,
+            lower,
+            reciprocals,
+        })
+    }
+
+    /// M⁻¹ b for `b` in speed order, each entry of the result held.
+    pub fn solve(&self, a: &mut Algebra, b: &[Id]) -> R<Vec<Id>> {
+        let l = self.order.len();
+        let mut x: Vec<Id> = self.order.iter().map(|&s| b[s]).collect();
+        for i in 0..l {
+            let taken = a.dot((0..i).map(|k| (self.lower[i][k], x[k])))?;
+            let rest = a.g.sub(x[i], taken)?;
+            x[i] = a.g.hold(rest)?;
+        }
+        for i in 0..l {
+            let scaled = a.dot([(x[i], self.reciprocals[i])])?;
+            x[i] = scaled;
+        }
+        for i in (0..l).rev() {
+            let taken = a.dot((i + 1..l).map(|k| (self.lower[k][i], x[k])))?;
+            let rest = a.g.sub(x[i], taken)?;
+            x[i] = a.g.hold(rest)?;
+        }
+        let mut out = vec![a.zero(); l];
+        for (p, &s) in self.order.iter().enumerate() {
+            out[s] = x[p];
+        }
+        Ok(out)
+    }
+}
