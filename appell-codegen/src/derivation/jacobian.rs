@@ -361,7 +361,50 @@ pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, St
     let forced = model.jacobian == Some(true);
     let g = &mut model.g;
     let allowed = budget(g, &s.inverse, forced);
-    within_budget(g, allowed, |g| derivatives(g, &s.inverse, &columns))
+    let differentiated = within_budget(g, allowed, |g| derivatives(g, &s.inverse, &columns));
+    let Ok(world) = world_inverse_dynamics(model, d) else {
+        return differentiated;
+    };
+    // The one with fewer expressions beside Q's.
+    let size = |g: &Graph, partials: &[Id]| {
+        let mut roots = s.inverse.clone();
+        roots.extend(partials);
+        g.dag_size(&roots)
+    };
+    match differentiated {
+        Ok(p) if size(&model.g, &p) <= size(&model.g, &world) => Ok(p),
+        _ => Ok(world),
+    }
+}
+
+/// [`inverse_dynamics`]' partials by the world frame's derivatives, at the
+/// acceleration symbols (a tree of one-axis joints).
+fn world_inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, String> {
+    use super::tree::world::{self, Accelerations};
+    let spec = model.tree.clone()?;
+    world::single_axis(&spec)?;
+    let failed = |e: SymbolicError| format!("the world-frame derivatives failed: {e}");
+    let accels: Vec<Id> = model
+        .speed_specs
+        .iter()
+        .map(|s| model.g.sym(s.accel))
+        .collect::<Result<_, _>>()
+        .map_err(failed)?;
+    let w =
+        world::world_derivatives(model, &spec, &[], Accelerations::At(&accels)).map_err(failed)?;
+    let (n, l) = (model.coords.len(), d.l);
+    let mut out = Vec::with_capacity(l * (n + l));
+    for i in 0..l {
+        for r in 0..n {
+            let entry = match w.coordinates.iter().position(|&x| x == r) {
+                Some(j) => w.by_coordinates[i * l + j],
+                None => model.g.int(0).map_err(failed)?,
+            };
+            out.push(entry);
+        }
+        out.extend(&w.by_speeds[i * l..(i + 1) * l]);
+    }
+    Ok(out)
 }
 
 /// The closed form's derivatives.
