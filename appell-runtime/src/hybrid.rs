@@ -451,8 +451,12 @@ impl<'a> Hybrid<'a> {
     }
 
     /// Radau5 as the integrator of every phase, for stiff ones (a stiff
-    /// spring, a regularised friction law): the Jacobian of each phase's
-    /// equations by dual numbers, one pass per coordinate and speed.
+    /// spring, a regularised friction law). The Jacobian of each phase's
+    /// equations takes u̇'s rows from the phase model's generated
+    /// [`Model::rhs_jacobian`](crate::Model::rhs_jacobian) where it has one
+    /// (unless [`Radau5::jacobian_by_duals`]), and the rest by dual
+    /// numbers, one pass per coordinate and speed (q̇'s rows only, where
+    /// u̇'s are generated).
     pub fn stiff_solver(mut self, solver: Radau5) -> Self {
         self.integrator = Integrator::Radau5(solver);
         self
@@ -660,7 +664,8 @@ impl<'a> Hybrid<'a> {
             }
             Integrator::Radau5(solver) => {
                 let f = |t: f64, x: &[f64], dx: &mut [f64]| ode.rates(t, x, dx);
-                let jac = |t: f64, x: &[f64], j: &mut [f64]| ode.jacobian(t, x, j);
+                let by_duals = solver.wants_duals();
+                let jac = |t: f64, x: &[f64], j: &mut [f64]| ode.jacobian(t, x, j, by_duals);
                 let sol = solver.solve_until(f, jac, g, now.t, &x0, stop);
                 let sol = first_failure(&failure, sol)?;
                 (sol.t, sol.x, sol.event)
@@ -831,8 +836,57 @@ impl<'p> PhaseOde<'p> {
         Ok(())
     }
 
-    /// ∂ẋ/∂x at `(t, x)` (row-major), one pass in dual numbers per column.
-    fn jacobian(&self, t: f64, x: &[f64], jac: &mut [f64]) -> Result<(), ModelError> {
+    /// ∂ẋ/∂x at `(t, x)` (row-major), the inputs held at their values: u̇'s
+    /// rows by the model's generated [`Model::rhs_jacobian`](crate::Model::rhs_jacobian)
+    /// where it has one and `by_duals` is false (the ignorable
+    /// coordinates' columns are zero: u̇ does not read them), else by dual
+    /// numbers as q̇'s always are ([`PhaseOde::dual_jacobian`]).
+    fn jacobian(
+        &self,
+        t: f64,
+        x: &[f64],
+        jac: &mut [f64],
+        by_duals: bool,
+    ) -> Result<(), ModelError> {
+        if by_duals || !self.prepared.has_generated_jacobian() {
+            return self.dual_jacobian(t, x, jac, true);
+        }
+        let (n, l, r) = (self.n, self.l, self.retained.len());
+        let (m, s) = (n + l, r + l);
+        let (q, u) = (&x[..n], &x[n..m]);
+        let inputs = self.phase.inputs_at(t, q, u)?;
+        let (mut state, mut values) = (vec![0.0; s], vec![0.0; s]);
+        let (mut a, mut b) = (vec![0.0; s * s], vec![0.0; s * inputs.len()]);
+        self.reduce(x, &mut state);
+        if !self
+            .prepared
+            .generated_jacobian(t, &state, &inputs, &mut values, &mut a, &mut b)?
+        {
+            return self.dual_jacobian(t, x, jac, true);
+        }
+        self.dual_jacobian(t, x, jac, false)?;
+        for i in 0..l {
+            let row = &mut jac[(n + i) * m..(n + i + 1) * m];
+            row.fill(0.0);
+            let from = &a[(r + i) * s..(r + i + 1) * s];
+            for (k, &c) in self.retained.iter().enumerate() {
+                row[c] = from[k];
+            }
+            row[n..].copy_from_slice(&from[r..]);
+        }
+        Ok(())
+    }
+
+    /// ∂ẋ/∂x at `(t, x)` (row-major) by one pass in dual numbers per
+    /// column, the inputs held at their values: q̇'s rows, and u̇'s when
+    /// `with_speeds` (else they are left as they are).
+    fn dual_jacobian(
+        &self,
+        t: f64,
+        x: &[f64],
+        jac: &mut [f64],
+        with_speeds: bool,
+    ) -> Result<(), ModelError> {
         let (n, l, r) = (self.n, self.l, self.retained.len());
         let m = n + l;
         let td = Dual64::from_re(t);
@@ -851,17 +905,20 @@ impl<'p> PhaseOde<'p> {
             xd[k].eps = 1.0;
             self.reduce(&xd, &mut state);
             let (q, u) = (&xd[..n], &xd[n..]);
-            let result = self
-                .prepared
-                .rhs_dual(td, &state, &inputs, &mut reduced)
-                .and_then(|()| {
-                    self.phase
-                        .model
-                        .dyn_driven_coordinate_rates_dual(td, q, u, &inputs, &mut qdot)
-                });
+            let speeds = if with_speeds {
+                self.prepared.rhs_dual(td, &state, &inputs, &mut reduced)
+            } else {
+                Ok(())
+            };
+            let result = speeds.and_then(|()| {
+                self.phase
+                    .model
+                    .dyn_driven_coordinate_rates_dual(td, q, u, &inputs, &mut qdot)
+            });
             xd[k].eps = 0.0;
             result?;
-            for (i, v) in qdot.iter().chain(&reduced[r..]).enumerate() {
+            let rows = if with_speeds { m } else { n };
+            for (i, v) in qdot.iter().chain(&reduced[r..]).take(rows).enumerate() {
                 jac[i * m + k] = v.eps;
             }
         }
@@ -879,4 +936,37 @@ fn first_failure<T>(
         return Err(HybridError::Guard(e));
     }
     result.map_err(HybridError::Integrate)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::{Phase, PhaseOde};
+    use crate::__doc_model::Pendulum;
+
+    /// A phase's Jacobian by the generated rhs_jacobian equals the one by
+    /// dual numbers.
+    #[test]
+    fn a_phase_takes_the_generated_jacobian() {
+        let model = Pendulum { g_over_l: 9.81 };
+        let mut phase = Phase::new("swing", &model);
+        phase.inputs = vec![0.4];
+        let ode = PhaseOde::new(&phase);
+        assert!(ode.prepared.has_generated_jacobian());
+        let x = [0.7, -1.3];
+        let (mut generated, mut duals) = ([f64::NAN; 4], [f64::NAN; 4]);
+        ode.jacobian(0.0, &x, &mut generated, false).unwrap();
+        ode.jacobian(0.0, &x, &mut duals, true).unwrap();
+        let expected = [0.0, 1.0, -9.81 * 0.7f64.cos(), 0.0];
+        for (a, b) in generated.iter().zip(&expected) {
+            assert!((a - b).abs() < 1e-14, "{generated:?} against {expected:?}");
+        }
+        for (a, b) in generated.iter().zip(&duals) {
+            assert!((a - b).abs() < 1e-15, "{generated:?} against {duals:?}");
+        }
+        // Without the rhs's passes, u̇'s row is left as it was.
+        let mut untouched = [f64::NAN; 4];
+        ode.dual_jacobian(0.0, &x, &mut untouched, false).unwrap();
+        assert_eq!(untouched[..2], [0.0, 1.0]);
+        assert!(untouched[2..].iter().all(|v| v.is_nan()));
+    }
 }

@@ -413,6 +413,12 @@ impl Radau5 {
         self
     }
 
+    /// Whether [`Radau5::jacobian_by_duals`] is set: for drivers that pass
+    /// their own Jacobian (the hybrid driver's phases).
+    pub(crate) const fn wants_duals(&self) -> bool {
+        self.jacobian_by_duals
+    }
+
     /// The settings checked, or [`IntegrateError::InvalidInput`] saying
     /// what is wrong.
     pub(super) fn check_settings(&self) -> Result<(), IntegrateError> {
