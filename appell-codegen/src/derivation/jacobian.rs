@@ -327,8 +327,27 @@ fn world(model: &mut Model, d: &Derivation, columns: &Columns) -> Result<WorldJa
             };
             forcing.push(entry.map_err(failed)?);
         }
-        let mut a = super::tree::spatial::Algebra::new(g).map_err(failed)?;
-        solved.push(factor.solve(&mut a, &forcing).map_err(failed)?);
+        solved.push(forcing);
+    }
+    let mut a = super::tree::spatial::Algebra::new(g).map_err(failed)?;
+    if factor.is_dense() {
+        // A chain: each column M⁻¹ b by M⁻¹ formed once (its columns are
+        // ∂ÿ/∂τ where the joints are driven) costs what a solve does, and
+        // the driven joints' columns come for free.
+        let inverse = factor.inverse(&mut a).map_err(failed)?;
+        for column in solved.iter_mut() {
+            let mut out = Vec::with_capacity(l);
+            for k in 0..l {
+                let row = (0..l).map(|j| (inverse[k * l + j], column[j]));
+                out.push(a.dot(row).map_err(failed)?);
+            }
+            *column = out;
+        }
+    } else {
+        // A branching tree: solves by the factors, whose zeros they skip.
+        for column in solved.iter_mut() {
+            *column = factor.solve(&mut a, column).map_err(failed)?;
+        }
     }
     for k in 0..l {
         derivatives.extend(solved.iter().map(|column| column[k]));

@@ -376,6 +376,14 @@ fn the_world_frame_derivatives_agree_with_differentiation() {
         let forward = super::world::world_derivatives(&mut d.model, &spec, &[], solved)
             .expect("world derivatives at the forward dynamics' accelerations");
         let s = structured(&mut d.model, &spec, &[]).expect("structured");
+        let factor = forward.factor.as_ref().expect("M's factors");
+        // The chain's factor has no zero below its diagonal; the branching
+        // tree's has, and M⁻¹ by the factors is M's inverse either way.
+        assert_eq!(factor.is_dense(), src == MIXED);
+        let inverse = {
+            let mut a = super::spatial::Algebra::new(&mut d.model.g).expect("algebra");
+            factor.inverse(&mut a).expect("M⁻¹")
+        };
         let l = d.full.l;
         let speeds: Vec<_> = d.model.speed_specs.iter().map(|s| s.symbol).collect();
         let coordinates: Vec<_> = w
@@ -397,6 +405,18 @@ fn the_world_frame_derivatives_agree_with_differentiation() {
             let values = state(&d, seed * 7919 * k);
             let at: Vec<(&str, f64)> = values.iter().map(|(n, v)| (n.as_str(), *v)).collect();
             let value = |e| g.eval_named(e, &at).expect("evaluates");
+            for i in 0..l {
+                for j in 0..l {
+                    let product: f64 = (0..l)
+                        .map(|k| value(forward.mass[i * l + k]) * value(inverse[k * l + j]))
+                        .sum();
+                    let identity = if i == j { 1.0 } else { 0.0 };
+                    assert!(
+                        (product - identity).abs() < 1e-9,
+                        "(M M⁻¹)[{i},{j}] = {product}"
+                    );
+                }
+            }
             // ÿ by M's factors is the articulated-body algorithm's.
             for (i, (&ours, &theirs)) in forward
                 .accelerations

@@ -19,6 +19,8 @@ pub struct MassFactor {
     lower: Vec<Vec<Id>>,
     /// 1 / dᵢ.
     reciprocals: Vec<Id>,
+    /// Whether L has no zero below its diagonal.
+    dense: bool,
 }
 
 impl MassFactor {
@@ -55,10 +57,12 @@ impl MassFactor {
                 lower[i][j] = a.g.hold(entry)?;
             }
         }
+        let dense = (1..l).all(|i| (0..i).all(|k| !a.g.is_zero(lower[i][k])));
         Ok(MassFactor {
             order,
             lower,
             reciprocals,
+            dense,
         })
     }
 
@@ -83,6 +87,49 @@ impl MassFactor {
         let mut out = vec![a.zero(); l];
         for (p, &s) in self.order.iter().enumerate() {
             out[s] = x[p];
+        }
+        Ok(out)
+    }
+}
+
+impl MassFactor {
+    /// Whether L has no zero below its diagonal: M of a chain.
+    pub fn is_dense(&self) -> bool {
+        self.dense
+    }
+
+    /// M⁻¹ = L⁻ᵀ D⁻¹ L⁻¹, l×l row-major in speed order, each entry held
+    /// (symmetric: each formed once).
+    pub fn inverse(&self, a: &mut Algebra) -> R<Vec<Id>> {
+        let l = self.order.len();
+        let one = a.g.int(1)?;
+        // X = L⁻¹, unit lower: Xᵢⱼ = −Σ_{j ≤ k < i} Lᵢₖ Xₖⱼ.
+        let mut x = vec![vec![a.zero(); l]; l];
+        for j in 0..l {
+            x[j][j] = one;
+            for i in j + 1..l {
+                let taken = a.dot((j..i).map(|k| (self.lower[i][k], x[k][j])))?;
+                let entry = a.g.neg(taken)?;
+                x[i][j] = a.g.hold(entry)?;
+            }
+        }
+        // (M⁻¹)ₚₖ = Σ_{k ≥ max(p, q)} Xₖₚ / dₖ Xₖq.
+        let mut scaled = vec![vec![a.zero(); l]; l];
+        for k in 0..l {
+            for p in 0..=k {
+                let entry = a.dot([(x[k][p], self.reciprocals[k])])?;
+                scaled[k][p] = a.g.hold(entry)?;
+            }
+        }
+        let mut out = vec![a.zero(); l * l];
+        for p in 0..l {
+            for q in p..l {
+                let entry = a.dot((q..l).map(|k| (scaled[k][p], x[k][q])))?;
+                let entry = a.g.hold(entry)?;
+                let (sp, sq) = (self.order[p], self.order[q]);
+                out[sp * l + sq] = entry;
+                out[sq * l + sp] = entry;
+            }
         }
         Ok(out)
     }
