@@ -2,8 +2,9 @@
 //! state x = (retained q, ẏ) and the inputs w, for the generated
 //! `rhs_jacobian`.
 //!
-//! Two candidates, each a set of expressions in the model's graph; the
-//! emitter lowers both and keeps the one with fewer operations per call:
+//! Four candidates, each a set of expressions in the model's graph; the
+//! emitter lowers those within its size limits and keeps the one with the
+//! fewest operations per call:
 //!
 //! - **closed**: ∂f/∂x, ∂f/∂w, ∂M/∂x (lower triangle) and ∂q̇_r/∂x. At run
 //!   time ÿ = M⁻¹ f, then ∂ÿ/∂x_j = M⁻¹ (∂f/∂x_j − (∂M/∂x_j) ÿ), with M
@@ -22,6 +23,11 @@
 //!   ∂ÿ/∂x_j = −M⁻¹ ∂R/∂x_j with M by the composite-rigid-body algorithm,
 //!   factored once. No ∂M appears: the recursion's held accelerations
 //!   carry it.
+//! - **world frame** (a plain tree of one-axis joints): the same
+//!   derivatives of inverse dynamics built directly in the world frame
+//!   (Carpentier and Mansard's algorithm unrolled, [`super::tree::world`]),
+//!   ÿ solved from M = Jᵀ Yᶜ J by its factors in the graph, and each
+//!   column ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) there too: one program.
 //!
 //! Each derivative is [`Graph::diff`](appell_symbolic::Graph::diff), which
 //! visits only the subexpressions that depend on the symbol: a joint's
@@ -32,6 +38,7 @@
 
 use appell_symbolic::{Graph, Id, Symbol, SymbolicError};
 
+use super::tree::world::{Accelerations, WorldDerivatives};
 use super::Derivation;
 use crate::model::Model;
 
@@ -230,10 +237,7 @@ pub fn differentiate(model: &mut Model, d: &Derivation) -> Jacobians {
         Ok(s) => recursive(model, d, &s.accelerations, &columns, forced),
         Err(_) => Err("no structured form".to_string()),
     };
-    let world = match &d.structured {
-        Ok(_) => world(model, d, &columns),
-        Err(_) => Err("no structured form".to_string()),
-    };
+    let world = world(model, d, &columns, forced);
     Jacobians {
         columns,
         closed,
@@ -291,76 +295,122 @@ fn recursive(
 /// The world-frame candidate: the tree's inverse-dynamics derivatives
 /// built directly ([`world_derivatives`](super::tree::world::world_derivatives)),
 /// with ÿ solved by M's factors in the same graph, and each column
-/// ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) by those factors. It grows with the
-/// (joint, descendant) pairs and the columns' solves, not by
-/// differentiating, so it has no budget of its own; the graph's limits
-/// still hold.
-fn world(model: &mut Model, d: &Derivation, columns: &Columns) -> Result<WorldJacobian, String> {
-    use super::tree::world::{self, Accelerations};
-    let spec = model.tree.clone()?;
-    world::single_axis(&spec)?;
-    let failed = |e: SymbolicError| format!("the world-frame derivatives failed: {e}");
+/// ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) by those factors (on a chain, by M⁻¹).
+/// Within the budget of a candidate differentiating the rhs's values.
+fn world(
+    model: &mut Model,
+    d: &Derivation,
+    columns: &Columns,
+    forced: bool,
+) -> Result<WorldJacobian, String> {
+    let Ok(s) = &d.structured else {
+        return Err("no structured form".to_string());
+    };
+    super::tree::world::single_axis(model.tree.as_ref()?)?;
+    let mut values = retained_rates(d);
+    values.extend(&s.accelerations);
+    let allowed = budget(&model.g, &values, forced);
     let fixed = &d.reduction.ignorable;
-    let w = world::world_derivatives(model, &spec, fixed, Accelerations::Solved).map_err(failed)?;
+    budgeted(
+        model,
+        |m| &mut m.g,
+        allowed,
+        |model| {
+            let w = world_frame(model, fixed, Accelerations::Solved)?;
+            world_columns(model, d, columns, &w)
+        },
+    )
+}
+
+/// The world frame's derivatives of `model`'s tree, the coordinates
+/// `fixed` at zero, or why there are none (a joint of more than one axis).
+fn world_frame(
+    model: &mut Model,
+    fixed: &[usize],
+    at: Accelerations,
+) -> Result<WorldDerivatives, SymbolicError> {
+    let spec = model
+        .tree
+        .clone()
+        .map_err(|why| SymbolicError::DimensionMismatch {
+            expected: "a tree of joints".to_string(),
+            found: why,
+        })?;
+    super::tree::world::world_derivatives(model, &spec, fixed, at)
+}
+
+/// The reduced rhs's rows and columns from the world frame's `w`: each
+/// column's ∂τ/∂c − ∂Q/∂c solved by M's factors, after the retained
+/// coordinates' rates' derivatives.
+fn world_columns(
+    model: &mut Model,
+    d: &Derivation,
+    columns: &Columns,
+    w: &WorldDerivatives,
+) -> Result<WorldJacobian, SymbolicError> {
     let factor = w
         .factor
         .as_ref()
-        .expect("solved accelerations have M's factors");
+        .ok_or_else(|| SymbolicError::DimensionMismatch {
+            expected: "M's factors".to_string(),
+            found: "accelerations given".to_string(),
+        })?;
     let (l, n) = (d.l, columns.len());
     let speeds: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
     let rates = retained_rates(d);
     let g = &mut model.g;
-    let mut derivatives = self::derivatives(g, &rates, columns).map_err(failed)?;
+    let mut derivatives = self::derivatives(g, &rates, columns)?;
     let mut solved = Vec::with_capacity(n);
     for c in columns.all() {
         let mut forcing = Vec::with_capacity(l);
         for k in 0..l {
             let entry = if let Some(j) = speeds.iter().position(|&s| s == c) {
-                g.neg(w.by_speeds[k * l + j])
+                g.neg(w.by_speeds[k * l + j])?
             } else if let Some(r) = model.coords.iter().position(|x| x.1.q == c) {
                 match w.coordinates.iter().position(|&x| x == r) {
-                    Some(j) => g.neg(w.by_coordinates[k * l + j]),
-                    None => return Err(format!("coordinate {r} is no joint's")),
+                    Some(j) => g.neg(w.by_coordinates[k * l + j])?,
+                    None => g.int(0)?,
                 }
             } else {
-                g.diff(w.inputs[k], c)
+                g.diff(w.inputs[k], c)?
             };
-            forcing.push(entry.map_err(failed)?);
+            forcing.push(entry);
         }
         solved.push(forcing);
     }
-    let mut a = super::tree::spatial::Algebra::new(g).map_err(failed)?;
+    let mut a = super::tree::spatial::Algebra::new(g)?;
     if factor.is_dense() {
         // A chain: each column M⁻¹ b by M⁻¹ formed once (its columns are
         // ∂ÿ/∂τ where the joints are driven) costs what a solve does, and
         // the driven joints' columns come for free.
-        let inverse = factor.inverse(&mut a).map_err(failed)?;
+        let inverse = factor.inverse(&mut a)?;
         for column in solved.iter_mut() {
             let mut out = Vec::with_capacity(l);
             for k in 0..l {
-                let row = (0..l).map(|j| (inverse[k * l + j], column[j]));
-                out.push(a.dot(row).map_err(failed)?);
+                out.push(a.dot((0..l).map(|j| (inverse[k * l + j], column[j])))?);
             }
             *column = out;
         }
     } else {
         // A branching tree: solves by the factors, whose zeros they skip.
         for column in solved.iter_mut() {
-            *column = factor.solve(&mut a, column).map_err(failed)?;
+            *column = factor.solve(&mut a, column)?;
         }
     }
     for k in 0..l {
         derivatives.extend(solved.iter().map(|column| column[k]));
     }
     Ok(WorldJacobian {
-        accelerations: w.accelerations,
+        accelerations: w.accelerations.clone(),
         derivatives,
     })
 }
 
 /// The derivatives of a tree's inverse dynamics Q(q, u, ÿ) by every
 /// coordinate, then every privileged speed (∂Q/∂ÿ is M), for the generated
-/// `inverse_dynamics_derivatives`; within the same budget as the rhs's.
+/// `inverse_dynamics_derivatives`: recursive Newton–Euler differentiated,
+/// or the world frame's derivatives where those have fewer expressions,
+/// each within the same budget as the rhs's.
 pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, String> {
     if model.jacobian == Some(false) {
         return Err("turned off by `jacobian(off)`".to_string());
@@ -381,7 +431,7 @@ pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, St
     let g = &mut model.g;
     let allowed = budget(g, &s.inverse, forced);
     let differentiated = within_budget(g, allowed, |g| derivatives(g, &s.inverse, &columns));
-    let Ok(world) = world_inverse_dynamics(model, d) else {
+    let Ok(world) = world_inverse_dynamics(model, allowed) else {
         return differentiated;
     };
     // The one with fewer expressions beside Q's.
@@ -397,33 +447,35 @@ pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, St
 }
 
 /// [`inverse_dynamics`]' partials by the world frame's derivatives, at the
-/// acceleration symbols (a tree of one-axis joints).
-fn world_inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, String> {
-    use super::tree::world::{self, Accelerations};
-    let spec = model.tree.clone()?;
-    world::single_axis(&spec)?;
-    let failed = |e: SymbolicError| format!("the world-frame derivatives failed: {e}");
-    let accels: Vec<Id> = model
-        .speed_specs
-        .iter()
-        .map(|s| model.g.sym(s.accel))
-        .collect::<Result<_, _>>()
-        .map_err(failed)?;
-    let w =
-        world::world_derivatives(model, &spec, &[], Accelerations::At(&accels)).map_err(failed)?;
-    let (n, l) = (model.coords.len(), d.l);
-    let mut out = Vec::with_capacity(l * (n + l));
-    for i in 0..l {
-        for r in 0..n {
-            let entry = match w.coordinates.iter().position(|&x| x == r) {
-                Some(j) => w.by_coordinates[i * l + j],
-                None => model.g.int(0).map_err(failed)?,
-            };
-            out.push(entry);
-        }
-        out.extend(&w.by_speeds[i * l..(i + 1) * l]);
-    }
-    Ok(out)
+/// acceleration symbols (a tree of one-axis joints), within `allowed` new
+/// expressions.
+fn world_inverse_dynamics(model: &mut Model, allowed: usize) -> Result<Vec<Id>, String> {
+    budgeted(
+        model,
+        |m| &mut m.g,
+        allowed,
+        |model| {
+            let accels: Vec<Id> = model
+                .speed_specs
+                .iter()
+                .map(|s| model.g.sym(s.accel))
+                .collect::<Result<_, _>>()?;
+            let w = world_frame(model, &[], Accelerations::At(&accels))?;
+            let (n, l) = (model.coords.len(), w.coordinates.len());
+            let zero = model.g.int(0)?;
+            let mut out = Vec::with_capacity(l * (n + l));
+            for i in 0..l {
+                for r in 0..n {
+                    out.push(match w.coordinates.iter().position(|&x| x == r) {
+                        Some(j) => w.by_coordinates[i * l + j],
+                        None => zero,
+                    });
+                }
+                out.extend(&w.by_speeds[i * l..(i + 1) * l]);
+            }
+            Ok(out)
+        },
+    )
 }
 
 /// The closed form's derivatives.
@@ -546,14 +598,26 @@ fn within_budget<T>(
     allowed: usize,
     build: impl FnOnce(&mut Graph) -> Result<T, SymbolicError>,
 ) -> Result<T, String> {
+    budgeted(g, |g| g, allowed, build)
+}
+
+/// [`within_budget`] for a `build` that needs more than the graph (`cx`,
+/// whose graph `graph` reaches).
+fn budgeted<C, T>(
+    cx: &mut C,
+    graph: impl Fn(&mut C) -> &mut Graph,
+    allowed: usize,
+    build: impl FnOnce(&mut C) -> Result<T, SymbolicError>,
+) -> Result<T, String> {
+    let g = graph(cx);
     let (before, limits) = (g.len(), g.limits());
     let cap = limits.max_nodes.min(before + allowed);
     g.set_limits(appell_symbolic::Limits {
         max_nodes: cap,
         ..limits
     });
-    let built = build(g);
-    g.set_limits(limits);
+    let built = build(cx);
+    graph(cx).set_limits(limits);
     match built {
         Ok(b) => Ok(b),
         Err(SymbolicError::NodeLimit { limit }) if limit == cap && cap < limits.max_nodes => {

@@ -93,7 +93,8 @@ impl Emitter<'_> {
     }
 
     /// `inverse_dynamics_derivatives`: a tree's recursive Newton–Euler
-    /// differentiated (stage 14's `inverse`) when it has at most
+    /// differentiated, or its world frame's derivatives (stage 14's
+    /// `inverse`, whichever has fewer expressions) when it has at most
     /// [`SIZE_LIMIT`] times the expressions of the recursion (any size with
     /// `jacobian(on)`), else the inverse dynamics in dual numbers; nothing
     /// with `jacobian(off)`.

@@ -420,7 +420,7 @@ fn identity(a: &mut Algebra) -> R<Transform> {
 }
 
 /// `first`, then `second` in `first`'s axes.
-fn compose(a: &mut Algebra, first: &Transform, second: &Transform) -> R<Transform> {
+pub(super) fn compose(a: &mut Algebra, first: &Transform, second: &Transform) -> R<Transform> {
     let rot = a.mat_mul(&first.rot, &second.rot)?;
     let moved = a.mat_vec(&first.rot, second.pos)?;
     let pos = a.add(first.pos, moved)?;

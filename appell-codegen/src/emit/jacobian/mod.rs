@@ -1,13 +1,15 @@
 //! `rhs_jacobian`: the reduced rhs and its Jacobians A = ∂rhs/∂state and
 //! B = ∂rhs/∂inputs in one call, from stage 14's derivatives.
 //!
-//! Of four candidates the cheapest is written: the closed form (one
+//! Of five candidates the cheapest is written: the closed form (one
 //! program for M, f, q̇ and their derivatives; M factored once by LDLᵀ; ÿ,
 //! then each column ∂ÿ/∂c = M⁻¹ (∂f/∂c − (∂M/∂c) ÿ) by the same factors,
 //! [`closed`]), the structured form (one program for the articulated-body
 //! algorithm's ÿ and its derivatives), inverse dynamics (a tree's recursive
 //! Newton–Euler differentiated at the articulated-body ÿ, each column
-//! −M⁻¹ ∂R, [`recursive`]), or dual numbers (the model's own rhs evaluated
+//! −M⁻¹ ∂R, [`recursive`]), the world frame (one program: its derivatives
+//! of inverse dynamics, ÿ and every column solved by M's factors), or dual
+//! numbers (the model's own rhs evaluated
 //! in W-wide dual numbers, ⌈columns / W⌉ times, by the runtime's
 //! `rhs_jacobian_by_duals`: no code of its own). A symbolic one is written
 //! only within a size limit against the rhs's expressions (dual numbers

@@ -6,9 +6,12 @@
 //! In the world frame a coordinate qⱼ moves its whole subtree rigidly:
 //! every world quantity of a descendant changes by the cross product with
 //! the joint's axis Jⱼ, and those changes cancel in τᵢ = Jᵢᵀ fᵢᶜ (fᵢᶜ the
-//! subtree's force) for every i in j's subtree. What is left is the same
-//! for all of them: the change of the velocity and acceleration relative
-//! to the parent, ∂v/∂qⱼ = v_λ × Jⱼ and ∂a/∂qⱼ = a_λ × Jⱼ + v_λ × ∂v/∂qⱼ.
+//! subtree's force) for every i in j's subtree. What is left is the change
+//! of the velocity and acceleration relative to the parent,
+//! ∂v/∂qⱼ = v_λ × Jⱼ and ∂a/∂qⱼ = a_λ × Jⱼ + v_λ × ∂v/∂qⱼ, the same for all
+//! of them, and a term −vᵢ × ∂v/∂qⱼ in each link's acceleration, which the
+//! inertia's variation by the velocity (v ×* Y − Y v×) carries, summed
+//! over the subtree like the inertias.
 //! So each (joint, descendant) pair costs a few 6-dot products against
 //! quantities computed once per link, where differentiating the recursion
 //! column by column repeats a recursion over the subtree per column.
@@ -81,7 +84,8 @@ pub fn single_axis(spec: &TreeSpec) -> Result<(), String> {
 }
 
 /// The [`WorldDerivatives`] of `model`'s tree at `accelerations`, the
-/// coordinates in `fixed` at zero. The tree must pass [`single_axis`].
+/// coordinates in `fixed` at zero; a tree that does not pass
+/// [`single_axis`] is a [`SymbolicError::DimensionMismatch`].
 pub fn world_derivatives(
     model: &mut Model,
     spec: &TreeSpec,
@@ -92,6 +96,18 @@ pub fn world_derivatives(
     let tree = links::links(&mut model.g, spec, &parts, fixed, links::Index::Speeds)?;
     let gravity = links::gravity(&mut model.g, spec)?;
     let size = parts.speeds.len();
+    let one_axis = tree
+        .iter()
+        .all(|k| k.subspace.len() == 1 && k.free.is_none());
+    if let Err(why) = single_axis(spec).and_then(|()| match one_axis && tree.len() == size {
+        true => Ok(()),
+        false => Err("a speed per link".to_string()),
+    }) {
+        return Err(SymbolicError::DimensionMismatch {
+            expected: "a tree of one-axis joints, one speed each".to_string(),
+            found: why,
+        });
+    }
     let coordinates = joint_coordinates(&parts, spec, &tree)?;
     let mut a = Algebra::new(&mut model.g)?;
     let up = [
@@ -278,7 +294,7 @@ fn placement(
     q: Id,
 ) -> R<(Transform, V6)> {
     let frame = match parent {
-        Some(p) => compose(a, p, &link.frame)?,
+        Some(p) => links::compose(a, p, &link.frame)?,
         None => link.frame,
     };
     let frame = hold_transform(a, &frame)?;
@@ -315,14 +331,6 @@ fn hold_transform(a: &mut Algebra, x: &Transform) -> R<Transform> {
         rot: [a.hold(x.rot[0])?, a.hold(x.rot[1])?, a.hold(x.rot[2])?],
         pos: a.hold(x.pos)?,
     })
-}
-
-/// `first`, then `second` in `first`'s axes.
-fn compose(a: &mut Algebra, first: &Transform, second: &Transform) -> R<Transform> {
-    let rot = a.mat_mul(&first.rot, &second.rot)?;
-    let moved = a.mat_vec(&first.rot, second.pos)?;
-    let pos = a.add(first.pos, moved)?;
-    Ok(Transform { rot, pos })
 }
 
 /// One link's subtree sums that do not depend on the accelerations.
