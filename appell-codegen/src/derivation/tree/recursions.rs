@@ -6,7 +6,7 @@
 use appell_symbolic::{Graph, Id, Number, SymbolicError};
 
 use super::links::Link;
-use super::spatial::{join, Algebra, M6, V3, V6};
+use super::spatial::{Algebra, M6, V3, V6};
 
 type R<T> = Result<T, SymbolicError>;
 
@@ -29,17 +29,12 @@ impl<'g, 'l> Recursions<'g, 'l> {
         gravity: V3,
         size: usize,
     ) -> R<Recursions<'g, 'l>> {
-        let a = Algebra::new(g)?;
-        let zero = a.zero();
-        let up = [
-            a.g.neg(gravity[0])?,
-            a.g.neg(gravity[1])?,
-            a.g.neg(gravity[2])?,
-        ];
+        let mut a = Algebra::new(g)?;
+        let ground = a.ground(gravity)?;
         Ok(Recursions {
             a,
             links,
-            ground: join([zero; 3], up),
+            ground,
             size,
         })
     }

@@ -256,6 +256,17 @@ impl<'g> Algebra<'g> {
         Ok(out)
     }
 
+    /// The ground's acceleration under `gravity`: (0, −g), gravity taken
+    /// as an acceleration of the ground (Featherstone's device).
+    pub fn ground(&mut self, gravity: V3) -> R<V6> {
+        let up = [
+            self.g.neg(gravity[0])?,
+            self.g.neg(gravity[1])?,
+            self.g.neg(gravity[2])?,
+        ];
+        Ok(join([self.zero; 3], up))
+    }
+
     /// The spatial inertia about a link's origin of a body of mass `m`,
     /// mass centre `c` and central inertia `ic`, all in the link's axes:
     /// [[Ic − m c̃ c̃, m c̃], [−m c̃, m 1]].

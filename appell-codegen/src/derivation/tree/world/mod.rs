@@ -110,12 +110,7 @@ pub fn world_derivatives(
     }
     let coordinates = joint_coordinates(&parts, spec, &tree)?;
     let mut a = Algebra::new(&mut model.g)?;
-    let up = [
-        a.g.neg(gravity[0])?,
-        a.g.neg(gravity[1])?,
-        a.g.neg(gravity[2])?,
-    ];
-    let ground = join([a.zero(); 3], up);
+    let ground = a.ground(gravity)?;
     let mut q = vec![a.zero(); size];
     for (s, &r) in coordinates.iter().enumerate() {
         if !fixed.contains(&r) {
