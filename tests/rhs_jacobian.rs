@@ -2,7 +2,8 @@
 //! call) against dual numbers through the generated rhs and against central
 //! differences, at random states: trees (the double pendulum and UR5: the
 //! closed form's derivatives; Panda, an 8-link chain and a leg on a free
-//! base with `jacobian(on)`: inverse dynamics differentiated), rolling contacts (the wheel-axle and two of its scenes)
+//! base with `jacobian(on)`: inverse dynamics differentiated; two legs on
+//! a free base: the world frame's derivatives), rolling contacts (the wheel-axle and two of its scenes)
 //! and numeric eliminations of the dependent speeds (the four-bar, the
 //! Chaplygin sleigh, the Whipple bicycle); and the rhs in dual numbers
 //! where the derive writes no symbolic derivatives (the mobile manipulator,
@@ -69,6 +70,28 @@ struct SpatialChain8Derived;
 #[derive(Appell, Clone, Debug, Default)]
 #[appell(urdf("tests/data/one_leg.urdf", base = free), gravity(-9.81 * N.z), jacobian(on))]
 struct OneLeg;
+
+/// Two legs of two joints on a free base, its Jacobian written: the world
+/// frame's candidate with the free root's turns, slides and the
+/// quaternion's scale mapped back (the states' quaternions are off the
+/// unit sphere).
+#[derive(Appell, Clone, Debug, Default)]
+#[appell(joint(base, free, parent = N, child = b))]
+#[appell(joint(hip_l, revolute(y), parent = b, child = thigh_l, xyz = [0, 0.1, -0.05], actuated))]
+#[appell(joint(knee_l, revolute(y), parent = thigh_l, child = shank_l, xyz = [0, 0, -0.2], actuated))]
+#[appell(joint(hip_r, revolute(y), parent = b, child = thigh_r, xyz = [0, -0.1, -0.05], actuated))]
+#[appell(joint(knee_r, revolute(y), parent = thigh_r, child = shank_r, xyz = [0, 0, -0.2], actuated))]
+#[appell(body(trunk, frame = b, mass = 3, center = origin(b) + 0.02 * b.z, inertia = principal(0.03, 0.04, 0.05)))]
+#[appell(body(thigh_l_body, frame = thigh_l, mass = 0.5, center = origin(thigh_l) - 0.1 * thigh_l.z,
+    inertia = principal(0.002, 0.002, 0.0004)))]
+#[appell(body(shank_l_body, frame = shank_l, mass = 0.3, center = origin(shank_l) - 0.1 * shank_l.z,
+    inertia = principal(0.001, 0.001, 0.0002)))]
+#[appell(body(thigh_r_body, frame = thigh_r, mass = 0.5, center = origin(thigh_r) - 0.1 * thigh_r.z,
+    inertia = principal(0.002, 0.002, 0.0004)))]
+#[appell(body(shank_r_body, frame = shank_r, mass = 0.3, center = origin(shank_r) - 0.1 * shank_r.z,
+    inertia = principal(0.001, 0.001, 0.0002)))]
+#[appell(gravity(-9.81 * N.z), jacobian(on))]
+struct TwoLegs;
 
 /// A planar base carrying an arm: a tree small enough for the symbolic
 /// inverse dynamics derivatives, whose rows mix a three-coordinate joint
@@ -221,15 +244,18 @@ fn trees_agree_with_dual_numbers_and_differences() {
     assert_agrees(&Panda, 4);
     assert_agrees(&SpatialChain8Derived, 5);
     assert_agrees(&OneLeg, 9);
+    assert_agrees(&TwoLegs, 10);
     for info in [Panda::info(), SpatialChain8Derived::info(), OneLeg::info()] {
         let j = info.jacobian.unwrap();
         assert!(j.form.starts_with("inverse dynamics"), "{}", j.form);
     }
-    assert!(ur5::Ur5::info()
-        .jacobian
-        .unwrap()
-        .form
-        .starts_with("inverse dynamics in the world frame"));
+    for info in [ur5::Ur5::info(), TwoLegs::info()] {
+        let form = info.jacobian.unwrap().form;
+        assert!(
+            form.starts_with("inverse dynamics in the world frame"),
+            "{form}"
+        );
+    }
 }
 
 #[test]

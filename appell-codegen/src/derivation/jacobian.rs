@@ -341,7 +341,8 @@ fn world_frame(
 
 /// The reduced rhs's rows and columns from the world frame's `w`: each
 /// column's ∂τ/∂c − ∂Q/∂c solved by M's factors, after the retained
-/// coordinates' rates' derivatives.
+/// coordinates' rates' derivatives; a free root's columns and rows mapped
+/// back to e and ṗ ([`free_roots`]).
 fn world_columns(
     model: &mut Model,
     d: &Derivation,
@@ -360,14 +361,14 @@ fn world_columns(
     let rates = retained_rates(d);
     let g = &mut model.g;
     let mut derivatives = self::derivatives(g, &rates, columns)?;
-    let mut solved = Vec::with_capacity(n);
+    let mut solved = Vec::with_capacity(n + 4 * w.roots.len());
     for c in columns.all() {
         let mut forcing = Vec::with_capacity(l);
         for k in 0..l {
             let entry = if let Some(j) = speeds.iter().position(|&s| s == c) {
                 g.neg(w.by_speeds[k * l + j])?
             } else if let Some(r) = model.coords.iter().position(|x| x.1.q == c) {
-                match w.coordinates.iter().position(|&x| x == r) {
+                match w.coordinates.iter().position(|&x| x == Some(r)) {
                     Some(j) => g.neg(w.by_coordinates[k * l + j])?,
                     None => g.int(0)?,
                 }
@@ -377,6 +378,15 @@ fn world_columns(
             forcing.push(entry);
         }
         solved.push(forcing);
+    }
+    // A free root's turns in the body's axes and its gravity's scale.
+    for root in &w.roots {
+        for &j in &root.angular {
+            let column = (0..l).map(|k| g.neg(w.by_coordinates[k * l + j]));
+            solved.push(column.collect::<Result<_, _>>()?);
+        }
+        let column = root.gravity.iter().map(|&x| g.neg(x));
+        solved.push(column.collect::<Result<_, _>>()?);
     }
     let mut a = super::tree::spatial::Algebra::new(g)?;
     if factor.is_dense() {
@@ -397,13 +407,115 @@ fn world_columns(
             *column = factor.solve(&mut a, column)?;
         }
     }
+    let extra = solved.split_off(n);
+    let symbols: Vec<Symbol> = columns.all().collect();
+    let mut accelerations = w.accelerations.clone();
+    let coords: Vec<Symbol> = model.coords.iter().map(|c| c.1.q).collect();
+    let at = Roots {
+        speeds: &speeds,
+        coordinates: &coords,
+        columns: &symbols,
+    };
+    free_roots(&mut a, &at, w, &mut solved, &extra, &mut accelerations)?;
     for k in 0..l {
         derivatives.extend(solved.iter().map(|column| column[k]));
     }
     Ok(WorldJacobian {
-        accelerations: w.accelerations.clone(),
+        accelerations,
         derivatives,
     })
+}
+
+/// The symbols a free root's columns are found by.
+struct Roots<'a> {
+    speeds: &'a [Symbol],
+    coordinates: &'a [Symbol],
+    columns: &'a [Symbol],
+}
+
+/// The reduced rhs's columns and accelerations from the nodes' (`solved`,
+/// in the Jacobian's columns; `extra`, per free root, its three turns and
+/// its gravity's scale): with s = |e|², the rhs's ÿ is S ÿ' for ÿ' the
+/// nodes' (S: s on ṗ's rows), which move at s ṗ under gravity s g. So
+/// ∂/∂ṗ is s ∂/∂ṗ', and the quaternion's columns are the turns by
+/// δθ = 2 vec(e* ⊗ δe) / s plus 2 e times d/ds, where
+/// dÿ'/ds = Σ ∂ÿ'/∂ṗ' ṗ + ∂ÿ'/∂(gravity's scale) / s, and S's own
+/// derivative adds ÿ' on ṗ's rows.
+fn free_roots(
+    a: &mut super::tree::spatial::Algebra,
+    at: &Roots,
+    w: &WorldDerivatives,
+    solved: &mut [Vec<Id>],
+    extra: &[Vec<Id>],
+    accelerations: &mut [Id],
+) -> Result<(), SymbolicError> {
+    let column = |s: Symbol| at.columns.iter().position(|&c| c == s);
+    let l = accelerations.len();
+    for (root, extra) in w.roots.iter().zip(extra.chunks(4)) {
+        let linear: Vec<Option<usize>> =
+            root.linear.iter().map(|&j| column(at.speeds[j])).collect();
+        // dÿ'/ds.
+        let mut radial = Vec::with_capacity(l);
+        let over = a.g.recip(root.scale)?;
+        for i in 0..l {
+            let mut terms = vec![(extra[3][i], over)];
+            for (k, &c) in linear.iter().enumerate() {
+                if let Some(c) = c {
+                    terms.push((solved[c][i], a.g.sym(at.speeds[root.linear[k]])?));
+                }
+            }
+            let sum = a.dot(terms)?;
+            radial.push(a.g.hold(sum)?);
+        }
+        let two = a.g.int(2)?;
+        let twice = a.g.mul(two, over)?;
+        let twice = a.g.hold(twice)?;
+        let (e0, v) = (root.e[0], [root.e[1], root.e[2], root.e[3]]);
+        let mut quaternion = Vec::new();
+        for (k, &r) in root.quaternion.iter().enumerate() {
+            let Some(c) = column(at.coordinates[r]) else {
+                continue;
+            };
+            // δθ for δe along e_k: vec(e* ⊗ δe) = e₀ δv − δe₀ v − v × δv.
+            let turn = if k == 0 {
+                [a.g.neg(v[0])?, a.g.neg(v[1])?, a.g.neg(v[2])?]
+            } else {
+                let mut u = [a.zero(); 3];
+                u[k - 1] = a.g.int(1)?;
+                let along = a.scale(u, e0)?;
+                let across = a.cross(v, u)?;
+                a.sub(along, across)?
+            };
+            let weights: Vec<Id> = turn
+                .iter()
+                .map(|&x| a.g.mul(twice, x))
+                .collect::<Result<_, _>>()?;
+            let scale = a.g.mul(two, root.e[k])?;
+            for i in 0..l {
+                let mut terms: Vec<(Id, Id)> = (0..3).map(|m| (weights[m], extra[m][i])).collect();
+                terms.push((scale, radial[i]));
+                solved[c][i] = a.dot(terms)?;
+            }
+            quaternion.push((c, scale));
+        }
+        for c in linear.into_iter().flatten() {
+            for x in solved[c].iter_mut() {
+                *x = a.g.mul(root.scale, *x)?;
+            }
+        }
+        // S on ṗ's rows, and S's derivative on the quaternion's columns.
+        for &i in &root.linear {
+            for column in solved.iter_mut() {
+                column[i] = a.g.mul(root.scale, column[i])?;
+            }
+            for &(c, scale) in &quaternion {
+                let from_s = a.g.mul(scale, accelerations[i])?;
+                solved[c][i] = a.g.add(solved[c][i], from_s)?;
+            }
+            accelerations[i] = a.g.mul(root.scale, accelerations[i])?;
+        }
+    }
+    Ok(())
 }
 
 /// The derivatives of a tree's inverse dynamics Q(q, u, ÿ) by every
@@ -466,7 +578,7 @@ fn world_inverse_dynamics(model: &mut Model, allowed: usize) -> Result<Vec<Id>, 
             let mut out = Vec::with_capacity(l * (n + l));
             for i in 0..l {
                 for r in 0..n {
-                    out.push(match w.coordinates.iter().position(|&x| x == r) {
+                    out.push(match w.coordinates.iter().position(|&x| x == Some(r)) {
                         Some(j) => w.by_coordinates[i * l + j],
                         None => zero,
                     });
@@ -735,6 +847,91 @@ mod tests {
         for &e in &r.forcing {
             let deps = g.dependencies(e);
             assert!(accels.iter().all(|&s| !deps.contains(s)));
+        }
+    }
+
+    /// A free base (its joint frame placed and turned) carrying a limb of
+    /// two links and a third link, under gravity off the vertical.
+    const FREE_BASE: &str = r#"
+        #[appell(joint(base, free, parent = N, child = b, xyz = [0.1, 0, 0.2], rpy = [0.1, 0.2, -0.3]))]
+        #[appell(joint(j_1, revolute(y), parent = b, child = l_1, xyz = [0.1, 0.05, 0.2], actuated))]
+        #[appell(joint(j_2, revolute(x), parent = l_1, child = l_2, xyz = [0, 0, 0.3], actuated))]
+        #[appell(joint(s_3, prismatic(z), parent = b, child = l_3, xyz = [-0.1, 0, 0.1]))]
+        #[appell(body(base_body, frame = b, mass = m, center = origin(b) + 0.03 * b.x - 0.02 * b.z,
+                      inertia = matrix(0.2, 0.25, 0.3, 0.01, -0.02, 0.015)))]
+        #[appell(body(b_1, frame = l_1, mass = 1.3, center = origin(l_1) + 0.15 * l_1.z,
+                      inertia = principal(0.04, 0.05, 0.02)))]
+        #[appell(body(b_2, frame = l_2, mass = 0.7, center = origin(l_2) + 0.1 * l_2.x + 0.2 * l_2.z,
+                      inertia = principal(0.01, 0.02, 0.015)))]
+        #[appell(body(b_3, frame = l_3, mass = 0.4, center = origin(l_3) + 0.05 * l_3.y,
+                      inertia = principal(0.002, 0.003, 0.004)))]
+        #[appell(gravity(-9.81 * N.z + 0.5 * N.x))]
+        struct FreeBase { m: f64 }
+    "#;
+
+    /// The world frame's candidate on a free root equals the rhs's
+    /// derivatives, the quaternion on the unit sphere and off it: the
+    /// turns, the slides' speeds and the quaternion's scale mapped back.
+    #[test]
+    fn a_free_root_gets_the_world_frame_candidate() {
+        let mut derived = derive_source(FREE_BASE);
+        let j = differentiate(&mut derived.model, &derived.full);
+        let world = j.world.expect("the world frame's candidate");
+        let d = &derived.full;
+        let s = d.structured.as_ref().expect("a structured form");
+        let mut roots = retained_rates(d);
+        roots.extend(&s.accelerations);
+        let expected = derivatives(&mut derived.model.g, &roots, &j.columns).expect("diff");
+        assert_eq!(expected.len(), world.derivatives.len());
+        let g = &derived.model.g;
+        let mut names: Vec<String> = vec!["m".to_string()];
+        names.extend(j.columns.all().map(|c| g.symbol_name(c).to_string()));
+        let mut x = 0x2545_f491_u64;
+        for round in 0..6 {
+            let mut values: Vec<f64> = names
+                .iter()
+                .map(|_| {
+                    x ^= x << 13;
+                    x ^= x >> 7;
+                    x ^= x << 17;
+                    (x % 20000) as f64 / 10000.0 - 1.0
+                })
+                .collect();
+            values[0] = 2.5;
+            let quaternion: Vec<usize> = (0..names.len())
+                .filter(|&k| names[k].starts_with("base_q"))
+                .collect();
+            assert_eq!(quaternion.len(), 4);
+            let norm = quaternion
+                .iter()
+                .map(|&k| values[k] * values[k])
+                .sum::<f64>()
+                .sqrt();
+            // On the sphere, then off it.
+            let radius = if round % 2 == 0 { 1.0 } else { 1.3 };
+            quaternion.iter().for_each(|&k| values[k] *= radius / norm);
+            let at: Vec<(&str, f64)> = names.iter().map(|n| n.as_str()).zip(values).collect();
+            let value = |e| g.eval_named(e, &at).expect("evaluates");
+            for (k, (&ours, &theirs)) in
+                world.accelerations.iter().zip(&s.accelerations).enumerate()
+            {
+                let (a, b) = (value(ours), value(theirs));
+                assert!(
+                    (a - b).abs() < 1e-10 * (1.0 + b.abs()),
+                    "ÿ[{k}]: {a} vs {b}"
+                );
+            }
+            let n = j.columns.len();
+            for (k, (&ours, &theirs)) in world.derivatives.iter().zip(&expected).enumerate() {
+                let (a, b) = (value(ours), value(theirs));
+                assert!(
+                    (a - b).abs() < 1e-9 * (1.0 + b.abs()),
+                    "row {}, column {} ({}), round {round}: {a} vs {b}",
+                    k / n,
+                    k % n,
+                    names[1 + k % n]
+                );
+            }
         }
     }
 

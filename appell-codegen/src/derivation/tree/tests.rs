@@ -389,7 +389,7 @@ fn the_world_frame_derivatives_agree_with_differentiation() {
         let coordinates: Vec<_> = w
             .coordinates
             .iter()
-            .map(|&r| d.model.coords[r].1.q)
+            .map(|&r| d.model.coords[r.expect("a joint coordinate")].1.q)
             .collect();
         let mut expected = Vec::new();
         for i in 0..l {

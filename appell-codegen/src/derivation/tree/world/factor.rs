@@ -4,7 +4,6 @@
 
 use appell_symbolic::{Id, SymbolicError};
 
-use super::super::links::Link;
 use super::super::spatial::Algebra;
 
 type R<T> = Result<T, SymbolicError>;
@@ -24,11 +23,10 @@ pub struct MassFactor {
 }
 
 impl MassFactor {
-    /// The factors of `mass` (l×l row-major over the speeds of `tree`'s
-    /// one-axis links).
-    pub fn new(a: &mut Algebra, tree: &[Link], mass: &[Id]) -> R<MassFactor> {
-        let l = tree.len();
-        let order: Vec<usize> = tree.iter().rev().map(|k| k.speeds[0]).collect();
+    /// The factors of `mass` (l×l row-major over the speeds), eliminated
+    /// in `order`: every speed after the speeds of its subtree.
+    pub fn new(a: &mut Algebra, order: Vec<usize>, mass: &[Id]) -> R<MassFactor> {
+        let l = order.len();
         let m = |i: usize, j: usize| mass[order[i] * l + order[j]];
         let mut lower = vec![vec![a.zero(); l]; l];
         let mut pivots = vec![a.zero(); l];

@@ -23,6 +23,16 @@ pub struct Shaped {
 }
 
 impl Shaped {
+    /// The zero inertia (a massless node).
+    pub fn zero(al: &Algebra) -> Shaped {
+        let z = al.zero();
+        Shaped {
+            m: z,
+            h: [z; 3],
+            a: [[z; 3]; 3],
+        }
+    }
+
     /// Y x = (A x_ω + h × x_ν, x_ω × h + m x_ν).
     pub fn apply(&self, al: &mut Algebra, x: V6) -> R<V6> {
         let (w, v) = split(x);

@@ -26,23 +26,29 @@
 
 mod factor;
 mod inertia;
+mod nodes;
 
 use appell_symbolic::{Id, SymbolicError};
 
-use super::links::{self, Link, Parts};
-use super::spatial::{join, split, Algebra, Transform, V6};
+use super::links::{self, Parts};
+use super::spatial::{Algebra, V6};
 use crate::model::tree::{Motion, TreeSpec};
 use crate::model::Model;
 pub use factor::MassFactor;
 use inertia::Shaped;
+pub use nodes::FreeRoot;
+use nodes::Node;
 
 type R<T> = Result<T, SymbolicError>;
 
 /// ∂Q/∂q, ∂Q/∂ẏ and M of a tree's inverse dynamics Q(q, ẏ, ÿ), each l×l
-/// row-major, rows and columns in speed order: column j is the speed of
-/// the link whose joint has speed j, or that joint's coordinate.
+/// row-major, rows and columns in speed order: column j is the speed j,
+/// or the change of the coordinates that moves along speed j's axis (its
+/// joint's coordinate, a slide, or a free joint's turn in the body's axes).
+/// With free roots, Q is that of the bodies the nodes describe: speeds
+/// s ṗ, gravity s g (see [`FreeRoot`]).
 pub struct WorldDerivatives {
-    /// ∂Qᵢ/∂q of the coordinate of speed j's joint.
+    /// ∂Qᵢ/∂q along speed j's axis.
     pub by_coordinates: Vec<Id>,
     /// ∂Qᵢ/∂ẏⱼ.
     pub by_speeds: Vec<Id>,
@@ -51,13 +57,15 @@ pub struct WorldDerivatives {
     /// The joints' inputs as generalized forces τ (0 where a joint is not
     /// actuated), in speed order.
     pub inputs: Vec<Id>,
-    /// The index among the model's coordinates of each speed's joint
-    /// coordinate, in speed order.
-    pub coordinates: Vec<usize>,
+    /// The coordinate moving along each speed's axis, by index among the
+    /// model's (None for a free joint's turn), in speed order.
+    pub coordinates: Vec<Option<usize>>,
     /// The accelerations the derivatives are taken at.
     pub accelerations: Vec<Id>,
     /// With [`Accelerations::Solved`], M's factors.
     pub factor: Option<MassFactor>,
+    /// The free joints at the root.
+    pub roots: Vec<FreeRoot>,
 }
 
 /// Where the accelerations come from.
@@ -69,14 +77,16 @@ pub enum Accelerations<'a> {
 }
 
 /// Why `spec` has no world-frame derivatives, if it has not: every moving
-/// joint must turn or slide about one axis.
+/// joint must turn or slide about one axis, but a free joint at the root.
 pub fn single_axis(spec: &TreeSpec) -> Result<(), String> {
-    let several = |k: &&crate::model::tree::LinkSpec| {
-        matches!(k.motion, Some(Motion::Spherical) | Some(Motion::Free))
+    let several = |k: &&crate::model::tree::LinkSpec| match k.motion {
+        Some(Motion::Spherical) => true,
+        Some(Motion::Free) => k.parent.is_some(),
+        _ => false,
     };
     match spec.links.iter().find(several) {
         Some(k) => Err(format!(
-            "joint `{}` has more than one axis, so no world-frame derivatives",
+            "joint `{}` has more than one axis below the root, so no world-frame derivatives",
             k.joint
         )),
         None => Ok(()),
@@ -85,7 +95,8 @@ pub fn single_axis(spec: &TreeSpec) -> Result<(), String> {
 
 /// The [`WorldDerivatives`] of `model`'s tree at `accelerations`, the
 /// coordinates in `fixed` at zero; a tree that does not pass
-/// [`single_axis`] is a [`SymbolicError::DimensionMismatch`].
+/// [`single_axis`], or has a free root and given accelerations, is a
+/// [`SymbolicError::DimensionMismatch`].
 pub fn world_derivatives(
     model: &mut Model,
     spec: &TreeSpec,
@@ -96,88 +107,127 @@ pub fn world_derivatives(
     let tree = links::links(&mut model.g, spec, &parts, fixed, links::Index::Speeds)?;
     let gravity = links::gravity(&mut model.g, spec)?;
     let size = parts.speeds.len();
-    let one_axis = tree
-        .iter()
-        .all(|k| k.subspace.len() == 1 && k.free.is_none());
-    if let Err(why) = single_axis(spec).and_then(|()| match one_axis && tree.len() == size {
-        true => Ok(()),
-        false => Err("a speed per link".to_string()),
-    }) {
+    if let Err(why) = single_axis(spec) {
         return Err(SymbolicError::DimensionMismatch {
-            expected: "a tree of one-axis joints, one speed each".to_string(),
+            expected: "a tree of one-axis joints, or a free joint at its root".to_string(),
             found: why,
         });
     }
-    let coordinates = joint_coordinates(&parts, spec, &tree)?;
     let mut a = Algebra::new(&mut model.g)?;
+    let mut world = nodes::world_tree(&mut a, &tree, spec, &parts, fixed)?;
+    if matches!(accelerations, Accelerations::At(_)) && !world.roots.is_empty() {
+        return Err(SymbolicError::DimensionMismatch {
+            expected: "accelerations to solve for".to_string(),
+            found: "a free root and given accelerations".to_string(),
+        });
+    }
+    let tree = &world.nodes;
     let ground = a.ground(gravity)?;
-    let mut q = vec![a.zero(); size];
-    for (s, &r) in coordinates.iter().enumerate() {
-        if !fixed.contains(&r) {
-            q[s] = parts.coordinates[r];
+    let grounds = grounds(&mut a, tree, &world.roots, ground)?;
+    let mut inputs = vec![a.zero(); size];
+    for node in tree {
+        for (c, &s) in node.speeds.iter().enumerate() {
+            inputs[s] = node.inputs[c];
         }
     }
-    let mut inputs = vec![a.zero(); size];
-    for link in &tree {
-        inputs[link.speeds[0]] = link.inputs[0];
-    }
-    let kin = kinematics(&mut a, &tree, &q, &parts.speeds)?;
-    let composite = composites(&mut a, &tree, &kin)?;
-    let mass = mass(&mut a, &tree, &kin, &composite, size)?;
+    let kin = kinematics(&mut a, tree, &world.speeds)?;
+    let composite = composites(&mut a, tree, &kin)?;
+    let mass = mass(&mut a, tree, &kin, &composite, size)?;
     let (accelerations, factor) = match accelerations {
         Accelerations::At(given) => (given.to_vec(), None),
         Accelerations::Solved => {
             let resting = vec![a.zero(); size];
-            let acc = accelerate(&mut a, &tree, &kin, ground, &resting)?;
-            let forces = subtree_forces(&mut a, &tree, &acc)?;
+            let acc = accelerate(&mut a, tree, &kin, &grounds, &resting)?;
+            let forces = subtree_forces(&mut a, tree, &acc)?;
             let mut free = vec![a.zero(); size];
-            for (i, link) in tree.iter().enumerate() {
-                let h = a.dot((0..6).map(|k| (kin[i].axis[k], forces[i][k])))?;
-                free[link.speeds[0]] = a.g.sub(inputs[link.speeds[0]], h)?;
+            for (i, node) in tree.iter().enumerate() {
+                for (c, &s) in node.speeds.iter().enumerate() {
+                    let h = a.dot((0..6).map(|k| (kin[i].axes[c][k], forces[i][k])))?;
+                    free[s] = a.g.sub(inputs[s], h)?;
+                }
             }
-            let factor = MassFactor::new(&mut a, &tree, &mass)?;
+            let order = tree
+                .iter()
+                .rev()
+                .flat_map(|n| n.speeds.iter().rev().copied());
+            let factor = MassFactor::new(&mut a, order.collect(), &mass)?;
             (factor.solve(&mut a, &free)?, Some(factor))
         }
     };
-    let acc = accelerate(&mut a, &tree, &kin, ground, &accelerations)?;
-    let forces = subtree_forces(&mut a, &tree, &acc)?;
+    for (r, root) in world.roots.iter_mut().enumerate() {
+        root.gravity = gravity_term(&mut a, tree, &kin, &composite, &grounds, r, size)?;
+    }
+    let acc = accelerate(&mut a, tree, &kin, &grounds, &accelerations)?;
+    let forces = subtree_forces(&mut a, tree, &acc)?;
     let sub = subtree(&mut a, &kin, &composite, &acc, &forces)?;
     let mut out = WorldDerivatives {
         by_coordinates: vec![a.zero(); size * size],
         by_speeds: vec![a.zero(); size * size],
         mass,
         inputs,
-        coordinates,
+        coordinates: world.coordinates,
         accelerations,
         factor,
+        roots: world.roots,
     };
-    pairs(&mut a, &tree, &kin, &composite, &acc, &sub, &mut out)?;
+    pairs(&mut a, tree, &kin, &composite, &acc, &sub, &mut out)?;
     Ok(out)
 }
 
-/// Each speed's joint coordinate, by the moving links in order.
-fn joint_coordinates(parts: &Parts, spec: &TreeSpec, tree: &[Link]) -> R<Vec<usize>> {
-    let mut out = vec![0; parts.speeds.len()];
-    let moving = spec.links.iter().filter(|k| k.motion.is_some());
-    for (link, written) in tree.iter().zip(moving) {
-        out[link.speeds[0]] = parts.coordinate(&written.coordinates[0])?;
+/// The ground's acceleration under each node without a parent: (0, −g),
+/// or (0, −s g) under a free root.
+fn grounds(a: &mut Algebra, tree: &[Node], roots: &[FreeRoot], ground: V6) -> R<Vec<V6>> {
+    let mut out = Vec::with_capacity(tree.len());
+    for node in tree {
+        out.push(match (node.parent, node.root) {
+            (None, Some(r)) => a.scale(ground, roots[r].scale)?,
+            _ => ground,
+        });
     }
     Ok(out)
 }
 
-/// One link's world quantities that do not depend on the accelerations.
+/// The gravity term of the free root `r`'s subtree, Jᵢ · Yᶜᵢ a₀ with a₀
+/// its ground's acceleration, in speed order (zero elsewhere).
+fn gravity_term(
+    a: &mut Algebra,
+    tree: &[Node],
+    kin: &[Kinematics],
+    composite: &[Composite],
+    grounds: &[V6],
+    r: usize,
+    size: usize,
+) -> R<Vec<Id>> {
+    let top = tree
+        .iter()
+        .position(|n| n.parent.is_none() && n.root == Some(r));
+    let ground = grounds[top.expect("a free root's node")];
+    let mut out = vec![a.zero(); size];
+    for (i, node) in tree.iter().enumerate() {
+        if node.root != Some(r) {
+            continue;
+        }
+        let force = composite[i].inertia.apply(a, ground)?;
+        for (c, &s) in node.speeds.iter().enumerate() {
+            out[s] = a.dot((0..6).map(|k| (kin[i].axes[c][k], force[k])))?;
+        }
+    }
+    Ok(out)
+}
+
+/// One node's world quantities that do not depend on the accelerations.
 struct Kinematics {
-    /// The joint's axis Jᵢ: its motion subspace in world axes about the
-    /// world origin.
-    axis: V6,
+    /// The columns' axes Jᵢ.
+    axes: Vec<V6>,
     /// The parent's velocity v_λ (zero for the ground).
     parent_velocity: V6,
-    /// The joint's velocity Jᵢ ẏᵢ.
+    /// The joint's velocity Σ Jᵢ ẏᵢ.
     joint: V6,
-    /// ∂v/∂qᵢ relative to the parent: v_λ × Jᵢ.
-    dv_dq: V6,
-    /// ∂a/∂ẏᵢ relative to the parent: 2 v_λ × Jᵢ.
-    da_dv: V6,
+    /// ∂v/∂q along each column, relative to the parent: v_λ × Jᵢ.
+    dv_dq: Vec<V6>,
+    /// ∂a/∂ẏ of each column relative to the parent: v_λ × Jᵢ + v × Jᵢ
+    /// (2 v_λ × Jᵢ for one column).
+    da_dv: Vec<V6>,
     /// The world inertia Yᵢ.
     inertia: Shaped,
     /// Its variation by the velocity: v ×* Y − Y v× (symmetric).
@@ -188,29 +238,45 @@ struct Kinematics {
     gyroscopic: V6,
 }
 
-/// The forward pass over the placements and velocities.
-fn kinematics(a: &mut Algebra, tree: &[Link], q: &[Id], speeds: &[Id]) -> R<Vec<Kinematics>> {
+/// The forward pass over the velocities, at `speeds` (speed order).
+fn kinematics(a: &mut Algebra, tree: &[Node], speeds: &[Id]) -> R<Vec<Kinematics>> {
     let zero6 = [a.zero(); 6];
-    let mut placed: Vec<(Transform, V6)> = Vec::with_capacity(tree.len());
+    let mut velocities: Vec<V6> = Vec::with_capacity(tree.len());
     let mut out = Vec::with_capacity(tree.len());
-    for link in tree {
-        let v_parent = link.parent.map_or(zero6, |p| placed[p].1);
-        let s = link.speeds[0];
-        let (world, axis) = placement(a, link, link.parent.map(|p| &placed[p].0), q[s])?;
-        let joint = a.scale(axis, speeds[s])?;
+    for node in tree {
+        let v_parent = node.parent.map_or(zero6, |p| velocities[p]);
+        let mut joint = a.scale(node.axes[0], speeds[node.speeds[0]])?;
+        for (axis, &s) in node.axes.iter().zip(&node.speeds).skip(1) {
+            let along = a.scale(*axis, speeds[s])?;
+            joint = a.add(joint, along)?;
+        }
         let v = a.add(v_parent, joint)?;
         let v = a.hold(v)?;
-        let dv_dq = a.cross_motion(v_parent, axis)?;
-        let dv_dq = a.hold(dv_dq)?;
-        let da_dv = a.add(dv_dq, dv_dq)?;
-        let inertia = Shaped::placed(a, &link.inertia, &world)?.hold(a)?;
+        let mut dv_dq = Vec::with_capacity(node.axes.len());
+        let mut da_dv = Vec::with_capacity(node.axes.len());
+        for &axis in &node.axes {
+            let turned = a.cross_motion(v_parent, axis)?;
+            let turned = a.hold(turned)?;
+            dv_dq.push(turned);
+            da_dv.push(match node.axes.len() {
+                1 => a.add(turned, turned)?,
+                _ => {
+                    let own = a.cross_motion(v, axis)?;
+                    a.add(turned, own)?
+                }
+            });
+        }
+        let inertia = match &node.inertia {
+            Some(y) => Shaped::placed(a, y, &node.world)?.hold(a)?,
+            None => Shaped::zero(a),
+        };
         let momentum = inertia.apply(a, v)?;
         let momentum = a.hold(momentum)?;
         let gyroscopic = a.cross_force(v, momentum)?;
         let variation = inertia.variation(a, v)?;
-        placed.push((world, v));
+        velocities.push(v);
         out.push(Kinematics {
-            axis,
+            axes: node.axes.clone(),
             parent_velocity: v_parent,
             joint,
             dv_dq,
@@ -224,50 +290,54 @@ fn kinematics(a: &mut Algebra, tree: &[Link], q: &[Id], speeds: &[Id]) -> R<Vec<
     Ok(out)
 }
 
-/// One link's acceleration-dependent quantities.
+/// One node's acceleration-dependent quantities.
 struct Accelerated {
-    /// ∂a/∂qᵢ relative to the parent: a_λ × Jᵢ + v_λ × ∂v/∂qᵢ.
-    da_dq: V6,
+    /// ∂a/∂q along each column, relative to the parent:
+    /// a_λ × Jᵢ + v_λ × ∂v/∂qᵢ.
+    da_dq: Vec<V6>,
     /// The force Y a + v ×* h, gravity in a.
     force: V6,
 }
 
 /// The forward pass over the accelerations, at `accels` (speed order),
-/// gravity as the ground's acceleration `ground`.
+/// gravity as the ground's acceleration under each root (`grounds`).
 fn accelerate(
     a: &mut Algebra,
-    tree: &[Link],
+    tree: &[Node],
     kin: &[Kinematics],
-    ground: V6,
+    grounds: &[V6],
     accels: &[Id],
 ) -> R<Vec<Accelerated>> {
     let mut acc: Vec<V6> = Vec::with_capacity(tree.len());
     let mut out = Vec::with_capacity(tree.len());
-    for (i, link) in tree.iter().enumerate() {
-        let a_parent = link.parent.map_or(ground, |p| acc[p]);
+    for (i, node) in tree.iter().enumerate() {
+        let a_parent = node.parent.map_or(grounds[i], |p| acc[p]);
         let k = &kin[i];
-        let s = link.speeds[0];
         let bias = a.cross_motion(k.parent_velocity, k.joint)?;
-        let along = a.scale(k.axis, accels[s])?;
-        let sum = a.add(a_parent, along)?;
+        let mut sum = a_parent;
+        for (axis, &s) in k.axes.iter().zip(&node.speeds) {
+            let along = a.scale(*axis, accels[s])?;
+            sum = a.add(sum, along)?;
+        }
         let sum = a.add(sum, bias)?;
         let here = a.hold(sum)?;
-        let turned = a.cross_motion(a_parent, k.axis)?;
-        let carried = a.cross_motion(k.parent_velocity, k.dv_dq)?;
-        let da_dq = a.add(turned, carried)?;
+        let mut da_dq = Vec::with_capacity(k.axes.len());
+        for (axis, dv) in k.axes.iter().zip(&k.dv_dq) {
+            let turned = a.cross_motion(a_parent, *axis)?;
+            let carried = a.cross_motion(k.parent_velocity, *dv)?;
+            let sum = a.add(turned, carried)?;
+            da_dq.push(a.hold(sum)?);
+        }
         let ya = k.inertia.apply(a, here)?;
         let force = a.add(ya, k.gyroscopic)?;
         acc.push(here);
-        out.push(Accelerated {
-            da_dq: a.hold(da_dq)?,
-            force,
-        });
+        out.push(Accelerated { da_dq, force });
     }
     Ok(out)
 }
 
 /// Each subtree's force fᶜ, summed leaves first and held.
-fn subtree_forces(a: &mut Algebra, tree: &[Link], acc: &[Accelerated]) -> R<Vec<V6>> {
+fn subtree_forces(a: &mut Algebra, tree: &[Node], acc: &[Accelerated]) -> R<Vec<V6>> {
     let mut force: Vec<V6> = acc.iter().map(|x| x.force).collect();
     for i in (0..tree.len()).rev() {
         force[i] = a.hold(force[i])?;
@@ -278,57 +348,7 @@ fn subtree_forces(a: &mut Algebra, tree: &[Link], acc: &[Accelerated]) -> R<Vec<
     Ok(force)
 }
 
-/// A link's world placement and its joint's axis Jᵢ there, from its
-/// parent's (None: the ground) and its joint coordinate `q`: the joint
-/// frame placed first (a constant transform), then the joint's turn or
-/// slide, so that a coordinate axis leaves a column of the placed frame.
-fn placement(
-    a: &mut Algebra,
-    link: &Link,
-    parent: Option<&Transform>,
-    q: Id,
-) -> R<(Transform, V6)> {
-    let frame = match parent {
-        Some(p) => links::compose(a, p, &link.frame)?,
-        None => link.frame,
-    };
-    let frame = hold_transform(a, &frame)?;
-    let (w, v) = split(link.subspace[0]);
-    let zero = [a.zero(); 3];
-    let (world, axis) = match link.turn {
-        Some(turn) => {
-            let rot = a.mat_mul(&frame.rot, &turn)?;
-            let along = a.mat_vec(&frame.rot, w)?;
-            let moment = a.cross(frame.pos, along)?;
-            let world = Transform {
-                rot,
-                pos: frame.pos,
-            };
-            (world, join(along, moment))
-        }
-        None => {
-            let along = a.mat_vec(&frame.rot, v)?;
-            let slide = a.scale(along, q)?;
-            let pos = a.add(frame.pos, slide)?;
-            let world = Transform {
-                rot: frame.rot,
-                pos,
-            };
-            (world, join(zero, along))
-        }
-    };
-    Ok((hold_transform(a, &world)?, a.hold(axis)?))
-}
-
-/// Every entry held.
-fn hold_transform(a: &mut Algebra, x: &Transform) -> R<Transform> {
-    Ok(Transform {
-        rot: [a.hold(x.rot[0])?, a.hold(x.rot[1])?, a.hold(x.rot[2])?],
-        pos: a.hold(x.pos)?,
-    })
-}
-
-/// One link's subtree sums that do not depend on the accelerations.
+/// One node's subtree sums that do not depend on the accelerations.
 struct Composite {
     /// Yᶜ.
     inertia: Shaped,
@@ -336,17 +356,17 @@ struct Composite {
     variation: Shaped,
     /// hᶜ.
     momentum: V6,
-    /// Yᶜ Jᵢ.
-    inertia_axis: V6,
-    /// (∂(v ×* Y v)/∂v − Y v×)ᶜᵀ Jᵢ = Bᶜ Jᵢ − Jᵢ ×* hᶜ.
-    variation_axis: V6,
-    /// ∂fᶜ/∂ẏᵢ: Yᶜ ∂a/∂ẏᵢ + Bᶜ Jᵢ + Jᵢ ×* hᶜ.
-    by_speed: V6,
+    /// Yᶜ Jᵢ, per column.
+    inertia_axis: Vec<V6>,
+    /// (∂(v ×* Y v)/∂v − Y v×)ᶜᵀ Jᵢ = Bᶜ Jᵢ − Jᵢ ×* hᶜ, per column.
+    variation_axis: Vec<V6>,
+    /// ∂fᶜ/∂ẏᵢ: Yᶜ ∂a/∂ẏᵢ + Bᶜ Jᵢ + Jᵢ ×* hᶜ, per column.
+    by_speed: Vec<V6>,
 }
 
 /// The backward pass over the inertias: the subtrees' inertia, variation
-/// and momentum summed leaves first, and each link's vectors.
-fn composites(a: &mut Algebra, tree: &[Link], kin: &[Kinematics]) -> R<Vec<Composite>> {
+/// and momentum summed leaves first, and each column's vectors.
+fn composites(a: &mut Algebra, tree: &[Node], kin: &[Kinematics]) -> R<Vec<Composite>> {
     let n = tree.len();
     let mut inertia: Vec<Shaped> = kin.iter().map(|k| k.inertia).collect();
     let mut variation: Vec<Shaped> = kin.iter().map(|k| k.variation).collect();
@@ -360,108 +380,135 @@ fn composites(a: &mut Algebra, tree: &[Link], kin: &[Kinematics]) -> R<Vec<Compo
             variation[p] = variation[p].add(a, &b)?;
             momentum[p] = a.add(momentum[p], h)?;
         }
-        let j = kin[i].axis;
-        let inertia_axis = y.apply(a, j)?;
-        let bj = b.apply(a, j)?;
-        let jh = a.cross_force(j, h)?;
-        let variation_axis = a.sub(bj, jh)?;
-        let by_speed = {
-            let ya = y.apply(a, kin[i].da_dv)?;
-            let sum = a.add(ya, bj)?;
-            a.add(sum, jh)?
-        };
-        out[i] = Some(Composite {
+        let mut c = Composite {
             inertia: y,
             variation: b,
             momentum: h,
-            inertia_axis: a.hold(inertia_axis)?,
-            variation_axis: a.hold(variation_axis)?,
-            by_speed: a.hold(by_speed)?,
-        });
+            inertia_axis: Vec::new(),
+            variation_axis: Vec::new(),
+            by_speed: Vec::new(),
+        };
+        for (&j, &da_dv) in kin[i].axes.iter().zip(&kin[i].da_dv) {
+            let inertia_axis = y.apply(a, j)?;
+            let bj = b.apply(a, j)?;
+            let jh = a.cross_force(j, h)?;
+            let variation_axis = a.sub(bj, jh)?;
+            let by_speed = {
+                let ya = y.apply(a, da_dv)?;
+                let sum = a.add(ya, bj)?;
+                a.add(sum, jh)?
+            };
+            c.inertia_axis.push(a.hold(inertia_axis)?);
+            c.variation_axis.push(a.hold(variation_axis)?);
+            c.by_speed.push(a.hold(by_speed)?);
+        }
+        out[i] = Some(c);
     }
-    Ok(out.into_iter().map(|s| s.expect("every link")).collect())
+    Ok(out.into_iter().map(|s| s.expect("every node")).collect())
+}
+
+/// The (row, column) pairs of speeds whose entries couple: each column of
+/// node i with each column of i's ancestors-or-self, as (i, c, k, d):
+/// column c of node i, column d of node k. Within a node each pair once
+/// for d ≤ c when `triangle`, else every pair.
+fn couplings(tree: &[Node], triangle: bool) -> Vec<(usize, usize, usize, usize)> {
+    let mut out = Vec::new();
+    for i in 0..tree.len() {
+        for c in 0..tree[i].speeds.len() {
+            let mut j = Some(i);
+            while let Some(k) = j {
+                let columns = match (k == i, triangle) {
+                    (true, true) => c + 1,
+                    _ => tree[k].speeds.len(),
+                };
+                out.extend((0..columns).map(|d| (i, c, k, d)));
+                j = tree[k].parent;
+            }
+        }
+    }
+    out
 }
 
 /// M, l×l row-major: Mᵢⱼ = Jⱼ · Yᶜᵢ Jᵢ for j an ancestor-or-self of i.
 fn mass(
     a: &mut Algebra,
-    tree: &[Link],
+    tree: &[Node],
     kin: &[Kinematics],
     composite: &[Composite],
     size: usize,
 ) -> R<Vec<Id>> {
     let mut m = vec![a.zero(); size * size];
-    for i in 0..tree.len() {
-        let row = tree[i].speeds[0];
-        let mut j = Some(i);
-        while let Some(k) = j {
-            let col = tree[k].speeds[0];
-            let x = kin[k].axis;
-            let y = composite[i].inertia_axis;
-            let entry = a.dot((0..6).map(|r| (x[r], y[r])))?;
-            m[row * size + col] = entry;
-            m[col * size + row] = entry;
-            j = tree[k].parent;
-        }
+    for (i, c, k, d) in couplings(tree, true) {
+        let (row, col) = (tree[i].speeds[c], tree[k].speeds[d]);
+        let x = kin[k].axes[d];
+        let y = composite[i].inertia_axis[c];
+        let entry = a.dot((0..6).map(|r| (x[r], y[r])))?;
+        m[row * size + col] = entry;
+        m[col * size + row] = entry;
     }
     Ok(m)
 }
 
-/// ∂fᶜ/∂qᵢ of each subtree: Jᵢ ×* fᶜ + Yᶜ ∂a/∂qᵢ + Bᶜ ∂v/∂qᵢ + ∂v/∂qᵢ ×* hᶜ.
+/// ∂fᶜ/∂q along each column of each subtree:
+/// Jᵢ ×* fᶜ + Yᶜ ∂a/∂qᵢ + Bᶜ ∂v/∂qᵢ + ∂v/∂qᵢ ×* hᶜ.
 fn subtree(
     a: &mut Algebra,
     kin: &[Kinematics],
     composite: &[Composite],
     acc: &[Accelerated],
     forces: &[V6],
-) -> R<Vec<V6>> {
+) -> R<Vec<Vec<V6>>> {
     let mut out = Vec::with_capacity(kin.len());
     for (i, c) in composite.iter().enumerate() {
-        let jf = a.cross_force(kin[i].axis, forces[i])?;
-        let ya = c.inertia.apply(a, acc[i].da_dq)?;
-        let bv = c.variation.apply(a, kin[i].dv_dq)?;
-        let vh = a.cross_force(kin[i].dv_dq, c.momentum)?;
-        let sum = a.add(jf, ya)?;
-        let sum = a.add(sum, bv)?;
-        let sum = a.add(sum, vh)?;
-        out.push(a.hold(sum)?);
+        let mut columns = Vec::with_capacity(kin[i].axes.len());
+        for (col, &axis) in kin[i].axes.iter().enumerate() {
+            let jf = a.cross_force(axis, forces[i])?;
+            let ya = c.inertia.apply(a, acc[i].da_dq[col])?;
+            let bv = c.variation.apply(a, kin[i].dv_dq[col])?;
+            let vh = a.cross_force(kin[i].dv_dq[col], c.momentum)?;
+            let sum = a.add(jf, ya)?;
+            let sum = a.add(sum, bv)?;
+            let sum = a.add(sum, vh)?;
+            columns.push(a.hold(sum)?);
+        }
+        out.push(columns);
     }
     Ok(out)
 }
 
-/// The entries: for link i and each ancestor-or-self j,
-/// ∂Qᵢ/∂qⱼ = Yᶜᵢ Jᵢ · ∂a/∂qⱼ + (B Jᵢ)ᶜ · ∂v/∂qⱼ and the like by ẏⱼ; for j a
-/// strict ancestor also ∂Qⱼ/∂qᵢ = Jⱼ · ∂fᶜᵢ/∂qᵢ and the like by ẏᵢ.
+/// The entries: for column c of node i and each column d of an
+/// ancestor-or-self k, ∂Q_c/∂q_d = Yᶜᵢ J_c · ∂a/∂q_d + (B J_c)ᶜ · ∂v/∂q_d
+/// and the like by ẏ_d (zero by a free root's slides' speeds); for k a
+/// strict ancestor also ∂Q_d/∂q_c = J_d · ∂fᶜᵢ/∂q_c and the like by ẏ_c.
 fn pairs(
     a: &mut Algebra,
-    tree: &[Link],
+    tree: &[Node],
     kin: &[Kinematics],
     composite: &[Composite],
     acc: &[Accelerated],
-    by_coordinate: &[V6],
+    by_coordinate: &[Vec<V6>],
     out: &mut WorldDerivatives,
 ) -> R<()> {
     let size = out.coordinates.len();
     let dot = |a: &mut Algebra, x: V6, y: V6| a.dot((0..6).map(|k| (x[k], y[k])));
-    for i in 0..tree.len() {
-        let row = tree[i].speeds[0];
-        let c = &composite[i];
-        let mut j = Some(i);
-        while let Some(k) = j {
-            let col = tree[k].speeds[0];
-            let ya = dot(a, c.inertia_axis, acc[k].da_dq)?;
-            let bv = dot(a, c.variation_axis, kin[k].dv_dq)?;
-            out.by_coordinates[row * size + col] = a.g.add(ya, bv)?;
-            let ya = dot(a, c.inertia_axis, kin[k].da_dv)?;
-            let bj = dot(a, c.variation_axis, kin[k].axis)?;
+    for (i, c, k, d) in couplings(tree, false) {
+        let (row, col) = (tree[i].speeds[c], tree[k].speeds[d]);
+        let (inertia_axis, variation_axis) =
+            (composite[i].inertia_axis[c], composite[i].variation_axis[c]);
+        let ya = dot(a, inertia_axis, acc[k].da_dq[d])?;
+        let bv = dot(a, variation_axis, kin[k].dv_dq[d])?;
+        out.by_coordinates[row * size + col] = a.g.add(ya, bv)?;
+        if !tree[k].slides {
+            let ya = dot(a, inertia_axis, kin[k].da_dv[d])?;
+            let bj = dot(a, variation_axis, kin[k].axes[d])?;
             out.by_speeds[row * size + col] = a.g.add(ya, bj)?;
-            if k != i {
-                let dq = dot(a, kin[k].axis, by_coordinate[i])?;
-                out.by_coordinates[col * size + row] = dq;
-                let dv = dot(a, kin[k].axis, c.by_speed)?;
-                out.by_speeds[col * size + row] = dv;
-            }
-            j = tree[k].parent;
+        }
+        if k != i {
+            let axis = kin[k].axes[d];
+            let dq = dot(a, axis, by_coordinate[i][c])?;
+            out.by_coordinates[col * size + row] = dq;
+            let dv = dot(a, axis, composite[i].by_speed[c])?;
+            out.by_speeds[col * size + row] = dv;
         }
     }
     Ok(())
