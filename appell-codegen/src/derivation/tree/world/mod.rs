@@ -1,7 +1,8 @@
 //! The derivatives of recursive Newton–Euler by the coordinates and the
 //! speeds, in the world frame (Carpentier and Mansard, "Analytical
 //! derivatives of rigid body dynamics algorithms", RSS 2018), unrolled
-//! over a tree of one-axis joints with constants folded.
+//! over a tree of one-axis joints with constants folded; a free joint at
+//! the root is two nodes of three columns each (the `nodes` module).
 //!
 //! In the world frame a coordinate qⱼ moves its whole subtree rigidly:
 //! every world quantity of a descendant changes by the cross product with
