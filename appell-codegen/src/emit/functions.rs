@@ -93,8 +93,9 @@ impl Emitter<'_> {
             solve_x_and_w: self.elimination(true),
             solve_x: self.elimination(false),
         };
-        let jacobian = self.jacobian(&common);
-        let rhs = self.rhs(&common, &jacobian);
+        let (rhs, form, articulated) = self.rhs(&common);
+        let jacobian = self.jacobian(&common, articulated);
+        let rhs = self.rhs_info(rhs, &form, &jacobian);
         let jacobian_fn = &jacobian.function;
         let info = &rhs.info;
         let (info_ident, name) = (&self.info_ident, &self.type_name);

@@ -63,14 +63,11 @@ struct Factors {
 }
 
 impl Emitter<'_> {
-    /// `prepare`, `rhs` and the `ModelInfo` (which counts the rhs's
-    /// operations and names the form): the structured form where the model
-    /// has one and it costs fewer operations per call, else the closed form.
-    pub(super) fn rhs(
-        &self,
-        common: &super::functions::Common,
-        jacobian: &super::jacobian::JacobianParts,
-    ) -> RhsParts {
+    /// `prepare` and `rhs` (their `info` left empty for [`Self::rhs_info`]),
+    /// the form's description, and whether it is the articulated-body
+    /// algorithm's: the structured form where the model has one and it
+    /// costs fewer operations per call, else the closed form.
+    pub(super) fn rhs(&self, common: &super::functions::Common) -> (RhsParts, String, bool) {
         if let (false, Ok(s)) = (self.d.closed_form, &self.d.structured) {
             let chosen = self.structured_rhs(common, &s.accelerations);
             let form = format!(
@@ -78,8 +75,7 @@ impl Emitter<'_> {
                 chosen.ops.total(),
                 crate::derivation::tree::STRUCTURED_ONLY_LINKS
             );
-            let info = self.info(chosen.ops, chosen.extra, &form, jacobian);
-            return RhsParts { info, ..chosen };
+            return (chosen, form, true);
         }
         let flat = self.flat_rhs(common);
         let flat_total = flat.ops.total() + flat.extra;
@@ -89,8 +85,7 @@ impl Emitter<'_> {
             } else {
                 format!("closed form: {} operations for M and f per call against the projected joint tree's {}", pr.closed_ops, pr.ops)
             };
-            let info = self.info(flat.ops, flat.extra, &form, jacobian);
-            return RhsParts { info, ..flat };
+            return (flat, form, false);
         }
         if !self.d.closed_form {
             // A large tree's scene: M and f from the tree's recursions, for
@@ -101,29 +96,40 @@ impl Emitter<'_> {
             } else {
                 format!("structured: M by the composite-rigid-body algorithm and f by recursive Newton–Euler over the joint tree, solved by LDLᵀ, {flat_total} operations per call")
             };
-            let info = self.info(flat.ops, flat.extra, &form, jacobian);
-            return RhsParts { info, ..flat };
+            return (flat, form, false);
         }
-        let (chosen, form) = match &self.d.structured {
+        let (chosen, form, structured) = match &self.d.structured {
             Ok(s) if matches!(self.d.elimination, Elimination::Symbolic) => {
                 let structured = self.structured_rhs(common, &s.accelerations);
                 let total = structured.ops.total();
                 if total < flat_total {
                     let form = format!("structured: the articulated-body algorithm over the joint tree, {total} operations per call against the closed form's {flat_total}");
-                    (structured, form)
+                    (structured, form, true)
                 } else {
                     let form = format!("closed form: {flat_total} operations per call against the structured form's {total}");
-                    (flat, form)
+                    (flat, form, false)
                 }
             }
-            Ok(_) => (flat, "closed form".to_string()),
-            Err(reason) if reason.is_empty() => (flat, "closed form".to_string()),
+            Ok(_) => (flat, "closed form".to_string(), false),
+            Err(reason) if reason.is_empty() => (flat, "closed form".to_string(), false),
             Err(reason) => (
                 flat,
                 format!("closed form ({reason}, so no structured form)"),
+                false,
             ),
         };
-        let info = self.info(chosen.ops, chosen.extra, &form, jacobian);
+        (chosen, form, structured)
+    }
+
+    /// The chosen rhs with its `ModelInfo`, which counts its operations,
+    /// names its form and says which Jacobian was written.
+    pub(super) fn rhs_info(
+        &self,
+        chosen: RhsParts,
+        form: &str,
+        jacobian: &super::jacobian::JacobianParts,
+    ) -> RhsParts {
+        let info = self.info(chosen.ops, chosen.extra, form, jacobian);
         RhsParts { info, ..chosen }
     }
 

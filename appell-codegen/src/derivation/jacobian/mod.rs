@@ -137,12 +137,15 @@ pub struct RecursiveJacobian {
     pub rates: Vec<Id>,
 }
 
-/// The world-frame candidate (a tree of one-axis joints; Carpentier and
-/// Mansard's derivatives of recursive Newton–Euler unrolled): ÿ solved by
-/// M's factors, and the reduced rhs's derivatives.
+/// The world-frame candidate (a tree of one-axis joints, on a fixed or a
+/// free root; Carpentier and Mansard's derivatives of recursive
+/// Newton–Euler unrolled): ÿ solved by M's factors, and the reduced rhs's
+/// derivatives.
 #[derive(Clone, Debug)]
 pub struct WorldJacobian {
-    /// ÿ = M⁻¹ (τ − h), M by the subtrees' inertias.
+    /// ÿ = M⁻¹ (τ − h), M by the subtrees' inertias (a free root's ṗ rows
+    /// scaled as the rhs reads its quaternion, see
+    /// [`FreeRoot`](super::tree::world::FreeRoot)).
     pub accelerations: Vec<Id>,
     /// Rows: the retained coordinates' rates, then ÿ; row-major over the
     /// columns.
@@ -162,8 +165,8 @@ pub struct Jacobians {
     pub structured: Result<Vec<Id>, String>,
     /// The inverse-dynamics candidate, or why there is none.
     pub recursive: Result<RecursiveJacobian, String>,
-    /// The world frame's candidate (a tree of one-axis joints), or why
-    /// there is none.
+    /// The world frame's candidate (a tree of one-axis joints, on a fixed
+    /// or a free root), or why there is none.
     pub world: Result<WorldJacobian, String>,
     /// For a tree's recursive Newton–Euler inverse dynamics Q(q, u, ÿ):
     /// ∂Q/∂q (l rows, one column per coordinate) then ∂Q/∂u (l × l), each

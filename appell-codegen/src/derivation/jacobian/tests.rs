@@ -117,7 +117,19 @@ const FREE_BASE: &str = r#"
 /// turns, the slides' speeds and the quaternion's scale mapped back.
 #[test]
 fn a_free_root_gets_the_world_frame_candidate() {
-    let mut derived = derive_source(FREE_BASE);
+    // The same robot, and on a free joint below a link welded to the ground.
+    let welded = FREE_BASE.replace(
+        "joint(base, free, parent = N, child = b, ",
+        "joint(mount, weld, parent = N, child = m_0, xyz = [0, 0, 1]))]\n#[appell(joint(base, free, parent = m_0, child = b, ",
+    );
+    assert_ne!(welded, FREE_BASE);
+    for src in [FREE_BASE, welded.as_str()] {
+        free_root_agrees(src);
+    }
+}
+
+fn free_root_agrees(src: &str) {
+    let mut derived = derive_source(src);
     let j = differentiate(&mut derived.model, &derived.full);
     let world = j.world.expect("the world frame's candidate");
     let d = &derived.full;

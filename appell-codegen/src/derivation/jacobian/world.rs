@@ -41,7 +41,8 @@ pub(super) fn world(
 }
 
 /// The world frame's derivatives of `model`'s tree, the coordinates
-/// `fixed` at zero, or why there are none (a joint of more than one axis).
+/// `fixed` at zero, or why there are none (a joint of more than one axis
+/// below the root; a free root with the accelerations given).
 fn world_frame(
     model: &mut Model,
     fixed: &[usize],
@@ -129,8 +130,7 @@ fn world_columns(
     let symbols: Vec<Symbol> = columns.all().collect();
     let mut accelerations = w.accelerations.clone();
     let coords: Vec<Symbol> = model.coords.iter().map(|c| c.1.q).collect();
-    let at = Roots {
-        speeds: &speeds,
+    let at = Symbols {
         coordinates: &coords,
         columns: &symbols,
     };
@@ -145,8 +145,7 @@ fn world_columns(
 }
 
 /// The symbols a free root's columns are found by.
-struct Roots<'a> {
-    speeds: &'a [Symbol],
+struct Symbols<'a> {
     coordinates: &'a [Symbol],
     columns: &'a [Symbol],
 }
@@ -154,14 +153,14 @@ struct Roots<'a> {
 /// The reduced rhs's columns and accelerations from the nodes' (`solved`,
 /// in the Jacobian's columns; `extra`, per free root, its three turns and
 /// its gravity's scale): with s = |e|², the rhs's ÿ is S ÿ' for ÿ' the
-/// nodes' (S: s on ṗ's rows), which move at s ṗ under gravity s g. So
-/// ∂/∂ṗ is s ∂/∂ṗ', and the quaternion's columns are the turns by
-/// δθ = 2 vec(e* ⊗ δe) / s plus 2 e times d/ds, where
-/// dÿ'/ds = Σ ∂ÿ'/∂ṗ' ṗ + ∂ÿ'/∂(gravity's scale) / s, and S's own
-/// derivative adds ÿ' on ṗ's rows.
+/// nodes' (S: s on ṗ's rows), which move at s ṗ under gravity s g. The
+/// quaternion's columns are the turns by δθ = 2 vec(e* ⊗ δe) / s plus
+/// 2 e times d/ds: dÿ'/ds = ∂ÿ'/∂(gravity's scale) / s (the speeds s ṗ
+/// add nothing: ∂ÿ'/∂ṗ' is zero, a boost changing no force), and S's own
+/// derivative adds ÿ' on ṗ's rows. The columns by ṗ are zero.
 fn free_roots(
     a: &mut super::super::tree::spatial::Algebra,
-    at: &Roots,
+    at: &Symbols,
     w: &WorldDerivatives,
     solved: &mut [Vec<Id>],
     extra: &[Vec<Id>],
@@ -170,20 +169,12 @@ fn free_roots(
     let column = |s: Symbol| at.columns.iter().position(|&c| c == s);
     let l = accelerations.len();
     for (root, extra) in w.roots.iter().zip(extra.chunks(4)) {
-        let linear: Vec<Option<usize>> =
-            root.linear.iter().map(|&j| column(at.speeds[j])).collect();
         // dÿ'/ds.
-        let mut radial = Vec::with_capacity(l);
         let over = a.g.recip(root.scale)?;
-        for i in 0..l {
-            let mut terms = vec![(extra[3][i], over)];
-            for (k, &c) in linear.iter().enumerate() {
-                if let Some(c) = c {
-                    terms.push((solved[c][i], a.g.sym(at.speeds[root.linear[k]])?));
-                }
-            }
-            let sum = a.dot(terms)?;
-            radial.push(a.g.hold(sum)?);
+        let mut radial = Vec::with_capacity(l);
+        for &x in &extra[3] {
+            let scaled = a.g.mul(x, over)?;
+            radial.push(a.g.hold(scaled)?);
         }
         let two = a.g.int(2)?;
         let twice = a.g.mul(two, over)?;
@@ -208,26 +199,21 @@ fn free_roots(
                 .iter()
                 .map(|&x| a.g.mul(twice, x))
                 .collect::<Result<_, _>>()?;
-            let scale = a.g.mul(two, root.e[k])?;
+            let doubled = a.g.mul(two, root.e[k])?;
             for i in 0..l {
                 let mut terms: Vec<(Id, Id)> = (0..3).map(|m| (weights[m], extra[m][i])).collect();
-                terms.push((scale, radial[i]));
+                terms.push((doubled, radial[i]));
                 solved[c][i] = a.dot(terms)?;
             }
-            quaternion.push((c, scale));
-        }
-        for c in linear.into_iter().flatten() {
-            for x in solved[c].iter_mut() {
-                *x = a.g.mul(root.scale, *x)?;
-            }
+            quaternion.push((c, doubled));
         }
         // S on ṗ's rows, and S's derivative on the quaternion's columns.
         for &i in &root.linear {
             for column in solved.iter_mut() {
                 column[i] = a.g.mul(root.scale, column[i])?;
             }
-            for &(c, scale) in &quaternion {
-                let from_s = a.g.mul(scale, accelerations[i])?;
+            for &(c, doubled) in &quaternion {
+                let from_s = a.g.mul(doubled, accelerations[i])?;
                 solved[c][i] = a.g.add(solved[c][i], from_s)?;
             }
             accelerations[i] = a.g.mul(root.scale, accelerations[i])?;
@@ -237,7 +223,7 @@ fn free_roots(
 }
 
 /// [`inverse_dynamics`]' partials by the world frame's derivatives, at the
-/// acceleration symbols (a tree of one-axis joints), within `allowed` new
+/// acceleration symbols (a tree of one-axis joints on a fixed root), within `allowed` new
 /// expressions.
 pub(super) fn world_inverse_dynamics(model: &mut Model, allowed: usize) -> Result<Vec<Id>, String> {
     budgeted(

@@ -193,7 +193,13 @@ impl Emitter<'_> {
     /// `jacobian(on)`), the one with the fewest operations per call once
     /// lowered; where none is left, or stage 14 has no candidate, the rhs
     /// in dual numbers; nothing with `jacobian(off)`.
-    pub(super) fn jacobian(&self, common: &super::functions::Common) -> JacobianParts {
+    /// `articulated`: whether the rhs written is the articulated-body
+    /// algorithm's (else the closed form's).
+    pub(super) fn jacobian(
+        &self,
+        common: &super::functions::Common,
+        articulated: bool,
+    ) -> JacobianParts {
         if self.model.jacobian == Some(false) {
             return JacobianParts {
                 function: TokenStream::new(),
@@ -213,6 +219,11 @@ impl Emitter<'_> {
         };
         let layout = self.layout(j);
         let mut sized = self.candidates(j, &layout);
+        if self.quaternion_in_state() {
+            // Off the unit sphere the closed form and the recursions read a
+            // quaternion differently; the Jacobian must be the rhs's.
+            sized.retain(|c| (c.kind == Kind::Closed) != articulated);
+        }
         if sized.is_empty() {
             let why = |r: Result<(), &String>| r.err().cloned().unwrap_or_default();
             let c = why(j.closed.as_ref().map(|_| ()));
@@ -292,6 +303,17 @@ impl Emitter<'_> {
             info: InfoParts::Symbolic(info),
             summary: form,
         }
+    }
+
+    /// Whether a quaternion's four coordinates are in the state: there the
+    /// rhs's forms agree only on the unit sphere.
+    fn quaternion_in_state(&self) -> bool {
+        let retained = &self.d.reduction.retained;
+        let model = self.model;
+        model
+            .quaternions
+            .iter()
+            .any(|block| block.iter().all(|c| retained.contains(c)))
     }
 
     /// Every symbolic candidate stage 14 built, with its sizes, counted

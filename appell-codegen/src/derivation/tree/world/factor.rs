@@ -1,4 +1,4 @@
-//! M = L D Lᵀ in the graph, the links taken leaves first so that a tree's
+//! M = L D Lᵀ in the graph, the speeds taken leaves first so that a tree's
 //! M factors without fill (Featherstone's LTDL order), and solves by it:
 //! ÿ = M⁻¹ (τ − h), and the Jacobian's columns −M⁻¹ ∂R/∂c.
 
@@ -8,13 +8,14 @@ use super::super::spatial::Algebra;
 
 type R<T> = Result<T, SymbolicError>;
 
-/// M's factors over the speeds in elimination order: a link after every
-/// descendant. Every entry is held, so a solve multiplies each once.
+/// M's factors over the speeds in elimination order: a speed after every
+/// speed of its subtree. Every entry is held, so a solve multiplies each
+/// once.
 pub struct MassFactor {
     /// The speed at each position of the elimination order.
     order: Vec<usize>,
     /// L below the diagonal in that order, row-major; literal zeros where a
-    /// row's link is not an ancestor of the column's.
+    /// row's speed does not move the column's.
     lower: Vec<Vec<Id>>,
     /// 1 / dᵢ.
     reciprocals: Vec<Id>,
@@ -91,7 +92,8 @@ impl MassFactor {
 }
 
 impl MassFactor {
-    /// Whether L has no zero below its diagonal: M of a chain.
+    /// Whether L has no zero below its diagonal: M of a chain (one speed
+    /// per link).
     pub fn is_dense(&self) -> bool {
         self.dense
     }

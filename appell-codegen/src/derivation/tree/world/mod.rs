@@ -17,10 +17,10 @@
 //! quantities computed once per link, where differentiating the recursion
 //! column by column repeats a recursion over the subtree per column.
 //!
-//! The accelerations ÿ the forces are taken at are given, or solved from
-//! M ÿ = τ − h with M and h from the same passes (M by the subtrees'
-//! inertias, factored leaves first), which costs less than the
-//! articulated-body algorithm beside them.
+//! The accelerations ÿ the forces are taken at are given (on a fixed
+//! root), or solved from M ÿ = τ − h with M and h from the same passes (M
+//! by the subtrees' inertias, factored leaves first), which costs less
+//! than the articulated-body algorithm beside them.
 //!
 //! Input: the model's tree and [`Accelerations`]; output:
 //! [`WorldDerivatives`].
@@ -51,7 +51,7 @@ type R<T> = Result<T, SymbolicError>;
 pub struct WorldDerivatives {
     /// ∂Qᵢ/∂q along speed j's axis.
     pub by_coordinates: Vec<Id>,
-    /// ∂Qᵢ/∂ẏⱼ.
+    /// ∂Qᵢ/∂ẏⱼ (by s ṗ for a free root's slides: zero).
     pub by_speeds: Vec<Id>,
     /// M = ∂Q/∂ÿ.
     pub mass: Vec<Id>,
@@ -61,7 +61,8 @@ pub struct WorldDerivatives {
     /// The coordinate moving along each speed's axis, by index among the
     /// model's (None for a free joint's turn), in speed order.
     pub coordinates: Vec<Option<usize>>,
-    /// The accelerations the derivatives are taken at.
+    /// The accelerations the derivatives are taken at (the nodes' ÿ': a
+    /// free root's p̈ / s).
     pub accelerations: Vec<Id>,
     /// With [`Accelerations::Solved`], M's factors.
     pub factor: Option<MassFactor>,
@@ -78,11 +79,21 @@ pub enum Accelerations<'a> {
 }
 
 /// Why `spec` has no world-frame derivatives, if it has not: every moving
-/// joint must turn or slide about one axis, but a free joint at the root.
+/// joint must turn or slide about one axis, but a free joint at the root
+/// (no moving link above it; welded ones may be).
 pub fn single_axis(spec: &TreeSpec) -> Result<(), String> {
+    let moves_above = |mut parent: Option<usize>| {
+        while let Some(p) = parent {
+            if spec.links[p].motion.is_some() {
+                return true;
+            }
+            parent = spec.links[p].parent;
+        }
+        false
+    };
     let several = |k: &&crate::model::tree::LinkSpec| match k.motion {
         Some(Motion::Spherical) => true,
-        Some(Motion::Free) => k.parent.is_some(),
+        Some(Motion::Free) => moves_above(k.parent),
         _ => false,
     };
     match spec.links.iter().find(several) {
@@ -114,14 +125,18 @@ pub fn world_derivatives(
             found: why,
         });
     }
-    let mut a = Algebra::new(&mut model.g)?;
-    let mut world = nodes::world_tree(&mut a, &tree, spec, &parts, fixed)?;
-    if matches!(accelerations, Accelerations::At(_)) && !world.roots.is_empty() {
+    let free = spec
+        .links
+        .iter()
+        .any(|k| matches!(k.motion, Some(Motion::Free)));
+    if matches!(accelerations, Accelerations::At(_)) && free {
         return Err(SymbolicError::DimensionMismatch {
             expected: "accelerations to solve for".to_string(),
             found: "a free root and given accelerations".to_string(),
         });
     }
+    let mut a = Algebra::new(&mut model.g)?;
+    let mut world = nodes::world_tree(&mut a, &tree, spec, &parts, fixed)?;
     let tree = &world.nodes;
     let ground = a.ground(gravity)?;
     let grounds = grounds(&mut a, tree, &world.roots, ground)?;
@@ -202,7 +217,13 @@ fn gravity_term(
     let top = tree
         .iter()
         .position(|n| n.parent.is_none() && n.root == Some(r));
-    let ground = grounds[top.expect("a free root's node")];
+    let Some(top) = top else {
+        return Err(SymbolicError::DimensionMismatch {
+            expected: "a free root's node".to_string(),
+            found: "none".to_string(),
+        });
+    };
+    let ground = grounds[top];
     let mut out = vec![a.zero(); size];
     for (i, node) in tree.iter().enumerate() {
         if node.root != Some(r) {

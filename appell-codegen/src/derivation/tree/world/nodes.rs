@@ -145,9 +145,7 @@ pub(super) fn world_tree(
         }
         last.push(world.nodes.len() - 1);
     }
-    if world.speeds.len() != size
-        || world.nodes.iter().map(|n| n.speeds.len()).sum::<usize>() != size
-    {
+    if world.nodes.iter().map(|n| n.speeds.len()).sum::<usize>() != size {
         return Err(unsupported("a speed per column".to_string()));
     }
     Ok(world)
