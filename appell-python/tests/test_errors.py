@@ -65,6 +65,25 @@ def test_functions_a_model_lacks(pendulum):
     assert B.shape == (2, 0)
 
 
+def test_the_pendulums_derivatives(pendulum):
+    # Q = m l² a + m g l sin q: ∂Q/∂q = m g l cos q, ∂Q/∂v = 0, M = m l².
+    q, v, a = np.array([0.3]), np.array([-0.7]), np.array([0.2])
+    tau, dq, dv, m = pendulum.inverse_dynamics_derivatives(q, v, a)
+    np.testing.assert_allclose(tau, [0.25 * 0.2 + 9.81 * 0.5 * np.sin(0.3)], rtol=1e-14)
+    np.testing.assert_allclose(dq, [[9.81 * 0.5 * np.cos(0.3)]], rtol=1e-14)
+    np.testing.assert_allclose(dv, [[0.0]], atol=1e-15)
+    np.testing.assert_allclose(m, [[0.25]], rtol=1e-14)
+    if pendulum.has_jacobian:
+        accel, fq, fv, fu = pendulum.forward_dynamics_derivatives(q, v)
+        np.testing.assert_allclose(fq, [[-9.81 / 0.5 * np.cos(0.3)]], rtol=1e-14)
+        assert fu.shape == (1, 0)
+    else:
+        with pytest.raises(appell.ModelError, match="forward_dynamics_derivatives"):
+            pendulum.forward_dynamics_derivatives(q, v)
+    with pytest.raises(ValueError, match="shape"):
+        pendulum.inverse_dynamics_derivatives(np.zeros(2), v, a)
+
+
 def test_compile_error_names_the_line(cache):
     text = textwrap.dedent("""\
         coordinates(q), speeds(q), positive(m, l)

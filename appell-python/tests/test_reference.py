@@ -160,3 +160,28 @@ def test_ur5_against_pinocchio(ur5):
                                rtol=1e-10, atol=1e-10)
     np.testing.assert_allclose(ur5.gravity_forces(q), np.array([s["gravity_torque"] for s in states]),
                                rtol=1e-10, atol=1e-10)
+
+
+def test_ur5_derivatives_against_pinocchio(ur5):
+    """inverse_dynamics_derivatives against computeRNEADerivatives and
+    forward_dynamics_derivatives against computeABADerivatives (the
+    reference the Rust tests read), batched over the states and one by
+    one."""
+    data = json.loads((REPO / "tests/reference/pinocchio/derivatives/ur5.json").read_text())
+    assert ur5.coordinate_names == data["joints"]
+    states = data["states"]
+    q, v, a, tau = (np.array([s[k] for s in states]) for k in ("q", "v", "a", "tau"))
+    torques, dq, dv, m = ur5.inverse_dynamics_derivatives(q, v, a)
+    accel, fq, fv, fu = ur5.forward_dynamics_derivatives(q, v, tau)
+    pairs = ((dq, "dtau_dq"), (dv, "dtau_dv"), (m, "dtau_da"), (fq, "ddq_dq"), (fv, "ddq_dv"),
+             (fu, "ddq_dtau"))
+    for ours, key in pairs:
+        theirs = np.array([s[key] for s in states])
+        assert ours.shape == theirs.shape, key
+        worst = np.max(np.abs(ours - theirs)) / (1.0 + np.max(np.abs(theirs)))
+        assert worst < 1e-9, f"{key}: {worst:.2e}"
+    np.testing.assert_allclose(torques, ur5.inverse_dynamics(q, v, a), rtol=1e-12, atol=1e-10)
+    np.testing.assert_allclose(accel, ur5.rhs(ur5.reduced_state(q, v), tau)[:, 5:], rtol=1e-12, atol=1e-10)
+    for k in (0, len(states) - 1):
+        for batched, single in zip((accel, fq, fv, fu), ur5.forward_dynamics_derivatives(q[k], v[k], tau[k])):
+            assert np.array_equal(batched[k], single)

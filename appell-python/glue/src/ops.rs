@@ -31,6 +31,12 @@ pub enum Op {
     MassMatrixAndForcing,
     /// `(q, v, a[l]) -> Q[l]` (recursive Newton–Euler on trees).
     InverseDynamics,
+    /// `(q, v, a) -> Q[l], ∂Q/∂q[l×n], ∂Q/∂v[l×l], M[l×l]` (Pinocchio's
+    /// `computeRNEADerivatives`).
+    InverseDynamicsDerivatives,
+    /// `(q, v, u) -> ÿ[l], ∂ÿ/∂q[l×n], ∂ÿ/∂v[l×l], ∂ÿ/∂u[l×i]` (Pinocchio's
+    /// `computeABADerivatives`).
+    ForwardDynamicsDerivatives,
     /// `q -> g[l]`, the forces that hold the mechanism still.
     GravityForces,
     /// `(q, v) -> h[l]`, velocity products and loads at zero inputs.
@@ -44,7 +50,7 @@ pub enum Op {
 
 impl Op {
     /// Every operation, for the Python package's table.
-    pub const ALL: [Op; 11] = [
+    pub const ALL: [Op; 13] = [
         Op::Rhs,
         Op::RhsJacobian,
         Op::Linearize,
@@ -52,6 +58,8 @@ impl Op {
         Op::MassMatrix,
         Op::MassMatrixAndForcing,
         Op::InverseDynamics,
+        Op::InverseDynamicsDerivatives,
+        Op::ForwardDynamicsDerivatives,
         Op::GravityForces,
         Op::BiasForces,
         Op::Energies,
@@ -68,6 +76,8 @@ impl Op {
             Op::MassMatrix => "mass_matrix",
             Op::MassMatrixAndForcing => "mass_matrix_and_forcing",
             Op::InverseDynamics => "inverse_dynamics",
+            Op::InverseDynamicsDerivatives => "inverse_dynamics_derivatives",
+            Op::ForwardDynamicsDerivatives => "forward_dynamics_derivatives",
             Op::GravityForces => "gravity_forces",
             Op::BiasForces => "bias_forces",
             Op::Energies => "energies",
@@ -92,10 +102,13 @@ impl Op {
             Op::Rhs | Op::RhsJacobian | Op::Linearize => vec![("x", s), ("u", i)],
             Op::CoordinateRates
             | Op::MassMatrixAndForcing
+            | Op::ForwardDynamicsDerivatives
             | Op::Energies
             | Op::ConstraintForces => vec![("q", n), ("v", l), ("u", i)],
             Op::MassMatrix | Op::GravityForces => vec![("q", n)],
-            Op::InverseDynamics => vec![("q", n), ("v", l), ("a", l)],
+            Op::InverseDynamics | Op::InverseDynamicsDerivatives => {
+                vec![("q", n), ("v", l), ("a", l)]
+            }
             Op::BiasForces => vec![("q", n), ("v", l)],
         }
     }
@@ -117,6 +130,8 @@ impl Op {
             Op::MassMatrix => l * l,
             Op::MassMatrixAndForcing => l * l + l,
             Op::InverseDynamics | Op::GravityForces | Op::BiasForces => l,
+            Op::InverseDynamicsDerivatives => l + l * n + 2 * l * l,
+            Op::ForwardDynamicsDerivatives => l + l * n + l * l + l * i,
             Op::Energies => 4,
             Op::ConstraintForces => m + n,
         }
@@ -412,6 +427,24 @@ fn eval_row<M: Model>(
         Op::InverseDynamics => model
             .inverse_dynamics(t, a[0], a[1], a[2], out)
             .map_err(text),
+        Op::InverseDynamicsDerivatives => {
+            let n = info.coordinates.len();
+            let (forces, rest) = out.split_at_mut(l);
+            let (dq, rest) = rest.split_at_mut(l * n);
+            let (du, m) = rest.split_at_mut(l * l);
+            model
+                .inverse_dynamics_derivatives(t, a[0], a[1], a[2], forces, dq, du, m)
+                .map_err(text)
+        }
+        Op::ForwardDynamicsDerivatives => {
+            let n = info.coordinates.len();
+            let (accel, rest) = out.split_at_mut(l);
+            let (dq, rest) = rest.split_at_mut(l * n);
+            let (du, dinputs) = rest.split_at_mut(l * l);
+            model
+                .forward_dynamics_derivatives(t, a[0], a[1], a[2], accel, dq, du, dinputs)
+                .map_err(text)
+        }
         Op::GravityForces => model.gravity_forces(t, a[0], out).map_err(text),
         Op::BiasForces => model.bias_forces(t, a[0], a[1], out).map_err(text),
         Op::Energies => {

@@ -303,6 +303,44 @@ class Model:
         lead = out.shape[:-1]
         return out[..., : s * s].reshape(lead + (s, s)), out[..., s * s :].reshape(lead + (s, ni))
 
+    def inverse_dynamics_derivatives(
+            self, q: ArrayLike, v: ArrayLike, a: ArrayLike, t: float = 0.0, params: Any = None
+    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """Inverse dynamics and its derivatives in one call (Pinocchio's
+        ``computeRNEADerivatives``): (Q, ∂Q/∂q of shape (l, n), ∂Q/∂v of
+        shape (l, l), M). One column per coordinate: a quaternion's four
+        components are four columns, where Pinocchio differentiates along
+        its tangent. A model derived with ``jacobian(off)``, or one that is
+        not a tree, raises ModelError."""
+        args = [self._array("q", q, self.coordinate_names), self._array("v", v, self.speed_names),
+                self._array("a", a, self.speed_names)]
+        out = self._call("inverse_dynamics_derivatives", args, t, params)
+        l, n = self._l, len(self.coordinate_names)
+        lead = out.shape[:-1]
+        at = l + l * n
+        return (out[..., :l], out[..., l:at].reshape(lead + (l, n)),
+                out[..., at : at + l * l].reshape(lead + (l, l)), out[..., at + l * l :].reshape(lead + (l, l)))
+
+    def forward_dynamics_derivatives(
+            self, q: ArrayLike, v: ArrayLike, u: Optional[ArrayLike] = None, t: float = 0.0,
+            params: Any = None
+    ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The accelerations and their derivatives in all coordinates, in one
+        call (Pinocchio's ``computeABADerivatives``): (ÿ, ∂ÿ/∂q of shape
+        (l, n), ∂ÿ/∂v of shape (l, l), ∂ÿ/∂u of shape (l, inputs)), zero
+        columns for the coordinates the equations do not read. For a robot
+        whose joints are all driven, ∂ÿ/∂u is M⁻¹ (Pinocchio's
+        ``ddq_dtau``). Models without a generated Jacobian raise
+        ModelError."""
+        args = [self._array("q", q, self.coordinate_names), self._array("v", v, self.speed_names),
+                self._array("u", u, self.input_names)]
+        out = self._call("forward_dynamics_derivatives", args, t, params)
+        l, n = self._l, len(self.coordinate_names)
+        lead = out.shape[:-1]
+        at = l + l * n
+        return (out[..., :l], out[..., l:at].reshape(lead + (l, n)),
+                out[..., at : at + l * l].reshape(lead + (l, l)), out[..., at + l * l :].reshape(lead + (l, self._ni)))
+
     def simulate(self, x0: ArrayLike, t_eval: ArrayLike, u: Optional[ArrayLike] = None,
                  method: str = "dop853", rtol: float = 1e-8, atol: float = 1e-10,
                  t0: Optional[float] = None, h_max: Optional[float] = None,
