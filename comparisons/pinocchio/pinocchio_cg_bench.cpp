@@ -1,10 +1,11 @@
 // Times Pinocchio's code-generated dynamics (CppADCodeGen): CodeGenABA,
-// CodeGenRNEA, CodeGenCRBA, and a gravity generator written here on
-// Pinocchio's CodeGenBase as its own generators are, on the same states as
+// CodeGenRNEA, CodeGenCRBA, CodeGenABADerivatives (computeABADerivatives
+// recorded), and a gravity generator written here on Pinocchio's
+// CodeGenBase as its own generators are, on the same states as
 // pinocchio_bench (bench_common.hpp draws them).
 //
 //   pinocchio_cg_bench URDF [--free] [--name NAME] [--weld J1,J2,...] [--batch B] [--reps R]
-//                           [--seed S] [--only aba,rnea,crba_sym,gravity]
+//                           [--seed S] [--only aba,rnea,crba_sym,gravity,aba_derivatives]
 //                           [--cflags "-Ofast -march=native"]
 //
 // Each function is recorded with CppAD on Pinocchio's algorithm (scalar
@@ -16,7 +17,9 @@
 // generated C is compiled with --cflags (default "-Ofast -march=native":
 // Pinocchio's default -Ofast for its generated code, and this CPU's
 // instructions as for every other native build here). Only forward
-// evaluation is generated (no Jacobians).
+// evaluation is generated (no Jacobians of the recorded functions: the
+// derivatives timed are computeABADerivatives' own, recorded as a
+// function of q, v and tau).
 //
 // Output: as pinocchio_bench's (impl "pinocchio_cg"), plus one line per
 // function saying how long recording, generating and compiling took.
@@ -125,7 +128,7 @@ int main(int argc, char ** argv)
   const bench::Batch b = bench::draw(model, o.free, o.count, o.seed);
   const std::vector<std::string> flags = bench::split(cflags, ' ');
 
-  const std::vector<std::string> names = {"aba", "rnea", "crba_sym", "gravity"};
+  const std::vector<std::string> names = {"aba", "rnea", "crba_sym", "gravity", "aba_derivatives"};
   auto prepared = [&](auto & generator, const char * fn) {
     auto [seconds, compiled] = generator.prepare(flags);
     std::printf(
@@ -200,6 +203,32 @@ int main(int argc, char ** argv)
       [&](int k) {
         g.evalFunction(b.q[k]);
         return g.out().sum();
+      });
+  }
+  if (bench::wanted(o.only, names, "aba_derivatives"))
+  {
+    // The generated function's output is ddq_dq, ddq_dv and Minv, each nv x
+    // nv row-major; the checksum is pinocchio_bench's: every entry of the
+    // first two, and of the symmetric M^-1 from its upper triangle.
+    Opened<pinocchio::CodeGenABADerivatives<double>> g(model, "partial_aba", lib + "aba_derivatives");
+    prepared(g, "aba_derivatives");
+    auto sum = [&]() {
+      const Eigen::VectorXd & y = g.out();
+      double total = y.head(2 * n * n).sum();
+      for (int i = 0; i < n; ++i)
+        for (int j = i; j < n; ++j)
+          total += (i == j ? 1.0 : 2.0) * y[2 * n * n + i * n + j];
+      return total;
+    };
+    run(
+      "aba_derivatives",
+      [&](int k) {
+        g.evalFunction(b.q[k], b.v[k], b.tau[k]);
+        return g.out()[n * n + n * n - 1];
+      },
+      [&](int k) {
+        g.evalFunction(b.q[k], b.v[k], b.tau[k]);
+        return sum();
       });
   }
   return 0;

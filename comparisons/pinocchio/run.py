@@ -130,7 +130,8 @@ DERIVATIVES = ("rhs_jacobian", "rhs_jacobian_dual")
 DERIVATIVE_STATES = 20
 # appell function -> Pinocchio's code-generated counterpart
 # (pinocchio_cg_bench, impl "pinocchio_cg").
-PAIRS_CG = {"rhs": "aba", "inverse_dynamics": "rnea", "mass_matrix": "crba_sym", "gravity": "gravity"}
+PAIRS_CG = {"rhs": "aba", "inverse_dynamics": "rnea", "mass_matrix": "crba_sym", "gravity": "gravity",
+            "rhs_jacobian": "aba_derivatives"}
 # The Rust driver's conversions between the conventions (free bases only).
 CONVERSIONS = ["map_in", "map_out"]
 # Pinocchio functions shown in the second table, in order.
@@ -633,6 +634,9 @@ def report(path):
             cols += [f"appell rhs_jacobian ({v}), ns", f"appell dual ({v}), ns"]
         cols += ["Pinocchio aba_derivatives, ns", "Pinocchio ABA, ns"]
         cols += [f"aba_derivatives / rhs_jacobian ({v})" for v in variants]
+        if has_cg:
+            cols += ["Pinocchio codegen aba_derivatives, ns"]
+            cols += [f"codegen aba_derivatives / rhs_jacobian ({v})" for v in variants]
         cols += [f"dual / rhs_jacobian ({v})" for v in variants]
         cols += [f"rhs_jacobian / rhs ({v})" for v in variants] + ["aba_derivatives / ABA"]
         rows = []
@@ -643,6 +647,10 @@ def report(path):
                 row += [fmt_range(medians(k, name, "rhs_jacobian")), fmt_range(medians(k, name, "rhs_jacobian_dual"))]
             row += [fmt_range(medians("pinocchio", name, "aba_derivatives")), fmt_range(medians("pinocchio", name, "aba"))]
             row += [fmt_range(ratios("pinocchio", "aba_derivatives", k, "rhs_jacobian", name), fmt_ratio) for k in appell_keys]
+            if has_cg:
+                row += [fmt_range(medians("pinocchio_cg", name, "aba_derivatives"))]
+                row += [fmt_range(ratios("pinocchio_cg", "aba_derivatives", k, "rhs_jacobian", name), fmt_ratio)
+                        for k in appell_keys]
             row += [fmt_range(ratios(k, "rhs_jacobian_dual", k, "rhs_jacobian", name), fmt_ratio) for k in appell_keys]
             row += [fmt_range(ratios(k, "rhs_jacobian", k, "rhs", name), fmt_ratio) for k in appell_keys]
             row += [fmt_range(ratios("pinocchio", "aba_derivatives", "pinocchio", "aba", name), fmt_ratio)]
@@ -650,7 +658,9 @@ def report(path):
         out += ["Forward-dynamics derivatives: appell's `rhs_jacobian` (the generated rhs, A = ∂rhs/∂state and "
                 "B = ∂rhs/∂inputs in one call; \"(twin)\": from the same robot derived with `jacobian(on)`, "
                 "rust/src/jacobian.rs), the same three outputs by dual numbers (one `Dual64` rhs per column of A "
-                "and B), Pinocchio's `computeABADerivatives` (ddq_dq, ddq_dv, Minv) and its `aba`.", ""]
+                "and B), Pinocchio's `computeABADerivatives` (ddq_dq, ddq_dv, Minv) and its `aba`"
+                + (", and the same recorded and compiled by CppADCodeGen (`CodeGenABADerivatives`)" if has_cg else "")
+                + ".", ""]
         out += table(cols, rows)
         checks = meta.get("derivative_checks", {})
         if checks:
