@@ -73,7 +73,6 @@ pub fn minimal_linearization<M: Model>(
     fixed_speeds: &[&str],
 ) -> Result<Linearization, LinearizeError> {
     let info = M::info();
-    let n = info.coordinates.len();
     let (nr, nl) = (info.retained.len(), info.speeds.len());
     check_configuration(info, t, q_full)?;
     check_len("u", u, nl)?;
@@ -105,8 +104,66 @@ pub fn minimal_linearization<M: Model>(
         .collect();
     let full = linearize(model, t, &state, inputs)?;
 
-    // Retained positions eliminated, and their first-order dependence on the
-    // kept retained coordinates (|eliminated| × |kept|).
+    let Elimination {
+        eliminated,
+        kept,
+        follow,
+    } = eliminate(model, t, q_full, inputs, &retained, &dependent)?;
+
+    // z: the kept retained coordinates, then the speeds not fixed.
+    let speeds: Vec<usize> = (0..nl).filter(|&k| !fixed[k]).collect();
+    let rows: Vec<usize> = kept
+        .iter()
+        .copied()
+        .chain(speeds.iter().map(|&k| nr + k))
+        .collect();
+    let nz = rows.len();
+    let mut tmat = DMatrix::<f64>::zeros(nr + nl, nz);
+    for (col, &row) in rows.iter().enumerate() {
+        tmat[(row, col)] = 1.0;
+    }
+    for (e, &p) in eliminated.iter().enumerate() {
+        for k in 0..kept.len() {
+            tmat[(p, k)] = follow[(e, k)];
+        }
+    }
+    let a = full.a.select_rows(&rows) * tmat;
+    let b = full.b.select_rows(&rows);
+    finite(a.as_slice(), "the minimal state Jacobian")?;
+    let state_names = rows.iter().map(|&r| full.state_names[r].clone()).collect();
+    Ok(Linearization {
+        a,
+        b,
+        state_names,
+        input_names: full.input_names,
+    })
+}
+
+/// The retained coordinates a holonomic constraint fixes, as positions in
+/// the retained list, and the first-order dependence of each on the kept
+/// ones.
+struct Elimination {
+    /// Positions eliminated.
+    eliminated: Vec<usize>,
+    /// Positions kept.
+    kept: Vec<usize>,
+    /// |eliminated| × |kept|: δq_eliminated = follow δq_kept.
+    follow: DMatrix<f64>,
+}
+
+/// [`Elimination`] at `q_full` (every coordinate), `retained` and
+/// `dependent` the coordinates' indices; errors as
+/// [`minimal_linearization`]'s for the constraints.
+fn eliminate<M: Model>(
+    model: &M,
+    t: f64,
+    q_full: &[f64],
+    inputs: &[f64],
+    retained: &[usize],
+    dependent: &[usize],
+) -> Result<Elimination, LinearizeError> {
+    let info = M::info();
+    let (n, nr) = (info.coordinates.len(), retained.len());
     let mut eliminated: Vec<usize> = Vec::new();
     let mut kept: Vec<usize> = (0..nr).collect();
     let mut follow = DMatrix::<f64>::zeros(0, nr);
@@ -172,32 +229,9 @@ pub fn minimal_linearization<M: Model>(
         }
         finite(follow.as_slice(), "the constraint elimination")?;
     }
-
-    // z: the kept retained coordinates, then the speeds not fixed.
-    let speeds: Vec<usize> = (0..nl).filter(|&k| !fixed[k]).collect();
-    let rows: Vec<usize> = kept
-        .iter()
-        .copied()
-        .chain(speeds.iter().map(|&k| nr + k))
-        .collect();
-    let nz = rows.len();
-    let mut tmat = DMatrix::<f64>::zeros(nr + nl, nz);
-    for (col, &row) in rows.iter().enumerate() {
-        tmat[(row, col)] = 1.0;
-    }
-    for (e, &p) in eliminated.iter().enumerate() {
-        for k in 0..kept.len() {
-            tmat[(p, k)] = follow[(e, k)];
-        }
-    }
-    let a = full.a.select_rows(&rows) * tmat;
-    let b = full.b.select_rows(&rows);
-    finite(a.as_slice(), "the minimal state Jacobian")?;
-    let state_names = rows.iter().map(|&r| full.state_names[r].clone()).collect();
-    Ok(Linearization {
-        a,
-        b,
-        state_names,
-        input_names: full.input_names,
+    Ok(Elimination {
+        eliminated,
+        kept,
+        follow,
     })
 }
