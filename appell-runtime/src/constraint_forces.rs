@@ -525,45 +525,12 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
         sides.push(side);
     }
 
-    // Holonomic rows that are normal forces at a contact.
-    let holonomic_rows: Vec<(usize, usize)> = info
-        .row_sources
-        .iter()
-        .enumerate()
-        .filter_map(|(s, src)| match src {
-            RowSource::Holonomic { index } => Some((s, *index)),
-            _ => None,
-        })
-        .collect();
-    let mut located = vec![true; m];
-    for (s, src) in info.row_sources.iter().enumerate() {
-        if !matches!(src, RowSource::Rolling { .. }) {
-            located[s] = false;
-        }
-    }
-    if !holonomic_rows.is_empty() && normals.iter().any(Option::is_some) {
-        let jac = point_jacobians(model, info, t, q, &points)?;
-        for &(s, index) in &holonomic_rows {
-            let row = &dmat[s * n..(s + 1) * n];
-            for c in 0..nc {
-                let Some(dir) = normals[c] else { continue };
-                if !matches!(contacts[c].normal, Normal::Unavailable(_)) {
-                    continue;
-                }
-                if let Some(k) = row_as_normal(row, d0[s], &jac[c], dir) {
-                    let force = k * sol.multipliers[s];
-                    contacts[c].normal = Normal::Available {
-                        direction: dir,
-                        force,
-                        source: NormalSource::HolonomicRow { index },
-                    };
-                    contacts[c].force = add(contacts[c].force, scale(dir, force));
-                    located[s] = true;
-                    break;
-                }
-            }
-        }
-    }
+    let rows_at = Rows {
+        d: &dmat,
+        d0: &d0,
+        multipliers: &sol.multipliers,
+    };
+    let located = holonomic_normals(model, t, q, &rows_at, &points, &normals, &mut contacts)?;
 
     // The coordinates' own support at the remaining contacts, by the
     // system's momentum balances.
@@ -602,6 +569,74 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
         located: located.iter().all(|&x| x),
     };
     Ok((forces, parts))
+}
+
+/// A model's velocity constraint rows at a state: D (m × n, row-major),
+/// its time part d, and their multipliers.
+struct Rows<'a> {
+    d: &'a [f64],
+    d0: &'a [f64],
+    multipliers: &'a [f64],
+}
+
+/// Places the reactions of holonomic rows that are normal forces at a
+/// contact (`normals`: each contact's direction, if it has one) into
+/// `contacts`, and says which rows' reactions are placed: the rolling
+/// rows', and those.
+fn holonomic_normals<K: DynModel + ?Sized>(
+    model: &K,
+    t: f64,
+    q: &[f64],
+    rows: &Rows,
+    points: &[[f64; 3]],
+    normals: &[Option<[f64; 3]>],
+    contacts: &mut [ContactForce],
+) -> Result<Vec<bool>, OracleError> {
+    let info = model.dyn_info();
+    let (n, m, nc) = (
+        info.coordinates.len(),
+        info.constraints,
+        info.contacts.len(),
+    );
+    let holonomic_rows: Vec<(usize, usize)> = info
+        .row_sources
+        .iter()
+        .enumerate()
+        .filter_map(|(s, src)| match src {
+            RowSource::Holonomic { index } => Some((s, *index)),
+            _ => None,
+        })
+        .collect();
+    let mut located = vec![true; m];
+    for (s, src) in info.row_sources.iter().enumerate() {
+        if !matches!(src, RowSource::Rolling { .. }) {
+            located[s] = false;
+        }
+    }
+    if !holonomic_rows.is_empty() && normals.iter().any(Option::is_some) {
+        let jac = point_jacobians(model, info, t, q, points)?;
+        for &(s, index) in &holonomic_rows {
+            let row = &rows.d[s * n..(s + 1) * n];
+            for c in 0..nc {
+                let Some(dir) = normals[c] else { continue };
+                if !matches!(contacts[c].normal, Normal::Unavailable(_)) {
+                    continue;
+                }
+                if let Some(k) = row_as_normal(row, rows.d0[s], &jac[c], dir) {
+                    let force = k * rows.multipliers[s];
+                    contacts[c].normal = Normal::Available {
+                        direction: dir,
+                        force,
+                        source: NormalSource::HolonomicRow { index },
+                    };
+                    contacts[c].force = add(contacts[c].force, scale(dir, force));
+                    located[s] = true;
+                    break;
+                }
+            }
+        }
+    }
+    Ok(located)
 }
 
 /// k where a holonomic row (its q̇ part `row`, its time part `time`) is k
