@@ -36,86 +36,125 @@ struct Syms {
 /// roots take 1 + e²), mixing parameters (a, b) and state (x, y, z).
 fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
     if depth == 0 || rng.below(7) == 0 {
-        return match rng.below(8) {
-            0..=4 => g.sym(s.all[rng.below(5) as usize]).unwrap(),
-            5 => g.int(rng.below(9) as i64 - 4).unwrap(),
-            6 => g
-                .rational(rng.below(11) as i64 - 5, rng.below(4) as i64 + 1)
-                .unwrap(),
-            _ => g.float(rng.uniform(-3.0, 3.0)).unwrap(),
-        };
+        return leaf(g, s, rng);
     }
-    let one = g.int(1).unwrap();
-    let sub = |g: &mut Graph, rng: &mut Rng| random(g, s, rng, depth - 1);
-    let safe = |g: &mut Graph, rng: &mut Rng| {
-        let a = sub(g, rng);
-        let a2 = g.powi(a, 2).unwrap();
-        g.add(one, a2).unwrap()
+    let d = Draw {
+        s,
+        depth,
+        one: g.int(1).unwrap(),
     };
     match rng.below(24) {
+        k @ 0..=6 => arithmetic(g, rng, &d, k),
+        k @ 7..=19 => elementary(g, rng, &d, k),
+        k => branching(g, rng, &d, k),
+    }
+}
+
+/// A symbol or a number.
+fn leaf(g: &mut Graph, s: &Syms, rng: &mut Rng) -> Id {
+    match rng.below(8) {
+        0..=4 => g.sym(s.all[rng.below(5) as usize]).unwrap(),
+        5 => g.int(rng.below(9) as i64 - 4).unwrap(),
+        6 => g
+            .rational(rng.below(11) as i64 - 5, rng.below(4) as i64 + 1)
+            .unwrap(),
+        _ => g.float(rng.uniform(-3.0, 3.0)).unwrap(),
+    }
+}
+
+/// How a node `depth` deep draws its operands.
+struct Draw<'a> {
+    s: &'a Syms,
+    depth: u32,
+    one: Id,
+}
+
+impl Draw<'_> {
+    /// An operand one level down.
+    fn sub(&self, g: &mut Graph, rng: &mut Rng) -> Id {
+        random(g, self.s, rng, self.depth - 1)
+    }
+
+    /// 1 + e², for e one level down: a safe denominator, log or root.
+    fn safe(&self, g: &mut Graph, rng: &mut Rng) -> Id {
+        let a = self.sub(g, rng);
+        let a2 = g.powi(a, 2).unwrap();
+        g.add(self.one, a2).unwrap()
+    }
+}
+
+/// Sums, differences, products, quotients and integer powers (`k` in 0..=6).
+fn arithmetic(g: &mut Graph, rng: &mut Rng, d: &Draw, k: u64) -> Id {
+    match k {
         0 | 1 => {
-            let (a, b) = (sub(g, rng), sub(g, rng));
+            let (a, b) = (d.sub(g, rng), d.sub(g, rng));
             g.add(a, b).unwrap()
         }
         2 => {
-            let (a, b) = (sub(g, rng), sub(g, rng));
+            let (a, b) = (d.sub(g, rng), d.sub(g, rng));
             g.sub(a, b).unwrap()
         }
         3 | 4 => {
-            let (a, b) = (sub(g, rng), sub(g, rng));
+            let (a, b) = (d.sub(g, rng), d.sub(g, rng));
             g.mul(a, b).unwrap()
         }
         5 => {
-            let a = sub(g, rng);
-            let d = safe(g, rng);
-            g.div(a, d).unwrap()
+            let a = d.sub(g, rng);
+            let den = d.safe(g, rng);
+            g.div(a, den).unwrap()
         }
-        6 => {
-            let a = sub(g, rng);
+        _ => {
+            let a = d.sub(g, rng);
             g.powi(a, rng.below(5) as i64).unwrap()
         }
+    }
+}
+
+/// The elementary functions, each inside its domain (`k` in 7..=19).
+fn elementary(g: &mut Graph, rng: &mut Rng, d: &Draw, k: u64) -> Id {
+    match k {
         7 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             g.sin(a).unwrap()
         }
         8 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             g.cos(a).unwrap()
         }
         9 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             let s = g.sin(a).unwrap();
             g.tan(s).unwrap()
         }
         10 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             let s = g.sin(a).unwrap();
             g.exp(s).unwrap()
         }
         11 => {
-            let d = safe(g, rng);
-            g.ln(d).unwrap()
+            let den = d.safe(g, rng);
+            g.ln(den).unwrap()
         }
         12 => {
-            let d = safe(g, rng);
-            g.sqrt(d).unwrap()
+            let den = d.safe(g, rng);
+            g.sqrt(den).unwrap()
         }
         13 => {
-            let a = sub(g, rng);
-            let d = safe(g, rng);
-            g.atan2(a, d).unwrap()
+            let a = d.sub(g, rng);
+            let den = d.safe(g, rng);
+            g.atan2(a, den).unwrap()
         }
         14 => {
             // A large power, emitted as powi.
-            let d = safe(g, rng);
-            g.powi(d, -(65 + rng.below(3) as i64)).unwrap()
+            let den = d.safe(g, rng);
+            g.powi(den, -(65 + rng.below(3) as i64)).unwrap()
         }
         15 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             g.tanh(a).unwrap()
         }
         16 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             let s = g.sin(a).unwrap();
             if rng.below(2) == 0 {
                 g.sinh(s).unwrap()
@@ -125,7 +164,7 @@ fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
         }
         17 => {
             // asin and acos of sin(a)/2, inside their domain.
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             let s = g.sin(a).unwrap();
             let half = g.rational(1, 2).unwrap();
             let h = g.mul(half, s).unwrap();
@@ -136,21 +175,27 @@ fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
             }
         }
         18 => {
-            let a = sub(g, rng);
+            let a = d.sub(g, rng);
             g.atan(a).unwrap()
         }
-        19 => {
-            let d = safe(g, rng);
-            let b = sub(g, rng);
+        _ => {
+            let den = d.safe(g, rng);
+            let b = d.sub(g, rng);
             let s = g.sin(b).unwrap();
-            g.powf(d, s).unwrap()
+            g.powf(den, s).unwrap()
         }
+    }
+}
+
+/// Selections, minima and maxima, and signs (`k` in 20..=23).
+fn branching(g: &mut Graph, rng: &mut Rng, d: &Draw, k: u64) -> Id {
+    match k {
         20 => {
-            let (c, a, b) = (sub(g, rng), sub(g, rng), sub(g, rng));
+            let (c, a, b) = (d.sub(g, rng), d.sub(g, rng), d.sub(g, rng));
             g.select(c, a, b).unwrap()
         }
         21 => {
-            let (a, b) = (sub(g, rng), sub(g, rng));
+            let (a, b) = (d.sub(g, rng), d.sub(g, rng));
             if rng.below(2) == 0 {
                 g.min(a, b).unwrap()
             } else {
@@ -158,7 +203,7 @@ fn random(g: &mut Graph, s: &Syms, rng: &mut Rng, depth: u32) -> Id {
             }
         }
         _ => {
-            let (a, b) = (sub(g, rng), sub(g, rng));
+            let (a, b) = (d.sub(g, rng), d.sub(g, rng));
             let s = g.signum(a).unwrap();
             g.mul(s, b).unwrap()
         }
