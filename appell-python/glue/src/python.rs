@@ -11,7 +11,7 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::ops::{Arg, Compiled, Evaluate, Failure, Op};
-use crate::simulate::{Method, SimJob};
+use crate::simulate::{Event, Method, SimJob};
 
 /// The model a compiled module exports (`module.model`), wrapped by the
 /// Python package's `appell.Model`, which checks shapes and names.
@@ -483,105 +483,161 @@ impl NativeModel {
                 )))
             }
         };
-        let width = times.len() * s;
-        if let Some(g) = event {
-            if batch.is_some() {
-                return Err(PyValueError::new_err(
-                    "an event function takes one initial state, not a batch",
-                ));
-            }
-            let mut out = vec![0.0; width];
-            let mut raised: Option<PyErr> = None;
-            let mut call = |t: f64, x: &[f64]| -> f64 {
-                if raised.is_some() {
-                    return f64::NAN;
-                }
-                let state = PyArray1::from_slice(py, x);
-                match g.call1((t, state)).and_then(|v| v.extract::<f64>()) {
-                    Ok(v) => v,
-                    Err(e) => {
-                        raised = Some(e);
-                        f64::NAN
-                    }
-                }
-            };
-            let mut job = SimJob {
-                method,
-                x0: xs,
-                inputs: us,
-                t0,
-                t_eval: times,
-                rtol,
-                atol,
-                h_max,
-                max_steps,
-                out: &mut out,
-                event: Some(&mut call),
-                written: 0,
-                event_at: None,
-            };
-            let result = model.simulate(scene, &mut job);
-            let (written, event_at) = (job.written, job.event_at.take());
-            if let Some(e) = raised {
-                return Err(e);
-            }
-            result.map_err(|m| model_error(py, format!("simulate: {m}")))?;
-            out.truncate(written * s);
-            let states = PyArray1::from_vec(py, out).reshape(IxDyn(&[written, s]))?;
-            let at = match event_at {
-                Some((t, x)) => (t, PyArray1::from_vec(py, x)).into_pyobject(py)?.into_any(),
-                None => py.None().into_bound(py),
-            };
-            return Ok((&times[..written].to_vec(), states, at)
-                .into_pyobject(py)?
-                .into_any()
-                .unbind());
+        let settings = Settings {
+            method,
+            inputs: us,
+            t0,
+            t_eval: times,
+            rtol,
+            atol,
+            h_max,
+            max_steps,
+        };
+        let states = States { x0: xs, s, batch };
+        match event {
+            Some(g) => simulate_event(py, &*model, scene, &settings, &states, g),
+            None => simulate_rows(py, &*model, scene, &settings, &states, threads),
         }
-        let n = batch.unwrap_or(1);
-        let mut out = vec![0.0; n * width];
-        let run = |first: usize, chunk: &mut [f64]| -> Result<(), Failure> {
-            for (k, rows) in chunk.chunks_exact_mut(width.max(1)).enumerate() {
-                let row = first + k;
-                let mut job = SimJob {
-                    method,
-                    x0: &xs[row * s..(row + 1) * s],
-                    inputs: us,
-                    t0,
-                    t_eval: times,
-                    rtol,
-                    atol,
-                    h_max,
-                    max_steps,
-                    out: rows,
-                    event: None,
-                    written: 0,
-                    event_at: None,
-                };
-                model
-                    .simulate(scene, &mut job)
-                    .map_err(|message| Failure { row, message })?;
-            }
-            Ok(())
-        };
-        let result = if batch.is_some() {
-            py.allow_threads(|| split_rows(n, width, threads, 1, &mut out, run))
-        } else {
-            py.allow_threads(|| run(0, &mut out))
-        };
-        result.map_err(|f| {
-            let message = match batch {
-                Some(_) => format!("simulate at row {}: {}", f.row, f.message),
-                None => format!("simulate: {}", f.message),
-            };
-            model_error(py, message)
-        })?;
-        let shape: Vec<usize> = match batch {
-            Some(n) => vec![n, times.len(), s],
-            None => vec![times.len(), s],
-        };
-        Ok(PyArray1::from_vec(py, out)
-            .reshape(IxDyn(&shape))?
-            .into_any()
-            .unbind())
     }
+}
+
+/// What every simulation of one `simulate` call shares.
+struct Settings<'a> {
+    method: Method,
+    inputs: &'a [f64],
+    t0: f64,
+    t_eval: &'a [f64],
+    rtol: f64,
+    atol: f64,
+    h_max: Option<f64>,
+    max_steps: usize,
+}
+
+impl Settings<'_> {
+    /// The job that integrates from `x0` into `out`.
+    fn job<'b>(
+        &'b self,
+        x0: &'b [f64],
+        out: &'b mut [f64],
+        event: Option<&'b mut Event<'b>>,
+    ) -> SimJob<'b> {
+        SimJob {
+            method: self.method,
+            x0,
+            inputs: self.inputs,
+            t0: self.t0,
+            t_eval: self.t_eval,
+            rtol: self.rtol,
+            atol: self.atol,
+            h_max: self.h_max,
+            max_steps: self.max_steps,
+            out,
+            event,
+            written: 0,
+            event_at: None,
+        }
+    }
+}
+
+/// The initial states: one (`batch` None) or `batch` rows of `s` entries.
+struct States<'a> {
+    x0: &'a [f64],
+    s: usize,
+    batch: Option<usize>,
+}
+
+/// One run until the Python function `g(t, x)` changes sign: the times
+/// reached, the states there, and the event's (t, x) or None.
+fn simulate_event(
+    py: Python<'_>,
+    model: &dyn Evaluate,
+    scene: Option<usize>,
+    settings: &Settings<'_>,
+    states: &States<'_>,
+    g: Bound<'_, PyAny>,
+) -> PyResult<PyObject> {
+    let (s, times) = (states.s, settings.t_eval);
+    if states.batch.is_some() {
+        return Err(PyValueError::new_err(
+            "an event function takes one initial state, not a batch",
+        ));
+    }
+    let mut out = vec![0.0; times.len() * s];
+    let mut raised: Option<PyErr> = None;
+    let mut call = |t: f64, x: &[f64]| -> f64 {
+        if raised.is_some() {
+            return f64::NAN;
+        }
+        let state = PyArray1::from_slice(py, x);
+        match g.call1((t, state)).and_then(|v| v.extract::<f64>()) {
+            Ok(v) => v,
+            Err(e) => {
+                raised = Some(e);
+                f64::NAN
+            }
+        }
+    };
+    let mut job = settings.job(states.x0, &mut out, Some(&mut call));
+    let result = model.simulate(scene, &mut job);
+    let (written, event_at) = (job.written, job.event_at.take());
+    if let Some(e) = raised {
+        return Err(e);
+    }
+    result.map_err(|m| model_error(py, format!("simulate: {m}")))?;
+    out.truncate(written * s);
+    let reached = PyArray1::from_vec(py, out).reshape(IxDyn(&[written, s]))?;
+    let at = match event_at {
+        Some((t, x)) => (t, PyArray1::from_vec(py, x)).into_pyobject(py)?.into_any(),
+        None => py.None().into_bound(py),
+    };
+    Ok((&times[..written].to_vec(), reached, at)
+        .into_pyobject(py)?
+        .into_any()
+        .unbind())
+}
+
+/// One run per initial state, a batch split over `threads` with the GIL
+/// released: (len(t_eval), s), or (batch, len(t_eval), s).
+fn simulate_rows(
+    py: Python<'_>,
+    model: &dyn Evaluate,
+    scene: Option<usize>,
+    settings: &Settings<'_>,
+    states: &States<'_>,
+    threads: usize,
+) -> PyResult<PyObject> {
+    let (s, times, batch) = (states.s, settings.t_eval, states.batch);
+    let width = times.len() * s;
+    let n = batch.unwrap_or(1);
+    let mut out = vec![0.0; n * width];
+    let run = |first: usize, chunk: &mut [f64]| -> Result<(), Failure> {
+        for (k, rows) in chunk.chunks_exact_mut(width.max(1)).enumerate() {
+            let row = first + k;
+            let mut job = settings.job(&states.x0[row * s..(row + 1) * s], rows, None);
+            model
+                .simulate(scene, &mut job)
+                .map_err(|message| Failure { row, message })?;
+        }
+        Ok(())
+    };
+    let result = if batch.is_some() {
+        py.allow_threads(|| split_rows(n, width, threads, 1, &mut out, run))
+    } else {
+        py.allow_threads(|| run(0, &mut out))
+    };
+    result.map_err(|f| {
+        let message = match batch {
+            Some(_) => format!("simulate at row {}: {}", f.row, f.message),
+            None => format!("simulate: {}", f.message),
+        };
+        model_error(py, message)
+    })?;
+    let shape: Vec<usize> = match batch {
+        Some(n) => vec![n, times.len(), s],
+        None => vec![times.len(), s],
+    };
+    Ok(PyArray1::from_vec(py, out)
+        .reshape(IxDyn(&shape))?
+        .into_any()
+        .unbind())
 }
