@@ -837,6 +837,14 @@ impl Emitter<'_> {
         quote!({ #params_t #(#binds)* #statements #(#tests)* })
     }
 
+    /// The quaternions whose four coordinates are all in the reduced state.
+    pub(super) fn retained_quaternions(&self) -> impl Iterator<Item = &[usize; 4]> {
+        let retained = &self.d.reduction.retained;
+        let all = &self.model.quaternions;
+        all.iter()
+            .filter(|block| block.iter().all(|c| retained.contains(c)))
+    }
+
     /// A quaternion of the reduced state with zero length is an error in
     /// `rhs` itself: the rates no longer divide by its length (they hold
     /// on the unit sphere), so nothing else would turn non-finite. One
@@ -846,13 +854,9 @@ impl Emitter<'_> {
     pub(super) fn quaternion_length_checks(&self) -> TokenStream {
         let p = p();
         let model = self.model;
-        let retained = &self.d.reduction.retained;
         let g = &model.g;
         let mut checked = Vec::new();
-        for block in &model.quaternions {
-            if !block.iter().all(|c| retained.contains(c)) {
-                continue;
-            }
+        for block in self.retained_quaternions() {
             let symbols: Vec<Symbol> = block.iter().map(|&c| model.coords[c].1.q).collect();
             // The block's squared length: the norm reading its four
             // coordinates and nothing else.

@@ -81,28 +81,29 @@ fn world_columns(
     let g = &mut model.g;
     let mut derivatives = self::derivatives(g, &rates, columns)?;
     let mut solved = Vec::with_capacity(n + 4 * w.roots.len());
+    // −∂Q/∂c as the l entries of column j of the l×l matrix `m`.
+    let negated =
+        |g: &mut appell_symbolic::Graph, m: &[Id], j: usize| -> Result<Vec<Id>, SymbolicError> {
+            (0..l).map(|k| g.neg(m[k * l + j])).collect()
+        };
     for c in columns.all() {
-        let mut forcing = Vec::with_capacity(l);
-        for k in 0..l {
-            let entry = if let Some(j) = speeds.iter().position(|&s| s == c) {
-                g.neg(w.by_speeds[k * l + j])?
-            } else if let Some(r) = model.coords.iter().position(|x| x.1.q == c) {
-                match w.coordinates.iter().position(|&x| x == Some(r)) {
-                    Some(j) => g.neg(w.by_coordinates[k * l + j])?,
-                    None => g.int(0)?,
-                }
-            } else {
-                g.diff(w.inputs[k], c)?
-            };
-            forcing.push(entry);
-        }
+        let forcing = if let Some(j) = speeds.iter().position(|&s| s == c) {
+            negated(g, &w.by_speeds, j)?
+        } else if let Some(r) = model.coords.iter().position(|x| x.1.q == c) {
+            match w.coordinates.iter().position(|&x| x == Some(r)) {
+                Some(j) => negated(g, &w.by_coordinates, j)?,
+                None => vec![g.int(0)?; l],
+            }
+        } else {
+            let inputs = w.inputs.iter().map(|&tau| g.diff(tau, c));
+            inputs.collect::<Result<_, _>>()?
+        };
         solved.push(forcing);
     }
     // A free root's turns in the body's axes and its gravity's scale.
     for root in &w.roots {
         for &j in &root.angular {
-            let column = (0..l).map(|k| g.neg(w.by_coordinates[k * l + j]));
-            solved.push(column.collect::<Result<_, _>>()?);
+            solved.push(negated(g, &w.by_coordinates, j)?);
         }
         let column = root.gravity.iter().map(|&x| g.neg(x));
         solved.push(column.collect::<Result<_, _>>()?);

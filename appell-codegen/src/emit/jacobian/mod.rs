@@ -308,12 +308,7 @@ impl Emitter<'_> {
     /// Whether a quaternion's four coordinates are in the state: there the
     /// rhs's forms agree only on the unit sphere.
     fn quaternion_in_state(&self) -> bool {
-        let retained = &self.d.reduction.retained;
-        let model = self.model;
-        model
-            .quaternions
-            .iter()
-            .any(|block| block.iter().all(|c| retained.contains(c)))
+        self.retained_quaternions().next().is_some()
     }
 
     /// Every symbolic candidate stage 14 built, with its sizes, counted
