@@ -58,6 +58,19 @@ def wheel_axle(cache):
     return appell.from_model(attributes, parameters=defaults, name=name)
 
 
+PENDULUM = """
+coordinates(q), speeds(q), positive(m, l)
+point(P = O + l * sin(q) * N.x - l * cos(q) * N.y), particle(P, mass = m)
+gravity(-g * N.y)
+"""
+
+
+@pytest.fixture(scope="session")
+def pendulum(cache):
+    """A model without inputs."""
+    return appell.from_model(PENDULUM, parameters={"m": 1.0, "l": 0.5, "g": 9.81}, name="Pendulum")
+
+
 @pytest.fixture(scope="session")
 def bicycle(cache):
     attributes, defaults, name = rust_model("whipple_bicycle.rs")

@@ -31,6 +31,23 @@ def test_batched_equals_looped(ur5, rng):
     assert A.shape == (5, 11, 11) and B.shape == (5, 11, 6)
     A0, B0 = ur5.linearize(x[3], tau[3])
     assert np.array_equal(A[3], A0) and np.array_equal(B[3], B0)
+    rates = ur5.coordinate_rates(q, v, tau)
+    assert np.array_equal(rates, np.array([ur5.coordinate_rates(q[k], v[k], tau[k]) for k in range(300)]))
+    e = ur5.energies(q[:20], v[:20], tau[:20])
+    for k in (0, 19):
+        one = ur5.energies(q[k], v[k], tau[k])
+        assert all(e[name][k] == one[name] for name in one)
+
+
+def test_batched_constraint_forces_equal_looped(bicycle, rng):
+    q = rng.uniform(-0.5, 0.5, (12, len(bicycle.coordinate_names)))
+    v = rng.uniform(-3, 3, (12, 3))
+    tau = rng.uniform(-1, 1, (12, 1))
+    lam, qdd = bicycle.constraint_forces(q, v, tau)
+    assert lam.shape == (12, bicycle.info["constraints"])
+    for k in (0, 5, 11):
+        lam_k, qdd_k = bicycle.constraint_forces(q[k], v[k], tau[k])
+        assert np.array_equal(lam[k], lam_k) and np.array_equal(qdd[k], qdd_k)
 
 
 def test_threads_do_not_change_results(ur5, rng):
@@ -135,6 +152,60 @@ def test_simulate_event(wheel_axle):
     t_event, x_event = event
     assert abs(x_event[2] - 1.0) < 1e-6
     assert len(times) == len(states) and times[-1] <= t_event
+
+
+def test_simulate_with_a_feedback_law(wheel_axle):
+    from scipy.integrate import odeint
+
+    m = wheel_axle
+    x0 = np.array([0.3, 0.1, 0.0])
+    t = np.linspace(0.0, 2.0, 21)
+    # A law that returns the held value gives the held run, to the bit.
+    for method, extra in (("dop853", {}), ("radau5", {}), ("rk4", {"h_max": 1e-2})):
+        held = m.simulate(x0, t, u=[0.5], method=method, **extra)
+        law = m.simulate(x0, t, u=lambda t, x: np.array([0.5]), method=method, **extra)
+        assert np.array_equal(law, held), method
+    # A damping torque on psi1's rate, returned as a dict, against odeint
+    # calling the same law.
+    calls = []
+
+    def damping(t, x):
+        calls.append(t)
+        return {"tau": -2.0 * x[2]}
+
+    dop = m.simulate(x0, t, u=damping, rtol=1e-11, atol=1e-12)
+    assert len(calls) > len(t)
+    y = odeint(m.ode_function(form="odeint"), x0, t, args=(lambda x, t: [-2.0 * x[2]],),
+               rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(dop, y, atol=1e-7)
+    free = m.simulate(x0, t, u=[0.0], rtol=1e-11, atol=1e-12)
+    assert abs(dop[-1, 2]) < abs(free[-1, 2])
+    radau = m.simulate(x0, t, u=damping, method="radau5", rtol=1e-10, atol=1e-12)
+    np.testing.assert_allclose(radau, dop, atol=1e-7)
+    # A batch runs its rows one after another with the law.
+    many = np.array([x0, x0 + 0.1])
+    batch = m.simulate(many, t, u=damping)
+    for k in range(2):
+        assert np.array_equal(batch[k], m.simulate(many[k], t, u=damping))
+    # With an event as well.
+    times, states, event = m.simulate([0.3, 0.0, 0.0], np.linspace(0, 5, 51),
+                                      u=lambda t, x: [0.1], event=lambda t, x: x[2] - 1.0)
+    assert event is not None and abs(event[1][2] - 1.0) < 1e-6
+
+
+def test_odeint_form_without_inputs_is_pydys(pendulum):
+    from scipy.integrate import odeint
+
+    m = pendulum
+    assert m.input_names == []
+    x0, t = np.array([0.4, 0.0]), np.linspace(0.0, 1.0, 11)
+    # PyDy's generated rhs of a system without specifieds is f(x, t, p).
+    y = odeint(m.ode_function(form="odeint"), x0, t, args=({"m": 1.0, "l": 0.5, "g": 9.81},),
+               rtol=1e-11, atol=1e-12)
+    np.testing.assert_allclose(y, m.simulate(x0, t, rtol=1e-11, atol=1e-12), atol=1e-8)
+    longer = odeint(m.ode_function(form="odeint"), x0, t, args=({"m": 1.0, "l": 2.0, "g": 9.81},),
+                    rtol=1e-11, atol=1e-12)
+    assert abs(longer[-1, 0] - y[-1, 0]) > 1e-3
 
 
 def test_constraint_forces_and_energies(wheel_axle, rng):

@@ -13,18 +13,7 @@ import numpy as np
 import pytest
 
 import appell
-
-PENDULUM = """
-coordinates(q), speeds(q), positive(m, l)
-point(P = O + l * sin(q) * N.x - l * cos(q) * N.y), particle(P, mass = m)
-gravity(-g * N.y)
-"""
-
-
-@pytest.fixture(scope="module")
-def pendulum(cache):
-    return appell.from_model(PENDULUM, parameters={"m": 1.0, "l": 0.5, "g": 9.81}, name="Pendulum")
-
+from conftest import PENDULUM
 
 def test_shapes_names_and_values(wheel_axle):
     m = wheel_axle
@@ -56,6 +45,29 @@ def test_shapes_names_and_values(wheel_axle):
         m.simulate([0, 0, 0.0], [0, 1, 0.5], u=[0.0])
     with pytest.raises(appell.ModelError, match="h_max"):
         m.simulate([0, 0, 0.0], [0, 1], u=[0.0], method="rk4")
+
+
+def test_a_feedback_law_that_fails(wheel_axle, pendulum):
+    m, x0, t = wheel_axle, [0.3, 0.1, 0.0], [0.0, 1.0]
+
+    def raises(t, x):
+        raise ZeroDivisionError("the controller divided by zero")
+    with pytest.raises(ZeroDivisionError, match="controller"):
+        m.simulate(x0, t, u=raises)
+    with pytest.raises(ZeroDivisionError):
+        m.simulate(x0, t, u=raises, method="radau5")
+    with pytest.raises(ZeroDivisionError):
+        m.simulate(x0, t, u=raises, event=lambda t, x: x[2] - 1.0)
+    with pytest.raises(ValueError, match=r"expected \(1,\)"):
+        m.simulate(x0, t, u=lambda t, x: [0.0, 1.0])
+    with pytest.raises(KeyError, match="did you mean 'tau'"):
+        m.simulate(x0, t, u=lambda t, x: {"tua": 0.0})
+    with pytest.raises(appell.ModelError, match=r"u\(t, x\) returned NaN for input 0 at t = "):
+        m.simulate(x0, t, u=lambda t, x: [np.nan], method="rk4", h_max=0.1)
+    with pytest.raises(appell.ModelError, match=r"row 1: u\(t, x\) returned inf"):
+        m.simulate(np.array([x0, [5.0, 0.1, 0.0]]), t, u=lambda t, x: [np.inf] if x[0] > 4.0 else [0.0])
+    with pytest.raises(ValueError, match="no inputs"):
+        pendulum.simulate([0.1, 0.0], t, u=lambda t, x: [])
 
 
 def test_functions_a_model_lacks(pendulum):

@@ -1,5 +1,9 @@
 """The Python results against the Rust examples (bit for bit), SymPy's
-bicycle, the paper's closed form for the wheel-axle, and Pinocchio's UR5."""
+bicycle, the paper's closed form for the wheel-axle, and Pinocchio's UR5.
+
+The wheel-axle's reference is Wang & Pao's eq. 64, exact, which the Rust
+tests hold it to as well: no SymPy data for the wheel-axle is committed
+(the committed SymPy data is the bicycle's)."""
 
 from __future__ import annotations
 
@@ -125,6 +129,22 @@ def test_bicycle_rhs_and_jacobian_equal_rust(bicycle, rng):
         assert np.array_equal(A2, A) and np.array_equal(B2, B)
         # the Jacobian's program computes the rates its own way
         np.testing.assert_allclose(xdot, got, rtol=1e-12, atol=1e-12)
+
+
+def test_constraint_forces_equal_rust_bit_for_bit(wheel_axle, bicycle, rng):
+    """The multipliers against the command line's `contacts` action."""
+    for example, m, scale in (("wheel_axle", wheel_axle, 2.0), ("whipple_bicycle", bicycle, 0.5)):
+        lines, args = [], []
+        for _ in range(8):
+            q = full_coordinates(m, rng, scale)
+            v = rng.uniform(-3, 3, size=len(m.speed_names))
+            u = rng.uniform(-1, 1, size=len(m.input_names))
+            lines.append({"q": dict(zip(m.coordinate_names, q)), "u": dict(zip(m.speed_names, v)),
+                          "inputs": dict(zip(m.input_names, u))})
+            args.append((q, v, u))
+        for (q, v, u), a in zip(args, rust_answers(example, lines, action="contacts")):
+            lam, _ = m.constraint_forces(q, v, u)
+            assert np.array_equal(lam, np.array(a["multipliers"])), example
 
 
 def test_ur5_from_urdf_equals_rust_bit_for_bit(ur5, rng):

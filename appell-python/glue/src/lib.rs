@@ -18,7 +18,7 @@ mod simulate;
 
 pub use ops::{Arg, Compiled, Evaluate, Failure, Op};
 pub use python::{register, NativeModel};
-pub use simulate::{Event, Method, SimJob, DOP853_MAX_STATE};
+pub use simulate::{Event, Feedback, Method, SimJob, DOP853_MAX_STATE};
 
 /// The version of the interface between this crate and the Python package
 /// (`appell._loader` checks it when it loads a model).

@@ -2,9 +2,11 @@
 //! [`DynRhs`] so that the integrators are compiled once in this crate, not
 //! once per model.
 
+use std::cell::RefCell;
+
 use appell::integrate::{Dop853, EventFn, Radau5};
 use appell::num_dual::Dual64;
-use appell::DynRhs;
+use appell::{DynRhs, ModelError};
 
 /// The integrator of [`SimJob`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -39,6 +41,10 @@ pub const DOP853_MAX_STATE: usize = 64;
 /// An event function `g(t, x)` (see [`SimJob::event`]).
 pub type Event<'a> = dyn FnMut(f64, &[f64]) -> f64 + 'a;
 
+/// A state feedback `u(t, x)` (see [`SimJob::feedback`]): writes the
+/// inputs at `(t, x)` into its third argument, or says why it cannot.
+pub type Feedback<'a> = dyn FnMut(f64, &[f64], &mut [f64]) -> Result<(), String> + 'a;
+
 /// A simulation: from `x0` at `t0`, the state at each of `t_eval` (ordered
 /// in the direction of integration, the first not before `t0`), written
 /// row after row into `out`.
@@ -47,8 +53,13 @@ pub struct SimJob<'a> {
     pub method: Method,
     /// The initial reduced state.
     pub x0: &'a [f64],
-    /// The inputs, held constant.
+    /// The inputs, held constant (without [`SimJob::feedback`]).
     pub inputs: &'a [f64],
+    /// The inputs as a function of the time and the state, called at every
+    /// evaluation of the rhs. Radau5's Newton iteration then uses ∂rhs/∂x
+    /// with the inputs frozen at `u(t, x)` (the law's own derivative is not
+    /// known), which changes its convergence, not its solution.
+    pub feedback: Option<&'a mut Feedback<'a>>,
     /// The initial time.
     pub t0: f64,
     /// The output times.
@@ -70,6 +81,59 @@ pub struct SimJob<'a> {
     pub written: usize,
     /// Set by the simulation: the time of the event and the state there.
     pub event_at: Option<(f64, Vec<f64>)>,
+}
+
+/// The inputs of one run: held, or a feedback law called at every
+/// evaluation. A law's failure is kept, to be reported in place of the
+/// error it makes the integrator stop with.
+struct Law<'a> {
+    held: &'a [f64],
+    feedback: Option<RefCell<(&'a mut Feedback<'a>, Vec<f64>)>>,
+    failure: RefCell<Option<String>>,
+}
+
+impl<'a> Law<'a> {
+    fn of(job: &mut SimJob<'a>) -> Law<'a> {
+        let inputs = vec![0.0; job.inputs.len()];
+        Law {
+            held: job.inputs,
+            feedback: job.feedback.take().map(|f| RefCell::new((f, inputs))),
+            failure: RefCell::new(None),
+        }
+    }
+
+    /// `with` called on the inputs at `(t, x)`.
+    fn with<R>(
+        &self,
+        t: f64,
+        x: &[f64],
+        with: impl FnOnce(&[f64]) -> Result<R, ModelError>,
+    ) -> Result<R, ModelError> {
+        let Some(cell) = &self.feedback else {
+            return with(self.held);
+        };
+        let mut guard = cell.borrow_mut();
+        let (law, inputs) = &mut *guard;
+        if let Err(message) = law(t, x, inputs) {
+            self.failure.borrow_mut().get_or_insert(message);
+            return Err(ModelError::NonFinite {
+                what: "the inputs u(t, x)",
+            });
+        }
+        with(inputs)
+    }
+
+    fn rhs(&self, rhs: &dyn DynRhs, t: f64, x: &[f64], dx: &mut [f64]) -> Result<(), ModelError> {
+        self.with(t, x, |u| rhs.rhs(t, x, u, dx))
+    }
+
+    /// The run's error message: the law's failure, if it failed.
+    fn error(&self, e: impl ToString) -> String {
+        match self.failure.borrow().as_ref() {
+            Some(message) => message.clone(),
+            None => e.to_string(),
+        }
+    }
 }
 
 fn check(job: &SimJob<'_>, s: usize) -> Result<(), String> {
@@ -146,8 +210,8 @@ pub fn simulate_dyn(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), String
 fn dop853<const S: usize>(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), String> {
     let mut x0 = [0.0; S];
     x0.copy_from_slice(job.x0);
-    let inputs = job.inputs;
-    let f = |t: f64, x: &[f64; S], dx: &mut [f64; S]| rhs.rhs(t, x, inputs, dx);
+    let law = Law::of(job);
+    let f = |t: f64, x: &[f64; S], dx: &mut [f64; S]| law.rhs(rhs, t, x, dx);
     let solver = Dop853::new()
         .rtol(job.rtol)
         .atol(job.atol)
@@ -170,7 +234,7 @@ fn dop853<const S: usize>(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), 
         }
         None => solver.solve_with(f, job.t0, &x0, t_end, job.t_eval, &mut sink, None),
     }
-    .map_err(|e| e.to_string())?;
+    .map_err(|e| law.error(e))?;
     job.written = written.min(job.t_eval.len());
     if solution.event {
         job.event_at = Some((solution.t, solution.x.to_vec()));
@@ -214,10 +278,10 @@ fn jacobian(
 }
 
 fn radau5(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), String> {
-    let inputs = job.inputs;
+    let law = Law::of(job);
     let s = job.x0.len();
-    let f = |t: f64, x: &[f64], dx: &mut [f64]| rhs.rhs(t, x, inputs, dx);
-    let jac = |t: f64, x: &[f64], j: &mut [f64]| jacobian(rhs, t, x, inputs, j);
+    let f = |t: f64, x: &[f64], dx: &mut [f64]| law.rhs(rhs, t, x, dx);
+    let jac = |t: f64, x: &[f64], j: &mut [f64]| law.with(t, x, |u| jacobian(rhs, t, x, u, j));
     let mut out: Vec<(f64, Vec<f64>)> = job.t_eval.iter().map(|&t| (t, Vec::new())).collect();
     let solution = Radau5::new()
         .rtol(job.rtol)
@@ -225,7 +289,7 @@ fn radau5(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), String> {
         .max_steps(job.max_steps)
         .h_max(job.h_max)
         .solve_at(f, jac, job.t0, job.x0, &mut out)
-        .map_err(|e| e.to_string())?;
+        .map_err(|e| law.error(e))?;
     if solution.outputs != out.len() {
         return Err(format!(
             "the integrator reported {} of the {} output times",
@@ -244,7 +308,7 @@ fn rk4(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), String> {
     let Some(h_max) = job.h_max.filter(|h| *h > 0.0 && h.is_finite()) else {
         return Err("method=\"rk4\" needs a positive step h_max".into());
     };
-    let inputs = job.inputs;
+    let law = Law::of(job);
     let s = job.x0.len();
     let mut x = job.x0.to_vec();
     let (mut k1, mut k2, mut k3, mut k4, mut tmp) = (
@@ -255,25 +319,25 @@ fn rk4(rhs: &dyn DynRhs, job: &mut SimJob<'_>) -> Result<(), String> {
         vec![0.0; s],
     );
     let mut t = job.t0;
-    let err = |e: appell::ModelError| e.to_string();
+    let err = |e: ModelError| law.error(e);
     for (k, &target) in job.t_eval.iter().enumerate() {
         let span = target - t;
         let steps = (span.abs() / h_max).ceil() as usize;
         let h = if steps == 0 { 0.0 } else { span / steps as f64 };
         for _ in 0..steps {
-            rhs.rhs(t, &x, inputs, &mut k1).map_err(err)?;
+            law.rhs(rhs, t, &x, &mut k1).map_err(err)?;
             for i in 0..s {
                 tmp[i] = x[i] + 0.5 * h * k1[i];
             }
-            rhs.rhs(t + 0.5 * h, &tmp, inputs, &mut k2).map_err(err)?;
+            law.rhs(rhs, t + 0.5 * h, &tmp, &mut k2).map_err(err)?;
             for i in 0..s {
                 tmp[i] = x[i] + 0.5 * h * k2[i];
             }
-            rhs.rhs(t + 0.5 * h, &tmp, inputs, &mut k3).map_err(err)?;
+            law.rhs(rhs, t + 0.5 * h, &tmp, &mut k3).map_err(err)?;
             for i in 0..s {
                 tmp[i] = x[i] + h * k3[i];
             }
-            rhs.rhs(t + h, &tmp, inputs, &mut k4).map_err(err)?;
+            law.rhs(rhs, t + h, &tmp, &mut k4).map_err(err)?;
             for i in 0..s {
                 x[i] += h / 6.0 * (k1[i] + 2.0 * k2[i] + 2.0 * k3[i] + k4[i]);
             }

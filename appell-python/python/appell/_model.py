@@ -341,7 +341,7 @@ class Model:
         return (out[..., :l], out[..., l:at].reshape(lead + (l, n)),
                 out[..., at : at + l * l].reshape(lead + (l, l)), out[..., at + l * l :].reshape(lead + (l, self._ni)))
 
-    def simulate(self, x0: ArrayLike, t_eval: ArrayLike, u: Optional[ArrayLike] = None,
+    def simulate(self, x0: ArrayLike, t_eval: ArrayLike, u: Any = None,
                  method: str = "dop853", rtol: float = 1e-8, atol: float = 1e-10,
                  t0: Optional[float] = None, h_max: Optional[float] = None,
                  max_steps: int = 1_000_000, params: Any = None,
@@ -350,16 +350,31 @@ class Model:
         returns the states at ``t_eval``: (len(t_eval), s), or
         (N, len(t_eval), s) for N initial states (split over threads).
         ``method``: "dop853" (adaptive, explicit), "radau5" (implicit, for
-        stiff models) or "rk4" (fixed steps of at most ``h_max``). Inputs
-        ``u`` are held constant.
+        stiff models) or "rk4" (fixed steps of at most ``h_max``).
+
+        Inputs ``u``: held constant (an array or a dict of names), or a
+        function ``u(t, x)`` of the time and the reduced state that returns
+        them (array or dict), called at every evaluation of the rhs: a
+        feedback controller. With a function, the rows of a batch run one
+        after another, and Radau5's Newton iteration uses the model's
+        Jacobian with the inputs held at their current values (the law's own
+        derivative is not known), which may slow its convergence but does
+        not change its solution.
 
         With ``event`` (a function g(t, x); one initial state; DOP853), the
         run stops where g changes sign, and the result is a tuple
         (times reached, states there, (t_event, x_event) or None)."""
         xa = self._array("x0", x0, self.state_names)
-        ua = self._array("u", u, self.input_names)
-        if ua.ndim != 1:
-            raise ValueError("simulate holds the inputs constant: `u` must be one row")
+        feedback = None
+        if callable(u):
+            if not self.input_names:
+                raise ValueError(f"`u` is a function, but the model {self.name} has no inputs")
+            feedback = self._feedback(u)
+            ua = np.zeros(len(self.input_names))
+        else:
+            ua = self._array("u", u, self.input_names)
+            if ua.ndim != 1:
+                raise ValueError("`u` must be one row of inputs, or a function u(t, x)")
         times = np.ascontiguousarray(t_eval, dtype=np.float64)
         if times.ndim != 1 or times.size == 0:
             raise ValueError(f"`t_eval` must be a non-empty 1-D array, got shape {times.shape}")
@@ -369,16 +384,30 @@ class Model:
         p = None if params is None else self._parameter_array(params)
         return self._native.simulate(xa, ua, start, times, method, float(rtol), float(atol),
                                      None if h_max is None else float(h_max), int(max_steps),
-                                     self._scene, p, _threads, event)
+                                     self._scene, p, _threads, event, feedback)
+
+    def _feedback(self, law: Callable[..., Any]) -> Callable[[float, np.ndarray], np.ndarray]:
+        """``law(t, x)`` checked and returned as one float64 row of inputs."""
+        names = self.input_names
+
+        def inputs(t: float, x: np.ndarray) -> np.ndarray:
+            row = self._array("u", law(t, x), names)
+            if row.ndim != 1:
+                raise ValueError(f"u(t, x) must return one row of inputs {list(names)}, "
+                                 f"got shape {row.shape}")
+            return row
+        return inputs
 
     def ode_function(self, u: Optional[ArrayLike] = None, params: Any = None,
                      form: str = "solve_ivp") -> Callable[..., np.ndarray]:
         """The rhs as a plain function. ``form="solve_ivp"``: ``f(t, x)``
         for ``scipy.integrate.solve_ivp`` (``vectorized=True`` works: x of
-        shape (s, k)). ``form="odeint"``: ``f(x, t, r=None, p=None)`` as
-        PyDy's generated rhs, for ``scipy.integrate.odeint``; ``r`` the
-        inputs (array, dict, or a function ``r(x, t)``), ``p`` the
-        parameters (array or dict). ``u`` and ``params`` are the defaults."""
+        shape (s, k)). ``form="odeint"``: the signature of PyDy's generated
+        rhs, for ``scipy.integrate.odeint``: ``f(x, t, r=None, p=None)``,
+        or ``f(x, t, p=None)`` for a model without inputs (as PyDy drops
+        ``r`` for a system without specifieds); ``r`` the inputs (array,
+        dict, or a function ``r(x, t)``), ``p`` the parameters (array or
+        dict). ``u`` and ``params`` are the defaults."""
         fixed_u = self._array("u", u, self.input_names)
         fixed_p = None if params is None else self._parameter_array(params)
         rhs = self.rhs
@@ -390,6 +419,10 @@ class Model:
                     return rhs(np.ascontiguousarray(x.T), fixed_u, t, fixed_p).T
                 return rhs(x, fixed_u, t, fixed_p)
             return f
+        if form == "odeint" and not self.input_names:
+            def h(x: np.ndarray, t: float, p: Any = None) -> np.ndarray:
+                return rhs(x, fixed_u, t, fixed_p if p is None else p)
+            return h
         if form == "odeint":
             def g(x: np.ndarray, t: float, r: Any = None, p: Any = None) -> np.ndarray:
                 if r is None:

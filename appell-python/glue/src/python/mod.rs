@@ -11,7 +11,10 @@ use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
 use crate::ops::{Arg, Compiled, Evaluate, Failure, Op};
-use crate::simulate::{Event, Method, SimJob};
+use crate::simulate::Method;
+
+mod simulate;
+use simulate::{simulate_event, simulate_rows, Settings, States};
 
 /// The model a compiled module exports (`module.model`), wrapped by the
 /// Python package's `appell.Model`, which checks shapes and names.
@@ -37,7 +40,7 @@ where
 
 /// `appell.errors.ModelError(message)`: the package's exception for a
 /// model that cannot be evaluated where it was asked to be.
-fn model_error(py: Python<'_>, message: String) -> PyErr {
+pub(crate) fn model_error(py: Python<'_>, message: String) -> PyErr {
     match py
         .import("appell.errors")
         .and_then(|m| m.getattr("ModelError"))
@@ -60,7 +63,7 @@ fn failure(py: Python<'_>, f: Failure, batched: bool, op: Op) -> PyErr {
 /// Splits `rows` rows of `width` results over up to `threads` threads
 /// (one row per thread at least `min_rows` rows), the first failure by row
 /// returned.
-fn split_rows<F>(
+pub(crate) fn split_rows<F>(
     rows: usize,
     width: usize,
     threads: usize,
@@ -433,7 +436,10 @@ impl NativeModel {
     /// (N, len(t_eval), s). With `event` (one initial state, DOP853), a
     /// callable g(t, x) -> float: the run stops where g changes sign and
     /// the result is (times reached, states, (t_event, x_event) or None).
-    #[pyo3(signature = (x0, u, t0, t_eval, method="dop853", rtol=1e-8, atol=1e-10, h_max=None, max_steps=1_000_000, scene=None, params=None, threads=1, event=None))]
+    /// With `feedback`, a callable u(t, x) -> float64 array of the inputs
+    /// called at every evaluation of the rhs (`u` then only gives their
+    /// number): rows run one after another, holding the GIL.
+    #[pyo3(signature = (x0, u, t0, t_eval, method="dop853", rtol=1e-8, atol=1e-10, h_max=None, max_steps=1_000_000, scene=None, params=None, threads=1, event=None, feedback=None))]
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,
@@ -451,6 +457,7 @@ impl NativeModel {
         params: Option<Vec<f64>>,
         threads: usize,
         event: Option<Bound<'py, PyAny>>,
+        feedback: Option<Bound<'py, PyAny>>,
     ) -> PyResult<PyObject> {
         let method = Method::from_name(method).ok_or_else(|| {
             PyValueError::new_err(format!(
@@ -495,149 +502,8 @@ impl NativeModel {
         };
         let states = States { x0: xs, s, batch };
         match event {
-            Some(g) => simulate_event(py, &*model, scene, &settings, &states, g),
-            None => simulate_rows(py, &*model, scene, &settings, &states, threads),
+            Some(g) => simulate_event(py, &*model, scene, &settings, &states, g, feedback),
+            None => simulate_rows(py, &*model, scene, &settings, &states, threads, feedback),
         }
     }
-}
-
-/// What every simulation of one `simulate` call shares.
-struct Settings<'a> {
-    method: Method,
-    inputs: &'a [f64],
-    t0: f64,
-    t_eval: &'a [f64],
-    rtol: f64,
-    atol: f64,
-    h_max: Option<f64>,
-    max_steps: usize,
-}
-
-impl Settings<'_> {
-    /// The job that integrates from `x0` into `out`.
-    fn job<'b>(
-        &'b self,
-        x0: &'b [f64],
-        out: &'b mut [f64],
-        event: Option<&'b mut Event<'b>>,
-    ) -> SimJob<'b> {
-        SimJob {
-            method: self.method,
-            x0,
-            inputs: self.inputs,
-            t0: self.t0,
-            t_eval: self.t_eval,
-            rtol: self.rtol,
-            atol: self.atol,
-            h_max: self.h_max,
-            max_steps: self.max_steps,
-            out,
-            event,
-            written: 0,
-            event_at: None,
-        }
-    }
-}
-
-/// The initial states: one (`batch` None) or `batch` rows of `s` entries.
-struct States<'a> {
-    x0: &'a [f64],
-    s: usize,
-    batch: Option<usize>,
-}
-
-/// One run until the Python function `g(t, x)` changes sign: the times
-/// reached, the states there, and the event's (t, x) or None.
-fn simulate_event(
-    py: Python<'_>,
-    model: &dyn Evaluate,
-    scene: Option<usize>,
-    settings: &Settings<'_>,
-    states: &States<'_>,
-    g: Bound<'_, PyAny>,
-) -> PyResult<PyObject> {
-    let (s, times) = (states.s, settings.t_eval);
-    if states.batch.is_some() {
-        return Err(PyValueError::new_err(
-            "an event function takes one initial state, not a batch",
-        ));
-    }
-    let mut out = vec![0.0; times.len() * s];
-    let mut raised: Option<PyErr> = None;
-    let mut call = |t: f64, x: &[f64]| -> f64 {
-        if raised.is_some() {
-            return f64::NAN;
-        }
-        let state = PyArray1::from_slice(py, x);
-        match g.call1((t, state)).and_then(|v| v.extract::<f64>()) {
-            Ok(v) => v,
-            Err(e) => {
-                raised = Some(e);
-                f64::NAN
-            }
-        }
-    };
-    let mut job = settings.job(states.x0, &mut out, Some(&mut call));
-    let result = model.simulate(scene, &mut job);
-    let (written, event_at) = (job.written, job.event_at.take());
-    if let Some(e) = raised {
-        return Err(e);
-    }
-    result.map_err(|m| model_error(py, format!("simulate: {m}")))?;
-    out.truncate(written * s);
-    let reached = PyArray1::from_vec(py, out).reshape(IxDyn(&[written, s]))?;
-    let at = match event_at {
-        Some((t, x)) => (t, PyArray1::from_vec(py, x)).into_pyobject(py)?.into_any(),
-        None => py.None().into_bound(py),
-    };
-    Ok((&times[..written].to_vec(), reached, at)
-        .into_pyobject(py)?
-        .into_any()
-        .unbind())
-}
-
-/// One run per initial state, a batch split over `threads` with the GIL
-/// released: (len(t_eval), s), or (batch, len(t_eval), s).
-fn simulate_rows(
-    py: Python<'_>,
-    model: &dyn Evaluate,
-    scene: Option<usize>,
-    settings: &Settings<'_>,
-    states: &States<'_>,
-    threads: usize,
-) -> PyResult<PyObject> {
-    let (s, times, batch) = (states.s, settings.t_eval, states.batch);
-    let width = times.len() * s;
-    let n = batch.unwrap_or(1);
-    let mut out = vec![0.0; n * width];
-    let run = |first: usize, chunk: &mut [f64]| -> Result<(), Failure> {
-        for (k, rows) in chunk.chunks_exact_mut(width.max(1)).enumerate() {
-            let row = first + k;
-            let mut job = settings.job(&states.x0[row * s..(row + 1) * s], rows, None);
-            model
-                .simulate(scene, &mut job)
-                .map_err(|message| Failure { row, message })?;
-        }
-        Ok(())
-    };
-    let result = if batch.is_some() {
-        py.allow_threads(|| split_rows(n, width, threads, 1, &mut out, run))
-    } else {
-        py.allow_threads(|| run(0, &mut out))
-    };
-    result.map_err(|f| {
-        let message = match batch {
-            Some(_) => format!("simulate at row {}: {}", f.row, f.message),
-            None => format!("simulate: {}", f.message),
-        };
-        model_error(py, message)
-    })?;
-    let shape: Vec<usize> = match batch {
-        Some(n) => vec![n, times.len(), s],
-        None => vec![times.len(), s],
-    };
-    Ok(PyArray1::from_vec(py, out)
-        .reshape(IxDyn(&shape))?
-        .into_any()
-        .unbind())
 }
