@@ -10,6 +10,7 @@ from __future__ import annotations
 import json
 
 import numpy as np
+import pytest
 
 from conftest import REPO, rust_answers
 
@@ -205,3 +206,52 @@ def test_ur5_derivatives_against_pinocchio(ur5):
     for k in (0, len(states) - 1):
         for batched, single in zip((accel, fq, fv, fu), ur5.forward_dynamics_derivatives(q[k], v[k], tau[k])):
             assert np.array_equal(batched[k], single)
+
+
+def test_solo12_on_a_free_base_against_pinocchio(cache):
+    """A floating-base robot from its URDF, compared with Pinocchio's
+    reference state for state through the model's PinocchioMap: RNEA,
+    CRBA, gravity, and ABA with the joints' torques (the reference's base
+    wrench is not an input of the model; its ddq is checked through
+    Pinocchio's M and nle instead)."""
+    import appell
+
+    data = json.loads((REPO / "tests/reference/pinocchio/robots/solo12.json").read_text())
+    m = appell.from_urdf(REPO / data["urdf"], base="free", gravity=data["gravity"], progress=False)
+    pin = m.pinocchio_map()
+    names = [j["name"] for j in data["joints"]]
+    assert names[0] == "root_joint" and pin.base == "root_joint"
+    assert pin.joints == names[1:] and (pin.nq, pin.nv) == (data["nq"], data["nv"])
+    assert pin.joints == m.pinocchio_map(joints=names[1:]).joints
+    states = data["states"]
+    q_pin, v_pin, a_pin, tau_pin = (np.array([s[k] for s in states]) for k in ("q", "v", "a", "tau"))
+    q, v = pin.state_from(q_pin, v_pin)
+    np.testing.assert_allclose(pin.q_to(q), q_pin, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(pin.v_to(q, v), v_pin, rtol=1e-14, atol=1e-13)
+
+    def close(ours, key, tol=1e-10):
+        theirs = np.array([s[key] for s in states])
+        worst = np.max(np.abs(ours - theirs) / (1.0 + np.abs(theirs)))
+        assert worst < tol, f"{key}: {worst:.2e}"
+
+    v_dot = pin.a_from(q, v_pin, a_pin)
+    close(pin.tau_to(q, m.inverse_dynamics(q, v, v_dot)), "rnea")
+    close(pin.mass_to(q, m.mass_matrix(q)), "mass_matrix")
+    close(pin.tau_to(q, m.gravity_forces(q)), "gravity_torque")
+    np.testing.assert_allclose(pin.tau_from(q, pin.tau_to(q, v_dot)), v_dot, rtol=1e-12, atol=1e-12)
+    # Forward dynamics with the joints' torques: M a + nle = [0, tau_joints].
+    inputs = np.array([[s["tau"][6 + names[1:].index(i[len("tau_"):])] for i in m.input_names]
+                       for s in states])
+    accelerations = m.rhs(m.reduced_state(q, v), inputs)[:, len(m.info["retained"]):]
+    a = pin.a_to(q, v, accelerations)
+    mass, nle = (np.array([s[k] for s in states]) for k in ("mass_matrix", "nle"))
+    joint_tau = tau_pin.copy()
+    joint_tau[:, :6] = 0.0
+    residual = np.einsum("kij,kj->ki", mass, a) + nle - joint_tau
+    assert np.max(np.abs(residual)) / (1.0 + np.max(np.abs(joint_tau))) < 1e-10
+    with pytest.raises(KeyError, match="no free or planar joint 'base'"):
+        m.pinocchio_map(base="base")
+    with pytest.raises(appell.ModelError, match="no map to Pinocchio's conventions"):
+        m.pinocchio_map(joints=names[1:5])
+    with pytest.raises(ValueError, match="expected"):
+        pin.q_to(np.zeros(5))

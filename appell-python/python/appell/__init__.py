@@ -25,6 +25,7 @@ from typing import Any, Dict, Mapping, Optional, Sequence, Tuple, Union
 from . import _build, _native
 from ._build import cache_dir, set_cache_dir
 from ._model import Model, get_num_threads, set_num_threads
+from ._pinocchio import PinocchioMap
 from ._text import check_identifier, crate_source
 from .errors import AppellError, CompileError, Diagnostic, ModelError, ToolchainError
 
@@ -34,6 +35,7 @@ __all__ = [
     "from_model",
     "from_urdf",
     "Model",
+    "PinocchioMap",
     "cache_dir",
     "set_cache_dir",
     "cache_info",

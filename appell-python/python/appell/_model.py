@@ -8,6 +8,8 @@ from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple
 
 import numpy as np
 
+from ._pinocchio import PinocchioMap, base_coordinates, detect_base, model_name
+
 from .errors import ModelError
 
 ArrayLike = Union[np.ndarray, Sequence[float], Sequence[Sequence[float]], Mapping[str, Any]]
@@ -192,10 +194,34 @@ class Model:
         p = None if params is None else self._parameter_array(params)
         return self._native.call(op, args, float(t), self._scene, p, _threads, _min_rows)
 
+    def pinocchio_map(self, joints: Optional[Sequence[str]] = None,
+                      base: Optional[str] = None) -> "PinocchioMap":
+        """Conversions between this model's q, v, accelerations, forces and
+        M and Pinocchio's (see :class:`appell.PinocchioMap`). ``joints``:
+        the moving joints in Pinocchio's order (``pin_model.names[2:]`` on
+        a free base, ``[1:]`` on a fixed one; URDF names are written as the
+        model writes them, ``-`` as ``_``). By default the model's own
+        order: depth first from the root, children in the URDF file's
+        order, where Pinocchio's parser takes a link's children by joint
+        name; where the two differ, pass Pinocchio's. ``base``: the free or
+        planar joint's name, found from the coordinates' names by default
+        (``root_joint`` for ``from_urdf``)."""
+        kind, found = detect_base(self.coordinate_names)
+        if base is not None:
+            if found != base:
+                raise KeyError(f"no free or planar joint {base!r} among the coordinates "
+                               f"{self.coordinate_names}")
+        taken = base_coordinates(kind, found)
+        if joints is None:
+            joints = [c for c in self.coordinate_names if c not in taken]
+        native = self._native.pinocchio_map(kind, found or "", [model_name(str(j)) for j in joints])
+        return PinocchioMap(native, kind, found, joints)
+
     def reduced_state(self, q: ArrayLike, v: ArrayLike) -> np.ndarray:
         """The reduced state x (retained coordinates, then the speeds) from
-        all coordinates ``q`` and the speeds ``v``, as Pinocchio's (q, v)
-        give it; batched like every function."""
+        all coordinates ``q`` and the speeds ``v`` (the model's: from
+        Pinocchio's, :meth:`pinocchio_map` converts them); batched like
+        every function."""
         qa = self._array("q", q, self.coordinate_names)
         va = self._array("v", v, self.speed_names)
         keep = [self.coordinate_names.index(r) for r in self._info["retained"]]

@@ -3,6 +3,7 @@
 
 use std::sync::{Arc, RwLock};
 
+use appell::pinocchio::PinocchioMap;
 use appell::{Model, ModelInfo};
 use numpy::ndarray::IxDyn;
 use numpy::{PyArray1, PyArrayDyn, PyArrayMethods, PyReadonlyArrayDyn, PyUntypedArrayMethods};
@@ -13,7 +14,9 @@ use pyo3::types::{PyDict, PyList};
 use crate::ops::{Arg, Compiled, Evaluate, Failure, Op};
 use crate::simulate::Method;
 
+mod pinocchio;
 mod simulate;
+use pinocchio::NativePinocchioMap;
 use simulate::{simulate_event, simulate_rows, Settings, States};
 
 /// The model a compiled module exports (`module.model`), wrapped by the
@@ -228,6 +231,39 @@ impl NativeModel {
             .write()
             .unwrap_or_else(|poisoned| poisoned.into_inner()) = next;
         Ok(())
+    }
+
+    /// The conversions to and from Pinocchio's conventions for this
+    /// model's coordinates and speeds: a base `kind` (`"free"`, `"planar"`
+    /// or `"fixed"`) on the joint named `base`, then the moving `joints` in
+    /// Pinocchio's order.
+    fn pinocchio_map(
+        &self,
+        py: Python<'_>,
+        kind: &str,
+        base: &str,
+        joints: Vec<String>,
+    ) -> PyResult<NativePinocchioMap> {
+        let info = self.current().info(None);
+        let (c, s) = (info.coordinates, info.speeds);
+        let joints: Vec<&str> = joints.iter().map(String::as_str).collect();
+        let map = match kind {
+            "free" => PinocchioMap::free(base, c, s, &joints),
+            "planar" => PinocchioMap::planar(base, c, s, &joints),
+            "fixed" => PinocchioMap::fixed(c, s, &joints),
+            _ => {
+                return Err(PyValueError::new_err(format!(
+                    "unknown base `{kind}`: use \"free\", \"planar\" or \"fixed\""
+                )))
+            }
+        };
+        let map =
+            map.map_err(|e| model_error(py, format!("no map to Pinocchio's conventions: {e}")))?;
+        Ok(NativePinocchioMap {
+            map,
+            n: c.len(),
+            l: s.len(),
+        })
     }
 
     /// The names of the operations `call` takes.
