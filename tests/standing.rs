@@ -13,7 +13,7 @@
 //! accelerations of the stance legs. Both are compared with Pinocchio's
 //! ddq and λ through `appell::pinocchio::PinocchioMap`.
 
-use appell::constraint_forces::contact_forces;
+use appell::constraint_forces::{contact_forces, FootForce, Friction};
 use appell::pinocchio::PinocchioMap;
 use appell::{Appell, Model, RowSource};
 use serde_json::Value;
@@ -77,7 +77,8 @@ fn worst_difference<Full: Model, S: Model>(scene: &S, set: &str) -> (f64, f64) {
     let map = PinocchioMap::free("root_joint", full.coordinates, full.speeds, &joints).unwrap();
     let (n, l, nv) = (full.coordinates.len(), full.speeds.len(), map.nv());
     let prepared = scene.prepare::<f64>();
-    let (mut worst_a, mut worst_f) = (0.0f64, 0.0f64);
+    let (mut worst_a, mut worst_f, mut worst_cop) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut centres, mut flat) = (0, false);
     for s in data["states"].as_array().expect("states") {
         let (q_pin, v_pin, tau) = (numbers(&s["q"]), numbers(&s["v"]), numbers(&s["tau"]));
         let (mut q, mut u) = (vec![0.0; n], vec![0.0; l]);
@@ -127,13 +128,60 @@ fn worst_difference<Full: Model, S: Model>(scene: &S, set: &str) -> (f64, f64) {
             .map(|(_, m)| *m)
             .collect();
         worst_f = worst_f.max(relative(&feet, &numbers(&s["lambda"])));
+        // The same multipliers gathered by foot: the force at the link's
+        // origin, then a flat foot's moment about it, foot after foot.
+        let links: Vec<&str> = forces.feet.iter().map(|f| f.link).collect();
+        let by_foot: Vec<f64> = forces
+            .feet
+            .iter()
+            .flat_map(|f| f.force.iter().chain(f.moment.iter().flatten()).copied())
+            .collect();
+        assert_eq!(by_foot, feet, "{set}: the feet {links:?}");
+        let (residual, pressed) = center_of_pressure_residual(&forces.feet);
+        worst_cop = worst_cop.max(residual);
+        centres += pressed;
+        flat |= forces.feet.iter().any(|f| f.moment.is_some());
     }
+    assert!(
+        worst_cop < 1e-12,
+        "{set}: moment about the centre of pressure {worst_cop:.1e}"
+    );
+    assert!(!flat || centres > 0, "{set}: no flat foot pressed down");
     println!(
-        "{set}: {} speeds, {} operations per rhs call; worst relative difference to Pinocchio: accelerations {worst_a:.1e}, contact forces {worst_f:.1e}",
+        "{set}: {} speeds, {} operations per rhs call; worst relative difference to Pinocchio: accelerations {worst_a:.1e}, contact forces {worst_f:.1e}; {centres} centres of pressure, worst moment along the ground {worst_cop:.1e}",
         info.speeds.len(),
         info.rhs_ops.total
     );
     (worst_a, worst_f)
+}
+
+/// The largest component along the ground of the feet's moments about
+/// their centres of pressure on the plane z = 0 (zero by definition),
+/// relative to the force times the origin's height.
+fn center_of_pressure_residual(feet: &[FootForce]) -> (f64, usize) {
+    let (mut worst, mut pressed) = (0.0f64, 0);
+    for foot in feet {
+        let (Some(m), Some(p)) = (foot.moment, foot.center_of_pressure(0.0)) else {
+            assert!(foot.moment.is_none() || foot.force[2] <= 0.0, "{foot:?}");
+            continue;
+        };
+        let (f, o) = (foot.force, foot.position);
+        let r = [o[0] - p[0], o[1] - p[1], o[2] - p[2]];
+        let about = [
+            m[0] + r[1] * f[2] - r[2] * f[1],
+            m[1] + r[2] * f[0] - r[0] * f[2],
+        ];
+        let scale = f.iter().map(|x| x.abs()).sum::<f64>() * (1.0 + o[2].abs());
+        worst = worst.max(about[0].abs().max(about[1].abs()) / scale);
+        pressed += 1;
+        // The friction the foot needs is the horizontal force over F_z.
+        let Friction::Required { mu, normal, .. } = foot.friction() else {
+            panic!("{foot:?} pushes down")
+        };
+        assert_eq!(normal, f[2]);
+        assert!((mu - f[0].hypot(f[1]) / f[2]).abs() <= 1e-15 * (1.0 + mu));
+    }
+    (worst, pressed)
 }
 
 #[test]
@@ -362,4 +410,71 @@ fn a_stance_leg_stretched_straight_is_a_typed_error_not_a_nan() {
     let mut rates = vec![0.0; x.len()];
     let result = standing.rhs(&standing.prepare::<f64>(), 0.0, &x, &[0.0; 3], &mut rates);
     assert!(result.is_err(), "{result:?}: {rates:?}");
+}
+
+#[test]
+fn the_command_line_reports_each_foots_force() {
+    let robot = OneLeg;
+    let standing = OneLegStanding::from_ref(&robot);
+    let info = OneLegStanding::info();
+    let q = upright(0.4, 0.3, -0.6);
+    let u: Vec<f64> = (0..info.speeds.len())
+        .map(|k| 0.1 * k as f64 - 0.3)
+        .collect();
+    let inputs: Vec<f64> = (0..info.inputs.len())
+        .map(|k| 0.5 - 0.2 * k as f64)
+        .collect();
+    let object = |names: &[&str], values: &[f64]| {
+        let map: serde_json::Map<String, Value> = names
+            .iter()
+            .zip(values)
+            .map(|(n, v)| (n.to_string(), serde_json::json!(v)))
+            .collect();
+        Value::Object(map)
+    };
+    let line = serde_json::json!({
+        "q": object(info.coordinates, &q),
+        "u": object(info.speeds, &u),
+        "inputs": object(info.inputs, &inputs),
+    })
+    .to_string();
+    let args: Vec<String> = ["one_leg", "contacts", "--scene", "standing"]
+        .iter()
+        .map(|s| s.to_string())
+        .collect();
+    let mut out = Vec::new();
+    appell::cli::run_with(robot.clone(), &args, &mut line.as_bytes(), &mut out, |_| {
+        Ok(())
+    })
+    .unwrap();
+    let answer: Value = serde_json::from_slice(&out).unwrap();
+    let forces = contact_forces(standing, 0.0, &q, &u, &inputs).unwrap();
+    let [foot] = &forces.feet[..] else {
+        panic!("{:?}", forces.feet)
+    };
+    let mut at = [[0.0; 3]];
+    robot.contact_points(0.0, &q, &mut at).unwrap();
+    assert_eq!((foot.link, foot.contact, foot.position), ("foot", 0, at[0]));
+    assert_eq!(foot.moment, None);
+    let json = &answer["feet"][0];
+    assert_eq!(json["link"], "foot");
+    assert_eq!(numbers(&json["force"]), foot.force.to_vec());
+    assert_eq!(numbers(&json["position"]), foot.position.to_vec());
+    assert_eq!(json["moment"], Value::Null);
+    // The foot's force is the multipliers of its three rows, by axis.
+    for (axis, force) in foot.force.iter().enumerate() {
+        let row = info
+            .row_sources
+            .iter()
+            .position(|r| *r == RowSource::Contact { contact: 0, axis })
+            .unwrap();
+        assert_eq!(*force, forces.multipliers[row]);
+    }
+    match foot.friction() {
+        Friction::Required { mu, .. } => assert_eq!(json["friction"]["mu"], serde_json::json!(mu)),
+        Friction::LiftOff { normal } => {
+            assert_eq!(json["friction"]["lift_off"], serde_json::json!(normal))
+        }
+        other => panic!("{other:?}"),
+    }
 }

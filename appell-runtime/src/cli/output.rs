@@ -19,7 +19,9 @@ pub(super) fn result_number(x: f64, name: &str) -> Result<Value, String> {
 }
 
 /// `{"multipliers": [..], "rows": [{"source", "multiplier"}], "contacts":
-/// [{"point", "body", "position", "force", "normal", "friction"}]}`.
+/// [{"point", "body", "position", "force", "normal", "friction"}], "feet":
+/// [{"link", "position", "force", "moment", "friction"}]}` (a point foot's
+/// moment is `null`).
 pub(super) fn contact_forces_json(
     model: &dyn DynModel,
     t: f64,
@@ -86,13 +88,7 @@ pub(super) fn contact_forces_json(
                 }),
                 Normal::Unavailable(why) => json!({ "unavailable": format!("{why:?}") }),
             };
-            let friction = match c.friction() {
-                Friction::Required { mu, .. } => json!({ "mu": finite_or_null(mu) }),
-                Friction::LiftOff { normal } => json!({ "lift_off": finite_or_null(normal) }),
-                Friction::NormalUnavailable(why) => {
-                    json!({ "unavailable": format!("{why:?}") })
-                }
-            };
+            let friction = friction_json(c.friction());
             json!({
                 "point": c.point,
                 "body": info.bodies.get(c.body).map(|b| b.name),
@@ -103,9 +99,32 @@ pub(super) fn contact_forces_json(
             })
         })
         .collect();
+    let feet: Vec<Value> = f
+        .feet
+        .iter()
+        .map(|foot| {
+            json!({
+                "link": foot.link,
+                "position": v3(foot.position),
+                "force": v3(foot.force),
+                "moment": foot.moment.map(v3),
+                "friction": friction_json(foot.friction()),
+            })
+        })
+        .collect();
     Ok(json!({
         "multipliers": f.multipliers.iter().map(|x| finite_or_null(*x)).collect::<Vec<_>>(),
         "rows": rows,
         "contacts": contacts,
+        "feet": feet,
     }))
+}
+
+/// `{"mu"}`, `{"lift_off": normal}` or `{"unavailable": why}`.
+fn friction_json(friction: Friction) -> Value {
+    match friction {
+        Friction::Required { mu, .. } => json!({ "mu": finite_or_null(mu) }),
+        Friction::LiftOff { normal } => json!({ "lift_off": finite_or_null(normal) }),
+        Friction::NormalUnavailable(why) => json!({ "unavailable": format!("{why:?}") }),
+    }
 }

@@ -1,7 +1,8 @@
 //! Constraint forces by the multiplier route (Wang & Pao 2003, eqs. 69-70):
-//! the multipliers λ, each constraint row's generalized reaction, and the
+//! the multipliers λ, each constraint row's generalized reaction, the
 //! reaction on the body at every rolling contact, with the friction
-//! coefficient rolling without slip needs there.
+//! coefficient rolling without slip needs there, and the ground's force
+//! (and moment) on every foot a scene holds ([`FootForce`]).
 //!
 //! # Sign convention
 //!
@@ -63,6 +64,9 @@ use crate::Scalar;
 use crate::{Model, ModelInfo, RowSource};
 use nalgebra::{DMatrix, DVector};
 use num_dual::{Dual2_64, Dual64};
+
+mod feet;
+pub use feet::FootForce;
 
 /// The reaction of one velocity constraint row.
 #[derive(Clone, Debug, PartialEq)]
@@ -210,6 +214,10 @@ pub struct ConstraintForces {
     /// The reaction at each rolling contact, in [`ModelInfo::contacts`]
     /// order.
     pub contacts: Vec<ContactForce>,
+    /// The ground's reaction on each foot the rows hold
+    /// (`contact(link, point | flat)` in a scene that names it), in
+    /// [`Model::contact_links`] order.
+    pub feet: Vec<FootForce>,
 }
 
 /// Relative tolerance for "this holonomic row is a normal force at that
@@ -555,11 +563,13 @@ pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
     for c in &contacts {
         finite(c.force.iter().copied(), "a contact force")?;
     }
+    let feet = feet::foot_forces(model, t, q, &sol.multipliers)?;
     let forces = ConstraintForces {
         qddot: sol.qddot,
         multipliers: sol.multipliers,
         rows,
         contacts,
+        feet,
     };
     let parts = ContactParts {
         qdot,
