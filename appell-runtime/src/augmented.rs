@@ -382,6 +382,8 @@ pub fn project<M: Model>(
 ///
 /// Errors: those of [`accelerations`] and [`project`]; a non-finite state
 /// is reported, never returned.
+// accelerations' and project's arguments (q and q̇ in and out here) plus the fixed-step grid
+// h, steps and the per-step callback
 #[allow(clippy::too_many_arguments)]
 pub fn integrate<M: Model>(
     model: &M,

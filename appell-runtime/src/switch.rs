@@ -199,6 +199,8 @@ pub fn switch_state<A: DynModel + ?Sized, B: DynModel + ?Sized>(
 /// the speeds returned are `from`'s.
 ///
 /// Errors: as [`switch_state`], and a restitution outside [0, 1].
+// switch_state's arguments (two scenes, each with its own inputs, at one t, q, u) plus the
+// coefficient of restitution
 #[allow(clippy::too_many_arguments)]
 pub fn impact_state<A: DynModel + ?Sized, C: DynModel + ?Sized>(
     from: &A,
@@ -261,6 +263,7 @@ impl Met {
 /// `from`'s motion meeting `contact`'s constraints with Newton's
 /// coefficient `restitution`: after the impulse the rows' residual is −e
 /// times what it was, checked.
+// impact_state's arguments; switch_state shares this body and passes restitution 0
 #[allow(clippy::too_many_arguments)]
 fn meet<A: DynModel + ?Sized, C: DynModel + ?Sized>(
     from: &A,
@@ -365,6 +368,8 @@ fn rows<B: DynModel + ?Sized>(
 /// The impulse in `from`'s speeds after which the rows' residual
 /// `D q̇ + d` is `−restitution` times what it was (0: onto the rows): the
 /// coordinate rates after it, and the rows' impulses.
+// meet's t, q, u with `from`, its info and inputs, the rows D and d meet already computed
+// from `contact`, and the restitution
 #[allow(clippy::too_many_arguments)]
 fn impulse<A: DynModel + ?Sized>(
     from: &A,

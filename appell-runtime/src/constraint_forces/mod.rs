@@ -365,6 +365,8 @@ type RollingContact = (ContactForce, Option<[f64; 3]>, Option<f64>);
 /// oriented, and the side of the body's mass centre (see
 /// [`ContactParts::sides`]); the normal force itself is left to the
 /// callers.
+// called once per contact in contact_forces_parts' loop: the geometry, multipliers and
+// motion are computed once there for all contacts and lent to each call
 #[allow(clippy::too_many_arguments)]
 fn rolling_contact(
     info: &ModelInfo,
@@ -772,6 +774,8 @@ pub(crate) struct MomentumResidual {
 }
 
 /// [`MomentumResidual`] at a motion (q̇, and the accelerations in `motion`).
+// both callers (balance_normals here, sliding's balance_at) pass the q̇ and motion
+// contact_forces_parts already computed, so nothing is solved twice
 #[allow(clippy::too_many_arguments)]
 pub(crate) fn momentum_residual<K: DynModel + ?Sized>(
     model: &K,

@@ -124,6 +124,8 @@ where
 /// Without `std` there are no contact forces to watch: `solve` runs as it
 /// is.
 #[cfg(not(feature = "std"))]
+// the std `watched`'s signature, so the explicit run_model calls it the same way without
+// std; here every argument but `solve` is unused
 #[allow(clippy::too_many_arguments)]
 pub(in crate::integrate) fn watched<M: Model, T: Scalar, R>(
     _model: &M,

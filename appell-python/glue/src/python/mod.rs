@@ -381,6 +381,8 @@ impl NativeModel {
     /// for this call only. Batches run with the GIL released, split over
     /// up to `threads` threads of at least `min_rows` rows each.
     #[pyo3(signature = (op, args, t=0.0, scene=None, params=None, threads=1, min_rows=64))]
+    // one Rust parameter per Python argument of the #[pyo3(signature)] above, which holds the
+    // keyword defaults
     #[allow(clippy::too_many_arguments)]
     fn call<'py>(
         &self,
@@ -476,6 +478,8 @@ impl NativeModel {
     /// called at every evaluation of the rhs (`u` then only gives their
     /// number): rows run one after another, holding the GIL.
     #[pyo3(signature = (x0, u, t0, t_eval, method="dop853", rtol=1e-8, atol=1e-10, h_max=None, max_steps=1_000_000, scene=None, params=None, threads=1, event=None, feedback=None))]
+    // one Rust parameter per Python argument of the #[pyo3(signature)] above; they are gathered
+    // into Settings and States just below
     #[allow(clippy::too_many_arguments)]
     fn simulate<'py>(
         &self,

@@ -178,6 +178,8 @@ macro_rules! explicit_api {
         /// integration and within the interval), and stops at an event of `g`
         #[doc = concat!("when one is given (as [`", stringify!($ty), "::solve_until`]); output times past the")]
         /// event are not reached.
+        // the public general form: solve's problem plus the output times, an output callback and an
+        // optional event, each the caller's own; times and on_output become run's CallbackSink
         #[allow(clippy::too_many_arguments)]
         pub fn solve_with<T, F, const S: usize>(
             &self,

@@ -32,6 +32,8 @@ pub(in crate::integrate) fn sqrt(x: f64) -> f64 {
 
 /// Hairer's `HINIT`: a first step from the size of `x`, `f` and an estimate
 /// of the second derivative (one rhs call), for a method with `expo = 1/q`.
+// called once per run, from first_step: its own arguments (h_max for t_end) plus the
+// method's exponent and the first stage k1 it has just evaluated
 #[allow(clippy::too_many_arguments)]
 pub(super) fn initial_step<T, F, const S: usize>(
     set: &Settings,

@@ -42,6 +42,8 @@ pub(in crate::integrate) trait EmbeddedPair<T: Scalar, const S: usize> {
     /// rhs calls: the new state and the error norm (`0` without error
     /// control), with the FSAL stage at the new state evaluated at least
     /// when the step is accepted; `None` when a value is non-finite.
+    // once per step attempt in run's loop, #[inline] in both pairs: the step's times and state
+    // are the loop's locals, the rhs, settings and counters its borrows
     #[allow(clippy::too_many_arguments)]
     fn step<F>(
         &mut self,
@@ -61,6 +63,8 @@ pub(in crate::integrate) trait EmbeddedPair<T: Scalar, const S: usize> {
 
     /// The continuous extension of the accepted step from `(t, x)` to
     /// `x_new` (any extra rhs calls counted in `stats`).
+    // as `step`, once per accepted step that needs a dense output: the step's ends (t, hs, x,
+    // x_new) are run's loop locals, the rhs and counters its borrows
     #[allow(clippy::too_many_arguments)]
     fn dense<F>(
         &mut self,

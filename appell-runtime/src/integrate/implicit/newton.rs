@@ -132,6 +132,8 @@ impl Iteration {
 
     /// Solves `y = psi + h d f(t, y)` for `y` (holding the predictor on
     /// entry), scaled by `sk`; on success `fy` is `(y − psi)/(h d)`.
+    // called once per stage (TR, then BDF2) with that stage's time, psi and y/fy buffers from
+    // Stages; self is the Iteration, a separate struct holding the factored matrix
     #[allow(clippy::too_many_arguments)]
     pub(super) fn newton<F>(
         &mut self,

@@ -433,6 +433,8 @@ impl TrBdf2 {
         self.run_model(model, t0, x0, t_end, inputs, &mut [], None, Some(project))
     }
 
+    // one body for the four solve_model* forms, each passing `&mut []` or None for what it lacks;
+    // watched_slices may put the contact watch in as the event or after the projection
     #[allow(clippy::too_many_arguments)]
     fn run_model<M: Model>(
         &self,
@@ -475,6 +477,8 @@ impl TrBdf2 {
         self.run_prepared(rhs, t0, x0, t_end, inputs, out, None, None)
     }
 
+    // run's arguments with the prepared rhs and its inputs in place of f and jac_fn, which it
+    // builds from them; called by run_model and solve_prepared_at
     #[allow(clippy::too_many_arguments)]
     fn run_prepared<R: DynRhs + ?Sized>(
         &self,

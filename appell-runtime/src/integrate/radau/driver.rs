@@ -20,6 +20,8 @@ impl Radau5 {
     /// `jac_fn` from `(t0, x0)` to `t_end`, with the outputs `out` (times
     /// given, states written), an optional event function and an optional
     /// projection after every accepted step.
+    // one loop for solve, solve_at, solve_until and solve_projected (and run_prepared): each
+    // passes `&mut []` or None for the outputs, event or projection it does not take
     #[allow(clippy::too_many_arguments)]
     pub(super) fn run<F, J>(
         &self,

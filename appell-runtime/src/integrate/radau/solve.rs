@@ -519,6 +519,8 @@ impl Radau5 {
         self.run_model(model, inputs, t0, x0, t_end, &mut [], None, Some(project))
     }
 
+    // one body for the four solve_model* forms, each passing `&mut []` or None for what it lacks;
+    // watched_slices may put the contact watch in as the event or after the projection
     #[allow(clippy::too_many_arguments)]
     fn run_model<M: Model>(
         &self,
@@ -563,6 +565,8 @@ impl Radau5 {
 
     /// The integration of a prepared rhs (compiled once for `dyn DynRhs`),
     /// its Jacobian by dual numbers.
+    // run's arguments with the prepared rhs and its inputs in place of f and jac_fn, which it
+    // builds from them; called by run_model and solve_prepared_at
     #[allow(clippy::too_many_arguments)]
     fn run_prepared<R: DynRhs + ?Sized>(
         &self,

@@ -649,6 +649,8 @@ fn twin<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
 /// generated `rhs_jacobian` (`dual_columns` in
 /// `appell-runtime/src/linearize/jacobian.rs`); the buffers `x`, `w`, `y`
 /// are allocated by the caller and `prepared` made once.
+// `prepared` and the dual buffers x, w, y are made once by `jacobians` and reused for every
+// state of the timed batch; the rest: rhs_jacobian's state, inputs and its three outputs in `out`
 #[allow(clippy::too_many_arguments)]
 fn dual_jacobian<M: Model>(
     model: &M,
