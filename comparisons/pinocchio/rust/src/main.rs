@@ -8,7 +8,7 @@
 //! appell_bench list
 //! ```
 //!
-//! MODEL is `ur5`, `panda`, `spatial_chain_2`, `_4`, `_8`, `_16`, `_32` (and
+//! MODEL is `ur5`, `ur5_right_angles` (`arms.rs`), `panda`, `spatial_chain_2`, `_4`, `_8`, `_16`, `_32` (and
 //! `_64` with `--features large-models`), or a floating-base robot:
 //! `solo12`, `anymal_b`, `go1`, `hyq`, `hyq_right_angles`, `g1` (`floating.rs`). `--joints` gives the
 //! joint order in which the random numbers are drawn (Pinocchio's, which
@@ -58,6 +58,7 @@
 //!
 //! Adding a function is one `t.run(...)` line in [`bench`].
 
+mod arms;
 mod floating;
 mod jacobian;
 #[path = "../../../../examples/models/panda.rs"]
@@ -78,6 +79,7 @@ use appell::{Model, ModelError};
 /// The models this build has, by the names `run.py` uses.
 const MODELS: &[&str] = &[
     "ur5",
+    "ur5_right_angles",
     "panda",
     "spatial_chain_2",
     "spatial_chain_4",
@@ -898,6 +900,7 @@ fn main() -> ExitCode {
     };
     let result = match opts.model.as_str() {
         "ur5" => bench(&ur5::Ur5, &opts),
+        "ur5_right_angles" => bench(&arms::Ur5RightAngles, &opts),
         "panda" => with_twin(&panda::Panda, &jacobian::PandaJacobian, &opts),
         "spatial_chain_2" => bench(&spatial_chain::SpatialChain2, &opts),
         "spatial_chain_4" => bench(&spatial_chain::SpatialChain4, &opts),
