@@ -255,3 +255,7 @@ def test_solo12_on_a_free_base_against_pinocchio(cache):
         m.pinocchio_map(joints=names[1:5])
     with pytest.raises(ValueError, match="expected"):
         pin.q_to(np.zeros(5))
+    with pytest.raises(ValueError, match="have 20 and 3 rows"):
+        pin.v_to(q, v[:3])
+    with pytest.raises(ValueError, match=r"\(l, l\) or \(N, l, l\)"):
+        pin.mass_to(q[0], np.zeros(18 * 18))

@@ -56,7 +56,8 @@ pub struct SimJob<'a> {
     /// The inputs, held constant (without [`SimJob::feedback`]).
     pub inputs: &'a [f64],
     /// The inputs as a function of the time and the state, called at every
-    /// evaluation of the rhs. Radau5's Newton iteration then uses ∂rhs/∂x
+    /// evaluation of the rhs (and of Radau5's Jacobian, at the point it is
+    /// taken). Radau5's Newton iteration then uses ∂rhs/∂x
     /// with the inputs frozen at `u(t, x)` (the law's own derivative is not
     /// known), which changes its convergence, not its solution.
     pub feedback: Option<&'a mut Feedback<'a>>,

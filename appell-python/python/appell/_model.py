@@ -206,6 +206,10 @@ class Model:
         name; where the two differ, pass Pinocchio's. ``base``: the free or
         planar joint's name, found from the coordinates' names by default
         (``root_joint`` for ``from_urdf``)."""
+        full = self._native.info(None)
+        if list(full["speeds"]) != self.speed_names or list(full["coordinates"]) != self.coordinate_names:
+            raise ValueError(f"the scene {self.name} has other coordinates or speeds than the model: "
+                             "Pinocchio's q and v map to the model's, so take the model's pinocchio_map()")
         kind, found = detect_base(self.coordinate_names)
         if base is not None:
             if found != base:
@@ -381,9 +385,10 @@ class Model:
         Inputs ``u``: held constant (an array or a dict of names), or a
         function ``u(t, x)`` of the time and the reduced state that returns
         them (array or dict), called at every evaluation of the rhs: a
-        feedback controller. With a function, the rows of a batch run one
-        after another, and Radau5's Newton iteration uses the model's
-        Jacobian with the inputs held at their current values (the law's own
+        feedback controller (Radau5 also calls it where it evaluates its
+        Jacobian). With a function, the rows of a batch run one after
+        another, and Radau5's Newton iteration uses the model's Jacobian
+        with the inputs held at their current values (the law's own
         derivative is not known), which may slow its convergence but does
         not change its solution.
 

@@ -97,6 +97,8 @@ class PinocchioMap:
     def mass_to(self, q: Any, mass: Any) -> np.ndarray:
         """Pinocchio's mass matrix (nv, nv) at ``q`` from the model's."""
         m = _rows(mass)
+        if m.ndim not in (2, 3) or m.shape[-1] != m.shape[-2]:
+            raise ValueError(f"`mass` must be (l, l) or (N, l, l), got shape {m.shape}")
         rows = m.shape[:-2]
         flat = self._convert("mass_to", q, m.reshape(rows + (m.shape[-1] * m.shape[-2],)))
         return flat.reshape(flat.shape[:-1] + (self.nv, self.nv))

@@ -9,7 +9,7 @@
 //! force is its rows' multipliers, gathered by axis. The ground is the
 //! plane normal to N.z.
 
-use super::{dot, norm, Friction};
+use super::{norm, Friction};
 use crate::dynamic::DynModel;
 use crate::oracle::{finite_all as finite, OracleError};
 use crate::RowSource;
@@ -49,27 +49,15 @@ impl FootForce {
     /// assert!(matches!(foot.friction(), Friction::Required { mu, .. } if mu == 0.2));
     /// ```
     pub fn friction(&self) -> Friction {
-        let normal = self.force[2];
-        if normal.is_nan() || normal <= 0.0 {
-            return Friction::LiftOff { normal };
-        }
-        let tangential = norm([self.force[0], self.force[1], 0.0]);
-        let mu = tangential / normal;
-        if !mu.is_finite() {
-            return Friction::LiftOff { normal };
-        }
-        Friction::Required {
-            mu,
-            normal,
-            tangential,
-        }
+        Friction::of(self.force[2], norm([self.force[0], self.force[1], 0.0]))
     }
 
     /// A flat foot's centre of pressure on the ground plane at height
     /// `ground` along N.z: the point of that plane about which the
     /// reaction's moment has no component along the plane. `None` for a
-    /// point foot, or where the ground does not push (F_z ≤ 0). It lies
-    /// inside the sole exactly when the foot does not tip over its edge.
+    /// point foot, where the ground does not push (F_z ≤ 0), or where the
+    /// point overflows. It lies inside the sole exactly when the foot does
+    /// not tip over its edge.
     ///
     /// ```
     /// use appell_runtime::constraint_forces::FootForce;
@@ -97,7 +85,7 @@ impl FootForce {
         let rx = (m[1] + rz * f[0]) / f[2];
         let ry = (rz * f[1] - m[0]) / f[2];
         let p = [o[0] - rx, o[1] - ry, ground];
-        (dot(p, p).is_finite()).then_some(p)
+        p.iter().all(|x| x.is_finite()).then_some(p)
     }
 }
 

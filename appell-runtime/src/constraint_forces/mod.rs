@@ -151,6 +151,27 @@ pub enum Friction {
     NormalUnavailable(NormalUnavailable),
 }
 
+impl Friction {
+    /// The friction a contact needs whose normal force is `normal` and whose
+    /// force along the contact plane has the magnitude `tangential`.
+    fn of(normal: f64, tangential: f64) -> Friction {
+        if normal.is_nan() || normal <= 0.0 {
+            return Friction::LiftOff { normal };
+        }
+        let mu = tangential / normal;
+        if !mu.is_finite() {
+            // A normal force so small that no coefficient holds: the
+            // lift-off limit.
+            return Friction::LiftOff { normal };
+        }
+        Friction::Required {
+            mu,
+            normal,
+            tangential,
+        }
+    }
+}
+
 /// The reaction on the body at one rolling contact.
 #[derive(Clone, Debug, PartialEq)]
 pub struct ContactForce {
@@ -180,22 +201,8 @@ impl ContactForce {
             Normal::Available {
                 direction, force, ..
             } => {
-                if force.is_nan() || force <= 0.0 {
-                    return Friction::LiftOff { normal: force };
-                }
                 let t = sub(self.force, scale(direction, dot(self.force, direction)));
-                let tangential = norm(t);
-                let mu = tangential / force;
-                if !mu.is_finite() {
-                    // A normal force so small that no coefficient holds:
-                    // the lift-off limit.
-                    return Friction::LiftOff { normal: force };
-                }
-                Friction::Required {
-                    mu,
-                    normal: force,
-                    tangential,
-                }
+                Friction::of(force, norm(t))
             }
         }
     }
@@ -365,9 +372,6 @@ type RollingContact = (ContactForce, Option<[f64; 3]>, Option<f64>);
 /// oriented, and the side of the body's mass centre (see
 /// [`ContactParts::sides`]); the normal force itself is left to the
 /// callers.
-// called once per contact in contact_forces_parts' loop: the geometry, multipliers and
-// motion are computed once there for all contacts and lent to each call
-#[allow(clippy::too_many_arguments)]
 fn rolling_contact(
     info: &ModelInfo,
     c: usize,

@@ -67,7 +67,6 @@ pub(in crate::integrate) enum Hook<'h, 'a> {
 /// [`IntegrateError::Contact`], forces that cannot be evaluated
 /// [`IntegrateError::Model`].
 #[cfg(feature = "std")]
-#[allow(clippy::too_many_arguments)] // the problem's start and the two hooks
 pub(in crate::integrate) fn watched<M: Model, T: Scalar, R>(
     model: &M,
     inputs: &[T],
@@ -124,9 +123,6 @@ where
 /// Without `std` there are no contact forces to watch: `solve` runs as it
 /// is.
 #[cfg(not(feature = "std"))]
-// the std `watched`'s signature, so the explicit run_model calls it the same way without
-// std; here every argument but `solve` is unused
-#[allow(clippy::too_many_arguments)]
 pub(in crate::integrate) fn watched<M: Model, T: Scalar, R>(
     _model: &M,
     _inputs: &[T],

@@ -100,10 +100,12 @@ impl NativePinocchioMap {
                     )))
                 }
             };
-            if r.is_some() && rows.is_some_and(|n| Some(n) != r) {
-                return Err(PyValueError::new_err(format!(
-                    "the arguments of `{what}` have different numbers of rows"
-                )));
+            if let (Some(r), Some(first)) = (r, rows) {
+                if r != first {
+                    return Err(PyValueError::new_err(format!(
+                        "the arguments of `{what}` have {first} and {r} rows"
+                    )));
+                }
             }
             rows = rows.or(r);
             let slice = a

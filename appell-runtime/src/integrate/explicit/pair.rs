@@ -63,9 +63,6 @@ pub(in crate::integrate) trait EmbeddedPair<T: Scalar, const S: usize> {
 
     /// The continuous extension of the accepted step from `(t, x)` to
     /// `x_new` (any extra rhs calls counted in `stats`).
-    // as `step`, once per accepted step that needs a dense output: the step's ends (t, hs, x,
-    // x_new) are run's loop locals, the rhs and counters its borrows
-    #[allow(clippy::too_many_arguments)]
     fn dense<F>(
         &mut self,
         f: &mut F,
