@@ -234,3 +234,39 @@ def test_two_models_from_one_module_keep_their_own_parameters(wheel_axle):
     assert steep.parameters["alpha"] == 0.5 and wheel_axle.parameters["alpha"] == 0.2
     x = [0.3, 0.0, 0.0]
     assert steep.rhs(x, [0.0])[2] > wheel_axle.rhs(x, [0.0])[2]
+
+
+def test_foot_forces_of_a_scene(cache, rng):
+    """A one-legged robot on a free base standing on a point foot: the
+    scene's foot force is its rows' multipliers, by axis."""
+    from conftest import REPO
+
+    robot = appell.from_urdf(REPO / "tests/data/one_leg.urdf", base="free", progress=False,
+                             extra="contact(foot, point, effect = stance)\n"
+                                   "scene(standing, effects(gravity, actuation, stance))")
+    upright = {c: 0.0 for c in robot.coordinate_names}
+    upright.update(root_joint_qw=1.0, root_joint_z=0.45, knee=-0.5)
+    assert robot.info["feet"] == [] and robot.foot_forces(upright, np.zeros(9)) == {}
+    standing = robot.scene("standing")
+    assert standing.info["feet"] == [{"link": "foot", "flat": False}]
+    q = np.zeros((6, len(standing.coordinate_names)))
+    q[:, standing.coordinate_names.index("root_joint_qw")] = 1.0
+    q[:, standing.coordinate_names.index("root_joint_z")] = 0.45
+    q[:, standing.coordinate_names.index("hip_pitch")] = rng.uniform(0.2, 0.4, 6)
+    q[:, standing.coordinate_names.index("knee")] = rng.uniform(-0.8, -0.4, 6)
+    v = rng.uniform(-0.5, 0.5, (6, len(standing.speed_names)))
+    u = rng.uniform(-1.0, 1.0, (6, len(standing.input_names)))
+    feet = standing.foot_forces(q, v, u)
+    assert list(feet) == ["foot"] and feet["foot"]["moment"] is None
+    force, position = feet["foot"]["force"], feet["foot"]["position"]
+    assert force.shape == (6, 3) and position.shape == (6, 3)
+    lam, _ = standing.constraint_forces(q, v, u)
+    for k in range(6):
+        # The foot's three rows are among the multipliers, to the bit.
+        assert all(f in set(lam[k]) for f in force[k]), (force[k], lam[k])
+        one = standing.foot_forces(q[k], v[k], u[k])["foot"]
+        assert np.array_equal(one["force"], force[k]) and np.array_equal(one["position"], position[k])
+    # The foot is below the hip: 0.45 - 0.05 - 0.2 (cos a + cos(a + b)) up.
+    a = q[:, standing.coordinate_names.index("hip_pitch")]
+    b = q[:, standing.coordinate_names.index("knee")]
+    np.testing.assert_allclose(position[:, 2], 0.4 - 0.2 * (np.cos(a) + np.cos(a + b)), atol=1e-14)

@@ -16,7 +16,7 @@ mod ops;
 mod python;
 mod simulate;
 
-pub use ops::{Arg, Compiled, Evaluate, Failure, Op};
+pub use ops::{held_feet, Arg, Compiled, Evaluate, Failure, Op};
 pub use python::{register, NativeModel};
 pub use simulate::{Event, Feedback, Method, SimJob, DOP853_MAX_STATE};
 

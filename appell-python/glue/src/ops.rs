@@ -46,11 +46,32 @@ pub enum Op {
     /// `(q, v, u) -> multipliers[m], qddot[n]` (the constraint forces'
     /// multipliers from the independent KKT solve).
     ConstraintForces,
+    /// `(q, v, u) -> [position[3], force[3], moment[3]]` for each foot of
+    /// [`held_feet`] (`appell::constraint_forces::FootForce`; a point
+    /// foot's moment zero).
+    FootForces,
+}
+
+/// The feet a model or scene holds (`contact(link, point | flat)` rows in
+/// its `row_sources`): each one's index into `Model::contact_links` and
+/// whether it is flat (holds the link's rotation too), in that order.
+pub fn held_feet(info: &ModelInfo) -> Vec<(usize, bool)> {
+    let mut feet: Vec<(usize, bool)> = Vec::new();
+    for src in info.row_sources {
+        if let appell::RowSource::Contact { contact, axis } = *src {
+            match feet.iter_mut().find(|(c, _)| *c == contact) {
+                Some((_, flat)) => *flat |= axis >= 3,
+                None => feet.push((contact, axis >= 3)),
+            }
+        }
+    }
+    feet.sort_by_key(|(c, _)| *c);
+    feet
 }
 
 impl Op {
     /// Every operation, for the Python package's table.
-    pub const ALL: [Op; 13] = [
+    pub const ALL: [Op; 14] = [
         Op::Rhs,
         Op::RhsJacobian,
         Op::Linearize,
@@ -64,6 +85,7 @@ impl Op {
         Op::BiasForces,
         Op::Energies,
         Op::ConstraintForces,
+        Op::FootForces,
     ];
 
     /// The name the Python package uses.
@@ -82,6 +104,7 @@ impl Op {
             Op::BiasForces => "bias_forces",
             Op::Energies => "energies",
             Op::ConstraintForces => "constraint_forces",
+            Op::FootForces => "foot_forces",
         }
     }
 
@@ -104,7 +127,8 @@ impl Op {
             | Op::MassMatrixAndForcing
             | Op::ForwardDynamicsDerivatives
             | Op::Energies
-            | Op::ConstraintForces => vec![("q", n), ("v", l), ("u", i)],
+            | Op::ConstraintForces
+            | Op::FootForces => vec![("q", n), ("v", l), ("u", i)],
             Op::MassMatrix | Op::GravityForces => vec![("q", n)],
             Op::InverseDynamics | Op::InverseDynamicsDerivatives => {
                 vec![("q", n), ("v", l), ("a", l)]
@@ -134,6 +158,7 @@ impl Op {
             Op::ForwardDynamicsDerivatives => l + l * n + l * l + l * i,
             Op::Energies => 4,
             Op::ConstraintForces => m + n,
+            Op::FootForces => 9 * held_feet(info).len(),
         }
     }
 }
@@ -176,6 +201,8 @@ pub trait Evaluate: Send + Sync {
     fn info(&self, scene: Option<usize>) -> &'static ModelInfo;
     /// The scenes' `ModelInfo`s.
     fn scene_infos(&self) -> &'static [&'static ModelInfo];
+    /// The links of the model's `contact(link, ...)` declarations.
+    fn contact_links(&self) -> &'static [&'static str];
     /// The parameter values, in `ModelInfo::parameters` order.
     fn parameter_values(&self) -> Vec<f64>;
     /// A copy with the parameters `values` (in `ModelInfo::parameters`
@@ -225,6 +252,10 @@ where
 
     fn scene_infos(&self) -> &'static [&'static ModelInfo] {
         M::scene_infos()
+    }
+
+    fn contact_links(&self) -> &'static [&'static str] {
+        M::contact_links()
     }
 
     fn parameter_values(&self) -> Vec<f64> {
@@ -467,6 +498,21 @@ fn eval_row<M: Model>(
             }
             out[..m].copy_from_slice(&forces.multipliers);
             out[m..].copy_from_slice(&forces.qddot);
+            Ok(())
+        }
+        Op::FootForces => {
+            let forces = appell::constraint_forces::contact_forces(model, t, a[0], a[1], a[2])
+                .map_err(|e| e.to_string())?;
+            let held = held_feet(info);
+            let found: Vec<usize> = forces.feet.iter().map(|f| f.contact).collect();
+            if found != held.iter().map(|(c, _)| *c).collect::<Vec<_>>() {
+                return Err(format!("the feet {found:?} are not the rows' {held:?}"));
+            }
+            for (foot, chunk) in forces.feet.iter().zip(out.chunks_exact_mut(9)) {
+                chunk[..3].copy_from_slice(&foot.position);
+                chunk[3..6].copy_from_slice(&foot.force);
+                chunk[6..].copy_from_slice(&foot.moment.unwrap_or([0.0; 3]));
+            }
             Ok(())
         }
     }

@@ -302,6 +302,25 @@ class Model:
         out = self._call("constraint_forces", args, t, params)
         return out[..., : self._m], out[..., self._m :]
 
+    def foot_forces(self, q: ArrayLike, v: ArrayLike, u: Optional[ArrayLike] = None,
+                    t: float = 0.0, params: Any = None) -> Dict[str, Dict[str, Optional[np.ndarray]]]:
+        """The ground's reaction on each foot the model or scene holds
+        (``contact(link, point | flat)`` in a scene that names it; the
+        feet are ``info["feet"]``), keyed by the foot's link: ``position``
+        (the link's origin), ``force`` (on the link at its origin) and
+        ``moment`` (a flat foot's, about the origin; None for a point
+        foot), each in N's axes, with the batch's leading axis. The friction
+        a foot needs is ``hypot(force[0], force[1]) / force[2]`` where
+        ``force[2] > 0``."""
+        args = [self._array("q", q, self.coordinate_names), self._array("v", v, self.speed_names),
+                self._array("u", u, self.input_names)]
+        feet = self._info["feet"]
+        out = self._call("foot_forces", args, t, params)
+        out = out.reshape(out.shape[:-1] + (len(feet), 9))
+        return {foot["link"]: {"position": out[..., k, 0:3], "force": out[..., k, 3:6],
+                               "moment": out[..., k, 6:9] if foot["flat"] else None}
+                for k, foot in enumerate(feet)}
+
     @property
     def has_jacobian(self) -> bool:
         """Whether the derive generated the rhs's Jacobian (``rhs_jacobian``)."""

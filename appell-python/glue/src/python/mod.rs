@@ -11,7 +11,7 @@ use pyo3::exceptions::{PyRuntimeError, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 
-use crate::ops::{Arg, Compiled, Evaluate, Failure, Op};
+use crate::ops::{held_feet, Arg, Compiled, Evaluate, Failure, Op};
 use crate::simulate::Method;
 
 mod pinocchio;
@@ -194,7 +194,21 @@ impl NativeModel {
     #[pyo3(signature = (scene=None))]
     fn info<'py>(&self, py: Python<'py>, scene: Option<usize>) -> PyResult<Bound<'py, PyDict>> {
         self.check_scene(scene)?;
-        info_dict(py, self.current().info(scene))
+        let model = self.current();
+        let d = info_dict(py, model.info(scene))?;
+        let links = model.contact_links();
+        let feet = PyList::empty(py);
+        for (c, flat) in held_feet(model.info(scene)) {
+            let foot = PyDict::new(py);
+            let link = links.get(c).ok_or_else(|| {
+                PyRuntimeError::new_err(format!("contact {c} of {} links", links.len()))
+            })?;
+            foot.set_item("link", *link)?;
+            foot.set_item("flat", flat)?;
+            feet.append(foot)?;
+        }
+        d.set_item("feet", feet)?;
+        Ok(d)
     }
 
     /// A new object with the same model and parameters, whose parameters
