@@ -4,11 +4,15 @@ from __future__ import annotations
 
 import difflib
 import os
-from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Dict, List, Mapping, Optional, Sequence, Tuple, Union, overload
 
 import numpy as np
 
 from ._pinocchio import PinocchioMap, base_coordinates, detect_base, model_name
+
+#: What ``simulate`` returns with an event: the times reached, the states
+#: there, and the event's (t, x) or None.
+EventRun = Tuple[np.ndarray, np.ndarray, Optional[Tuple[float, np.ndarray]]]
 
 from .errors import ModelError
 
@@ -390,11 +394,26 @@ class Model:
         return (out[..., :l], out[..., l:at].reshape(lead + (l, n)),
                 out[..., at : at + l * l].reshape(lead + (l, l)), out[..., at + l * l :].reshape(lead + (l, self._ni)))
 
+    @overload
     def simulate(self, x0: ArrayLike, t_eval: ArrayLike, u: Any = None,
                  method: str = "dop853", rtol: float = 1e-8, atol: float = 1e-10,
                  t0: Optional[float] = None, h_max: Optional[float] = None,
                  max_steps: int = 1_000_000, params: Any = None,
-                 event: Optional[Callable[[float, np.ndarray], float]] = None) -> Any:
+                 event: None = None) -> np.ndarray: ...
+
+    @overload
+    def simulate(self, x0: ArrayLike, t_eval: ArrayLike, u: Any = None,
+                 method: str = "dop853", rtol: float = 1e-8, atol: float = 1e-10,
+                 t0: Optional[float] = None, h_max: Optional[float] = None,
+                 max_steps: int = 1_000_000, params: Any = None, *,
+                 event: Callable[[float, np.ndarray], float]) -> EventRun: ...
+
+    def simulate(self, x0: ArrayLike, t_eval: ArrayLike, u: Any = None,
+                 method: str = "dop853", rtol: float = 1e-8, atol: float = 1e-10,
+                 t0: Optional[float] = None, h_max: Optional[float] = None,
+                 max_steps: int = 1_000_000, params: Any = None,
+                 event: Optional[Callable[[float, np.ndarray], float]] = None
+                 ) -> Union[np.ndarray, EventRun]:
         """Integrates from ``x0`` at ``t0`` (default ``t_eval[0]``) and
         returns the states at ``t_eval``: (len(t_eval), s), or
         (N, len(t_eval), s) for N initial states (split over threads).
