@@ -63,6 +63,34 @@ fn failure(py: Python<'_>, f: Failure, batched: bool, op: Op) -> PyErr {
     model_error(py, message)
 }
 
+/// The model's rhs at one state `xs` (of the reduced state's length) and
+/// inputs `us` (of the inputs' number), as `rhs1` and `rhs_fast` call it.
+fn one_rhs(
+    py: Python<'_>,
+    model: &dyn Evaluate,
+    t: f64,
+    xs: &[f64],
+    us: &[f64],
+) -> PyResult<Vec<f64>> {
+    let mut out = vec![0.0; xs.len()];
+    let args = [
+        Arg {
+            data: xs,
+            len: xs.len(),
+            batched: false,
+        },
+        Arg {
+            data: us,
+            len: us.len(),
+            batched: false,
+        },
+    ];
+    model
+        .rows(None, Op::Rhs, t, &args, &mut out, 0)
+        .map_err(|f| failure(py, f, false, Op::Rhs))?;
+    Ok(out)
+}
+
 /// Splits `rows` rows of `width` results over up to `threads` threads
 /// (one row per thread at least `min_rows` rows), the first failure by row
 /// returned.
@@ -309,23 +337,7 @@ impl NativeModel {
                 info.inputs.len()
             )));
         }
-        let mut out = vec![0.0; s];
-        let args = [
-            Arg {
-                data: xs,
-                len: s,
-                batched: false,
-            },
-            Arg {
-                data: us,
-                len: us.len(),
-                batched: false,
-            },
-        ];
-        model
-            .rows(None, Op::Rhs, t, &args, &mut out, 0)
-            .map_err(|f| failure(py, f, false, Op::Rhs))?;
-        Ok(PyArray1::from_vec(py, out))
+        Ok(PyArray1::from_vec(py, one_rhs(py, &*model, t, xs, us)?))
     }
 
     /// The reduced rhs of the model (not a scene) at one state, when `x`
@@ -370,23 +382,10 @@ impl NativeModel {
         if xs.len() != s || us.len() != info.inputs.len() {
             return Ok(None);
         }
-        let mut out = vec![0.0; s];
-        let args = [
-            Arg {
-                data: xs,
-                len: s,
-                batched: false,
-            },
-            Arg {
-                data: us,
-                len: us.len(),
-                batched: false,
-            },
-        ];
-        model
-            .rows(None, Op::Rhs, t, &args, &mut out, 0)
-            .map_err(|f| failure(py, f, false, Op::Rhs))?;
-        Ok(Some(PyArray1::from_vec(py, out)))
+        Ok(Some(PyArray1::from_vec(
+            py,
+            one_rhs(py, &*model, t, xs, us)?,
+        )))
     }
 
     /// Evaluates operation `op` (see `operations()`) on `args`, each a
