@@ -91,7 +91,7 @@ pub mod __private {
     pub use crate::dual::{inverse_dynamics_derivatives_by_duals, rhs_jacobian_by_duals};
     pub use crate::linalg::{
         check_pivot, constraint_scale, ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs,
-        pivot_margin,
+        pivot_margin, substitute_row,
     };
     pub use crate::physical::check_body;
     pub use crate::{

@@ -150,6 +150,27 @@ pub struct WorldJacobian {
     /// Rows: the retained coordinates' rates, then ÿ; row-major over the
     /// columns.
     pub derivatives: Vec<Id>,
+    /// On a fixed root, the same columns before their solves, for the
+    /// emitter to solve in loops over the columns.
+    pub unsolved: Option<UnsolvedColumns>,
+}
+
+/// The world frame's columns left for the emitted code to solve: for each
+/// column c, M ∂ÿ/∂c = ∂τ/∂c − ∂Q/∂c, and M's factors.
+#[derive(Clone, Debug)]
+pub struct UnsolvedColumns {
+    /// The retained coordinates' rates' derivatives, row-major over the
+    /// columns.
+    pub rates: Vec<Id>,
+    /// Per column, its l right-hand sides in speed order.
+    pub forcing: Vec<Vec<Id>>,
+    /// The speed at each position of M's elimination order.
+    pub order: Vec<usize>,
+    /// L below its diagonal, `lower[i][k]` for positions k < i (literal
+    /// zeros where a row's speed does not move the column's).
+    pub lower: Vec<Vec<Id>>,
+    /// 1 / dᵢ at each position.
+    pub reciprocals: Vec<Id>,
 }
 
 /// The derivatives of the reduced rhs (stage 14), and why a candidate is

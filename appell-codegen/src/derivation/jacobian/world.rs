@@ -7,7 +7,9 @@ use appell_symbolic::{Id, Symbol, SymbolicError};
 
 use super::super::tree::world::{Accelerations, WorldDerivatives};
 use super::super::Derivation;
-use super::{budget, budgeted, derivatives, retained_rates, Columns, WorldJacobian};
+use super::{
+    budget, budgeted, derivatives, retained_rates, Columns, UnsolvedColumns, WorldJacobian,
+};
 use crate::model::Model;
 
 /// The world-frame candidate: the tree's inverse-dynamics derivatives
@@ -108,6 +110,18 @@ fn world_columns(
         let column = root.gravity.iter().map(|&x| g.neg(x));
         solved.push(column.collect::<Result<_, _>>()?);
     }
+    let unsolved = w.roots.is_empty().then(|| {
+        let l = factor.order().len();
+        UnsolvedColumns {
+            rates: derivatives.clone(),
+            forcing: solved.clone(),
+            order: factor.order().to_vec(),
+            lower: (0..l)
+                .map(|i| (0..i).map(|k| factor.lower(i, k)).collect())
+                .collect(),
+            reciprocals: factor.reciprocals().to_vec(),
+        }
+    });
     let mut a = super::super::tree::spatial::Algebra::new(g)?;
     if factor.is_dense() {
         // A chain: each column M⁻¹ b by M⁻¹ formed once (its columns are
@@ -142,6 +156,7 @@ fn world_columns(
     Ok(WorldJacobian {
         accelerations,
         derivatives,
+        unsolved,
     })
 }
 

@@ -123,6 +123,8 @@ impl Emitter<'_> {
             body,
             ops: program.ops,
             extra,
+            looped: 0,
+            overhead: 0,
         }
     }
 

@@ -18,6 +18,7 @@
 //! work is not hoisted: the function needs no `Prepared`.
 
 mod closed;
+mod loops;
 mod recursive;
 mod sparse;
 
@@ -105,11 +106,38 @@ struct Candidate {
     ops: OpCount,
     /// Operations besides the program's (the factorization and solves).
     extra: usize,
+    /// Operations in loops over the columns ([`loops`]), among `extra`'s
+    /// kind but vectorized.
+    looped: usize,
+    /// What the loops cost besides their operations, in operations'
+    /// worth (calls, the scratch zeroed and copied out): only compared.
+    overhead: usize,
 }
 
 impl Candidate {
+    /// Its operations per call.
     fn total(&self) -> usize {
-        self.ops.total() + self.extra
+        self.ops.total() + self.extra + self.looped
+    }
+
+    /// What candidates are compared by: the operations per call, those in
+    /// loops over the columns taken [`loops::LANES`] at a time, and the
+    /// loops' overhead.
+    fn cost(&self) -> usize {
+        self.ops.total() + self.extra + self.looped.div_ceil(loops::LANES) + self.overhead
+    }
+
+    /// How `info().jacobian.form` counts it.
+    fn describe_ops(&self) -> String {
+        if self.looped == 0 {
+            format!("{} operations per call", self.total())
+        } else {
+            format!(
+                "{} operations per call, {} of them in loops over the columns",
+                self.total(),
+                self.looped
+            )
+        }
     }
 }
 
@@ -146,6 +174,7 @@ enum Kind {
     Structured,
     Recursive,
     World,
+    WorldLoops,
 }
 
 impl Kind {
@@ -162,6 +191,9 @@ impl Kind {
             Kind::World => {
                 "inverse dynamics in the world frame: recursive Newton–Euler's derivatives by joint pairs (Carpentier and Mansard), ÿ and each column M⁻¹ (∂τ − ∂Q) by the factors of M (subtree inertias)"
             }
+            Kind::WorldLoops => {
+                "inverse dynamics in the world frame: recursive Newton–Euler's derivatives by joint pairs (Carpentier and Mansard), ÿ by the factors of M (subtree inertias), the columns M⁻¹ (∂τ − ∂Q) by the same factors in loops over the columns"
+            }
         }
     }
 
@@ -172,6 +204,7 @@ impl Kind {
             Kind::Structured => "the structured form's",
             Kind::Recursive => "inverse dynamics'",
             Kind::World => "the world frame's",
+            Kind::WorldLoops => "the world frame's in loops",
         }
     }
 }
@@ -266,11 +299,16 @@ impl Emitter<'_> {
                     Kind::Structured => self.structured_candidate(c.roots, &layout),
                     Kind::Recursive => self.recursive_candidate(c.roots, &layout),
                     Kind::World => self.structured_candidate(c.roots, &layout),
+                    Kind::WorldLoops => {
+                        let world = j.world.as_ref().expect("a world-frame candidate");
+                        let unsolved = world.unsolved.as_ref().expect("its columns unsolved");
+                        self.loop_candidate(c.roots, &layout, unsolved)
+                    }
                 };
                 (c.kind, candidate)
             })
             .collect();
-        lowered.sort_by_key(|(_, c)| c.total());
+        lowered.sort_by_key(|(_, c)| c.cost());
         let (kind, chosen) = lowered.remove(0);
         let what = kind.describe();
         let against = lowered
@@ -282,7 +320,7 @@ impl Emitter<'_> {
         } else {
             format!(" against {}", against.join(", "))
         };
-        let form = format!("{what}, {} operations per call{against}", chosen.total());
+        let form = format!("{what}, {}{against}", chosen.describe_ops());
         let p = p();
         let o = chosen.ops;
         let (add, mul, div, calls, total) = (
@@ -371,6 +409,16 @@ impl Emitter<'_> {
                 total,
                 values,
             });
+            if let Some(u) = &w.unsolved {
+                let roots = self.loop_roots(u, layout, j);
+                let total = size(&roots.all);
+                out.push(Sized {
+                    kind: Kind::WorldLoops,
+                    roots,
+                    total,
+                    values,
+                });
+            }
         }
         out
     }
@@ -470,6 +518,8 @@ impl Emitter<'_> {
             body,
             ops: program.ops,
             extra: 0,
+            looped: 0,
+            overhead: 0,
         }
     }
 

@@ -92,6 +92,22 @@ impl MassFactor {
 }
 
 impl MassFactor {
+    /// The speed at each position of the elimination order.
+    pub fn order(&self) -> &[usize] {
+        &self.order
+    }
+
+    /// L's entry at positions (i, k), k < i, in the elimination order (a
+    /// literal zero where a row's speed does not move the column's).
+    pub fn lower(&self, i: usize, k: usize) -> Id {
+        self.lower[i][k]
+    }
+
+    /// 1 / dᵢ at each position of the elimination order.
+    pub fn reciprocals(&self) -> &[Id] {
+        &self.reciprocals
+    }
+
     /// Whether L has no zero below its diagonal: M of a chain (one speed
     /// per link).
     pub fn is_dense(&self) -> bool {
