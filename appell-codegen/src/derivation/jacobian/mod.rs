@@ -148,11 +148,12 @@ pub struct WorldJacobian {
     /// [`FreeRoot`](super::tree::world::FreeRoot)).
     pub accelerations: Vec<Id>,
     /// Rows: the retained coordinates' rates, then ÿ; row-major over the
-    /// columns.
-    pub derivatives: Vec<Id>,
-    /// On a fixed root, the same columns before their solves, for the
-    /// emitter to solve in loops over the columns.
-    pub unsolved: Option<UnsolvedColumns>,
+    /// columns; `None` where solving every column in the graph would pass
+    /// the candidate's budget.
+    pub derivatives: Option<Vec<Id>>,
+    /// The same columns before their solves, for the emitter to solve in
+    /// loops over the columns.
+    pub unsolved: UnsolvedColumns,
 }
 
 /// The world frame's columns left for the emitted code to solve: for each
@@ -171,6 +172,22 @@ pub struct UnsolvedColumns {
     pub lower: Vec<Vec<Id>>,
     /// 1 / dᵢ at each position.
     pub reciprocals: Vec<Id>,
+    /// After the solve, a free root's ṗ rows scaled (see
+    /// [`FreeRoot`](super::tree::world::FreeRoot)).
+    pub rows: Vec<ScaledRow>,
+}
+
+/// A row of ÿ scaled after the solve, with terms added to some columns: a
+/// free root's ṗ row, by s = |e|², and 2 eₖ ÿ'ᵢ on the quaternion's
+/// columns.
+#[derive(Clone, Debug)]
+pub struct ScaledRow {
+    /// The row's speed.
+    pub speed: usize,
+    /// What the whole row is multiplied by.
+    pub scale: Id,
+    /// Then added: (the column among the Jacobian's, the term).
+    pub adds: Vec<(usize, Id)>,
 }
 
 /// The derivatives of the reduced rhs (stage 14), and why a candidate is

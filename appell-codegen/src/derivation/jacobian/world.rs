@@ -8,15 +8,19 @@ use appell_symbolic::{Id, Symbol, SymbolicError};
 use super::super::tree::world::{Accelerations, WorldDerivatives};
 use super::super::Derivation;
 use super::{
-    budget, budgeted, derivatives, retained_rates, Columns, UnsolvedColumns, WorldJacobian,
+    budget, budgeted, derivatives, retained_rates, Columns, ScaledRow, UnsolvedColumns,
+    WorldJacobian,
 };
 use crate::model::Model;
 
 /// The world-frame candidate: the tree's inverse-dynamics derivatives
 /// built directly ([`world_derivatives`](super::super::tree::world::world_derivatives)),
-/// with ÿ solved by M's factors in the same graph, and each column
-/// ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) by those factors (on a chain, by M⁻¹).
-/// Within the budget of a candidate differentiating the rhs's values.
+/// with ÿ solved by M's factors in the same graph, and each column's right
+/// side ∂τ/∂c − ∂Q/∂c left for the emitter's loops ([`right_sides`]),
+/// within the budget of a candidate differentiating the rhs's values; then,
+/// within what is left of it, each column ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c)
+/// solved by those factors in the graph too (on a chain, by M⁻¹), or
+/// `None` past it.
 pub(super) fn world(
     model: &mut Model,
     d: &Derivation,
@@ -31,15 +35,30 @@ pub(super) fn world(
     values.extend(&s.accelerations);
     let allowed = budget(&model.g, &values, forced);
     let fixed = &d.reduction.ignorable;
-    budgeted(
+    let before = model.g.len();
+    let (w, sides) = budgeted(
         model,
         |m| &mut m.g,
         allowed,
         |model| {
             let w = world_frame(model, fixed, Accelerations::Solved)?;
-            world_columns(model, d, columns, &w)
+            let sides = right_sides(model, d, columns, &w)?;
+            Ok((w, sides))
         },
+    )?;
+    let left = allowed.saturating_sub(model.g.len() - before);
+    let derivatives = budgeted(
+        model,
+        |m| &mut m.g,
+        left,
+        |model| solved_in_graph(model, &w, &sides),
     )
+    .ok();
+    Ok(WorldJacobian {
+        accelerations: sides.accelerations,
+        derivatives,
+        unsolved: sides.unsolved,
+    })
 }
 
 /// The world frame's derivatives of `model`'s tree, the coordinates
@@ -60,16 +79,31 @@ fn world_frame(
     super::super::tree::world::world_derivatives(model, &spec, fixed, at)
 }
 
-/// The reduced rhs's rows and columns from the world frame's `w`: each
-/// column's ∂τ/∂c − ∂Q/∂c solved by M's factors, after the retained
-/// coordinates' rates' derivatives; a free root's columns and rows mapped
-/// back to e and ṗ ([`free_roots`]).
-fn world_columns(
+/// A candidate's columns before their solves ([`right_sides`]).
+struct RightSides {
+    /// The Jacobian's columns, then each free root's four extra ones
+    /// ([`quaternion_columns`]), each its l right sides in speed order.
+    columns: Vec<Vec<Id>>,
+    /// The reduced rhs's ÿ: the nodes', a free root's ṗ rows by s.
+    accelerations: Vec<Id>,
+    /// What the emitter's loops solve.
+    unsolved: UnsolvedColumns,
+    /// The symbols the columns are by: the model's coordinates, and the
+    /// Jacobian's columns.
+    coordinates: Vec<Symbol>,
+    symbols: Vec<Symbol>,
+}
+
+/// The right sides ∂τ/∂c − ∂Q/∂c of every column from the world frame's
+/// `w`, the retained coordinates' rates' derivatives, and the reduced
+/// rhs's ÿ; the same columns for the emitter's loops, a free root's
+/// quaternion columns combined and its ṗ rows to scale after the solve.
+fn right_sides(
     model: &mut Model,
     d: &Derivation,
     columns: &Columns,
     w: &WorldDerivatives,
-) -> Result<WorldJacobian, SymbolicError> {
+) -> Result<RightSides, SymbolicError> {
     let factor = w
         .factor
         .as_ref()
@@ -77,12 +111,12 @@ fn world_columns(
             expected: "M's factors".to_string(),
             found: "accelerations given".to_string(),
         })?;
-    let (l, n) = (d.l, columns.len());
+    let l = d.l;
     let speeds: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
     let rates = retained_rates(d);
     let g = &mut model.g;
-    let mut derivatives = self::derivatives(g, &rates, columns)?;
-    let mut solved = Vec::with_capacity(n + 4 * w.roots.len());
+    let derivatives = self::derivatives(g, &rates, columns)?;
+    let mut sides = Vec::with_capacity(columns.len() + 4 * w.roots.len());
     // −∂Q/∂c as the l entries of column j of the l×l matrix `m`.
     let negated =
         |g: &mut appell_symbolic::Graph, m: &[Id], j: usize| -> Result<Vec<Id>, SymbolicError> {
@@ -100,29 +134,56 @@ fn world_columns(
             let inputs = w.inputs.iter().map(|&tau| g.diff(tau, c));
             inputs.collect::<Result<_, _>>()?
         };
-        solved.push(forcing);
+        sides.push(forcing);
     }
     // A free root's turns in the body's axes and its gravity's scale.
     for root in &w.roots {
         for &j in &root.angular {
-            solved.push(negated(g, &w.by_coordinates, j)?);
+            sides.push(negated(g, &w.by_coordinates, j)?);
         }
         let column = root.gravity.iter().map(|&x| g.neg(x));
-        solved.push(column.collect::<Result<_, _>>()?);
+        sides.push(column.collect::<Result<_, _>>()?);
     }
-    let unsolved = w.roots.is_empty().then(|| {
-        let l = factor.order().len();
-        UnsolvedColumns {
-            rates: derivatives.clone(),
-            forcing: solved.clone(),
-            order: factor.order().to_vec(),
-            lower: (0..l)
-                .map(|i| (0..i).map(|k| factor.lower(i, k)).collect())
-                .collect(),
-            reciprocals: factor.reciprocals().to_vec(),
-        }
-    });
+    let symbols: Vec<Symbol> = columns.all().collect();
+    let coordinates: Vec<Symbol> = model.coords.iter().map(|c| c.1.q).collect();
+    let at = Symbols {
+        coordinates: &coordinates,
+        columns: &symbols,
+    };
     let mut a = super::super::tree::spatial::Algebra::new(g)?;
+    let unsolved = unsolved(&mut a, &at, w, factor, &sides, derivatives)?;
+    let mut accelerations = w.accelerations.clone();
+    for root in &w.roots {
+        for &i in &root.linear {
+            accelerations[i] = a.g.mul(root.scale, accelerations[i])?;
+        }
+    }
+    Ok(RightSides {
+        columns: sides,
+        accelerations,
+        unsolved,
+        coordinates,
+        symbols,
+    })
+}
+
+/// The reduced rhs's rows over the columns, each column of `sides` solved
+/// by M's factors in the graph after the retained coordinates' rates'
+/// derivatives; a free root's columns and rows mapped back to e and ṗ
+/// ([`quaternion_columns`], [`scaled_rows`]).
+fn solved_in_graph(
+    model: &mut Model,
+    w: &WorldDerivatives,
+    sides: &RightSides,
+) -> Result<Vec<Id>, SymbolicError> {
+    let factor = w.factor.as_ref().expect("factors with the right sides");
+    let (l, n) = (w.accelerations.len(), sides.symbols.len());
+    let at = Symbols {
+        coordinates: &sides.coordinates,
+        columns: &sides.symbols,
+    };
+    let mut a = super::super::tree::spatial::Algebra::new(&mut model.g)?;
+    let mut solved = sides.columns.clone();
     if factor.is_dense() {
         // A chain: each column M⁻¹ b by M⁻¹ formed once (its columns are
         // ∂ÿ/∂τ where the joints are driven) costs what a solve does, and
@@ -142,22 +203,15 @@ fn world_columns(
         }
     }
     let extra = solved.split_off(n);
-    let symbols: Vec<Symbol> = columns.all().collect();
-    let mut accelerations = w.accelerations.clone();
-    let coords: Vec<Symbol> = model.coords.iter().map(|c| c.1.q).collect();
-    let at = Symbols {
-        coordinates: &coords,
-        columns: &symbols,
-    };
-    free_roots(&mut a, &at, w, &mut solved, &extra, &mut accelerations)?;
+    let quaternions = quaternion_columns(&mut a, &at, w, &mut solved, &extra)?;
+    for (root, quaternion) in w.roots.iter().zip(&quaternions) {
+        scaled_rows(&mut a, root, quaternion, &mut solved, &w.accelerations)?;
+    }
+    let mut derivatives = sides.unsolved.rates.clone();
     for k in 0..l {
         derivatives.extend(solved.iter().map(|column| column[k]));
     }
-    Ok(WorldJacobian {
-        accelerations,
-        derivatives,
-        unsolved,
-    })
+    Ok(derivatives)
 }
 
 /// The symbols a free root's columns are found by.
@@ -166,24 +220,69 @@ struct Symbols<'a> {
     columns: &'a [Symbol],
 }
 
-/// The reduced rhs's columns and accelerations from the nodes' (`solved`,
-/// in the Jacobian's columns; `extra`, per free root, its three turns and
-/// its gravity's scale): with s = |e|², the rhs's ÿ is S ÿ' for ÿ' the
-/// nodes' (S: s on ṗ's rows), which move at s ṗ under gravity s g. The
-/// quaternion's columns are the turns by δθ = 2 vec(e* ⊗ δe) / s plus
-/// 2 e times d/ds: dÿ'/ds = ∂ÿ'/∂(gravity's scale) / s (the speeds s ṗ
-/// add nothing: ∂ÿ'/∂ṗ' is zero, a boost changing no force), and S's own
-/// derivative adds ÿ' on ṗ's rows. The columns by ṗ are zero.
-fn free_roots(
+/// The columns left unsolved for the emitted code (`columns`: the
+/// Jacobian's, then each free root's four extra ones, see
+/// [`quaternion_columns`]), with M's factors and the rows to scale after
+/// the solve.
+fn unsolved(
     a: &mut super::super::tree::spatial::Algebra,
     at: &Symbols,
     w: &WorldDerivatives,
-    solved: &mut [Vec<Id>],
+    factor: &super::super::tree::world::MassFactor,
+    columns: &[Vec<Id>],
+    rates: Vec<Id>,
+) -> Result<UnsolvedColumns, SymbolicError> {
+    let l = factor.order().len();
+    let n = at.columns.len();
+    let mut forcing = columns[..n].to_vec();
+    // The quaternion's columns are linear in the extra ones: combined
+    // before the solve, they are solved as any other.
+    let quaternions = quaternion_columns(a, at, w, &mut forcing, &columns[n..])?;
+    let mut rows = Vec::new();
+    for (root, quaternion) in w.roots.iter().zip(&quaternions) {
+        for &i in &root.linear {
+            let mut adds = Vec::with_capacity(quaternion.len());
+            for &(c, doubled) in quaternion {
+                adds.push((c, a.g.mul(doubled, w.accelerations[i])?));
+            }
+            rows.push(ScaledRow {
+                speed: i,
+                scale: root.scale,
+                adds,
+            });
+        }
+    }
+    Ok(UnsolvedColumns {
+        rates,
+        forcing,
+        order: factor.order().to_vec(),
+        lower: (0..l)
+            .map(|i| (0..i).map(|k| factor.lower(i, k)).collect())
+            .collect(),
+        reciprocals: factor.reciprocals().to_vec(),
+        rows,
+    })
+}
+
+/// The quaternion's columns of `columns` (the Jacobian's) from `extra`
+/// (per free root, the columns of its three turns and of its gravity's
+/// scale), solved or not, since the map is linear; per root, each such
+/// column with its 2 eₖ. With s = |e|², the rhs's ÿ is S ÿ' for ÿ' the
+/// nodes' (S: s on ṗ's rows), which move at s ṗ under gravity s g. The
+/// quaternion's columns are the turns by δθ = 2 vec(e* ⊗ δe) / s plus
+/// 2 e times d/ds: dÿ'/ds = ∂ÿ'/∂(gravity's scale) / s (the speeds s ṗ
+/// add nothing: ∂ÿ'/∂ṗ' is zero, a boost changing no force). S's own
+/// part is [`scaled_rows`]'. The columns by ṗ are zero.
+fn quaternion_columns(
+    a: &mut super::super::tree::spatial::Algebra,
+    at: &Symbols,
+    w: &WorldDerivatives,
+    columns: &mut [Vec<Id>],
     extra: &[Vec<Id>],
-    accelerations: &mut [Id],
-) -> Result<(), SymbolicError> {
+) -> Result<Vec<Vec<(usize, Id)>>, SymbolicError> {
     let column = |s: Symbol| at.columns.iter().position(|&c| c == s);
-    let l = accelerations.len();
+    let l = w.accelerations.len();
+    let mut out = Vec::with_capacity(w.roots.len());
     for (root, extra) in w.roots.iter().zip(extra.chunks(4)) {
         // dÿ'/ds.
         let over = a.g.recip(root.scale)?;
@@ -219,20 +318,32 @@ fn free_roots(
             for i in 0..l {
                 let mut terms: Vec<(Id, Id)> = (0..3).map(|m| (weights[m], extra[m][i])).collect();
                 terms.push((doubled, radial[i]));
-                solved[c][i] = a.dot(terms)?;
+                columns[c][i] = a.dot(terms)?;
             }
             quaternion.push((c, doubled));
         }
-        // S on ṗ's rows, and S's derivative on the quaternion's columns.
-        for &i in &root.linear {
-            for column in solved.iter_mut() {
-                column[i] = a.g.mul(root.scale, column[i])?;
-            }
-            for &(c, doubled) in &quaternion {
-                let from_s = a.g.mul(doubled, accelerations[i])?;
-                solved[c][i] = a.g.add(solved[c][i], from_s)?;
-            }
-            accelerations[i] = a.g.mul(root.scale, accelerations[i])?;
+        out.push(quaternion);
+    }
+    Ok(out)
+}
+
+/// S on a free root's ṗ rows of the solved `columns`, and S's derivative
+/// (2 e ÿ', `accelerations` the nodes' ÿ') on the quaternion's columns
+/// (`quaternion`: each with its 2 eₖ).
+fn scaled_rows(
+    a: &mut super::super::tree::spatial::Algebra,
+    root: &super::super::tree::world::FreeRoot,
+    quaternion: &[(usize, Id)],
+    columns: &mut [Vec<Id>],
+    accelerations: &[Id],
+) -> Result<(), SymbolicError> {
+    for &i in &root.linear {
+        for column in columns.iter_mut() {
+            column[i] = a.g.mul(root.scale, column[i])?;
+        }
+        for &(c, doubled) in quaternion {
+            let from_s = a.g.mul(doubled, accelerations[i])?;
+            columns[c][i] = a.g.add(columns[c][i], from_s)?;
         }
     }
     Ok(())

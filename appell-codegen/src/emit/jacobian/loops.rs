@@ -4,13 +4,13 @@
 //! speed, A's columns then B's); then the forward and back substitutions
 //! by the factors, a whole row at a time (`linalg::substitute_row`), in
 //! loops the compiler vectorizes over the columns; then the rows copied
-//! into A and B. Unrolled, a chain's solves grow like l³ expressions; in
-//! loops they are 2l calls.
+//! into A and B (a free root's ṗ rows scaled first). Unrolled, a chain's
+//! solves grow like l³ expressions; in loops they are 2l calls.
 
 use proc_macro2::TokenStream;
 use quote::{format_ident, quote};
 
-use super::super::code::{code, Target};
+use super::super::code::{code, Code, Target};
 use super::super::{int, p, Emitter};
 use super::{Candidate, Layout, Roots};
 use crate::derivation::jacobian::{retained_rates, Jacobians, UnsolvedColumns};
@@ -34,6 +34,8 @@ struct Offsets {
     lower: usize,
     /// 1 / dᵢ in elimination order.
     reciprocals: usize,
+    /// The scaled rows' scales and added terms, row after row.
+    rows: usize,
 }
 
 impl Offsets {
@@ -41,11 +43,13 @@ impl Offsets {
         let rates = values;
         let forcing = rates + retained * width;
         let lower = forcing + l * width;
+        let reciprocals = lower + l * l.saturating_sub(1) / 2;
         Offsets {
             rates,
             forcing,
             lower,
-            reciprocals: lower + l * l.saturating_sub(1) / 2,
+            reciprocals,
+            rows: reciprocals + l,
         }
     }
 
@@ -74,6 +78,10 @@ impl Emitter<'_> {
             all.extend(&u.lower[i][..i]);
         }
         all.extend(&u.reciprocals);
+        for row in &u.rows {
+            all.push(row.scale);
+            all.extend(row.adds.iter().map(|&(_, term)| term));
+        }
         Roots { all, values }
     }
 
@@ -155,16 +163,49 @@ impl Emitter<'_> {
             solve.row(i, &program.outputs[at.reciprocals + i], &terms, true);
         }
         body.extend(solve.body);
+        body.extend(scaled_rows(u, layout, &program, at.rows, padded));
         body.extend(copy_out(layout, l, padded));
         Candidate {
             body,
             ops: program.ops,
             extra: 0,
-            looped: solve.looped,
+            // The free roots' rows scaled, and their added terms.
+            looped: solve.looped + u.rows.iter().map(|r| padded + r.adds.len()).sum::<usize>(),
             // The scratch zeroed and copied out, and the calls.
-            overhead: l * padded + solve.calls * CALL,
+            overhead: l * padded + (solve.calls + u.rows.len()) * CALL,
         }
     }
+}
+
+/// After the solve, a free root's ṗ rows of the scratch scaled and the
+/// quaternion's columns' terms added (`first`: the first scale's root).
+fn scaled_rows(
+    u: &UnsolvedColumns,
+    layout: &Layout,
+    program: &Code,
+    first: usize,
+    padded: usize,
+) -> TokenStream {
+    let p = p();
+    let mut out = TokenStream::new();
+    let mut at = first;
+    for row in &u.rows {
+        let (speed, width) = (int(row.speed), int(padded));
+        let scale = &program.outputs[at];
+        out.extend(quote! {
+            #p::substitute_row(&mut __x, #width, #speed, #scale, &[]);
+        });
+        at += 1;
+        for &(column, _) in &row.adds {
+            let written = layout.columns.iter().position(|&c| c == column);
+            if let (Some(w), false) = (written, program.zero[at]) {
+                let (k, term) = (int(row.speed * padded + w), &program.outputs[at]);
+                out.extend(quote!(__x[#k] = __x[#k] + #term;));
+            }
+            at += 1;
+        }
+    }
+    out
 }
 
 /// The scratch's rows (a row per speed) into ÿ's rows of `__a` and `__b`.

@@ -301,8 +301,7 @@ impl Emitter<'_> {
                     Kind::World => self.structured_candidate(c.roots, &layout),
                     Kind::WorldLoops => {
                         let world = j.world.as_ref().expect("a world-frame candidate");
-                        let unsolved = world.unsolved.as_ref().expect("its columns unsolved");
-                        self.loop_candidate(c.roots, &layout, unsolved)
+                        self.loop_candidate(c.roots, &layout, &world.unsolved)
                     }
                 };
                 (c.kind, candidate)
@@ -397,28 +396,29 @@ impl Emitter<'_> {
             });
         }
         if let (Ok(w), Ok(form)) = (&j.world, &self.d.structured) {
-            let roots = self.rows_roots(&w.accelerations, &w.derivatives, layout, j);
             // Against the rhs's values (q̇ and the articulated-body ÿ), not
             // its own ÿ by M's factors: the limit bounds the code's growth.
             let mut rhs = retained_rates(self.d);
             rhs.extend(&form.accelerations);
-            let (total, values) = (size(&roots.all), size(&rhs));
-            out.push(Sized {
-                kind: Kind::World,
-                roots,
-                total,
-                values,
-            });
-            if let Some(u) = &w.unsolved {
-                let roots = self.loop_roots(u, layout, j);
+            let values = size(&rhs);
+            if let Some(derivatives) = &w.derivatives {
+                let roots = self.rows_roots(&w.accelerations, derivatives, layout, j);
                 let total = size(&roots.all);
                 out.push(Sized {
-                    kind: Kind::WorldLoops,
+                    kind: Kind::World,
                     roots,
                     total,
                     values,
                 });
             }
+            let roots = self.loop_roots(&w.unsolved, layout, j);
+            let total = size(&roots.all);
+            out.push(Sized {
+                kind: Kind::WorldLoops,
+                roots,
+                total,
+                values,
+            });
         }
         out
     }
