@@ -256,7 +256,8 @@ fn trees_agree_with_dual_numbers_and_differences() {
             "{form}"
         );
     }
-    // The chain's columns are solved in loops.
+    // The chain's and the two legs' columns are solved in loops (the
+    // latter on a free root).
     for info in [SpatialChain8Derived::info(), TwoLegs::info()] {
         let form = info.jacobian.unwrap().form;
         assert!(form.contains("in loops over the columns"), "{form}");

@@ -24,8 +24,10 @@ pub struct OpCounts {
 pub struct JacobianInfo {
     /// What is differentiated: `closed form: ...` (∂M and ∂f, and
     /// ∂ÿ = M⁻¹ (∂f − ∂M ÿ) with M factored once), `structured: ...`
-    /// (the unrolled articulated-body algorithm differentiated), with the
-    /// operation counts the derive compared, or `dual numbers: ...` (the
+    /// (the unrolled articulated-body algorithm differentiated), `inverse
+    /// dynamics ...` (recursive Newton–Euler's derivatives, some with the
+    /// columns solved "in loops over the columns"), with the operation
+    /// counts of the candidates the derive compared, or `dual numbers: ...` (the
     /// rhs evaluated in dual numbers, so many directions a pass, and why
     /// not symbolically).
     pub form: &'static str,

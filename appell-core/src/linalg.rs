@@ -459,8 +459,8 @@ pub const ROW_CHUNK: usize = 8;
 ///
 /// # Panics
 ///
-/// If a row is not within `m`: the generated calls name rows of a buffer
-/// whose length they have checked.
+/// If a row is not within `m`: the generated calls name rows of their
+/// own scratch array, sized for them.
 #[inline]
 pub fn substitute_row<T: Scalar>(
     m: &mut [T],
@@ -488,7 +488,7 @@ pub fn substitute_row<T: Scalar>(
         c += ROW_CHUNK;
     }
     // The last columns, fewer than a chunk (none where the caller pads
-    // its rows to a multiple of 8, as the generated code does).
+    // its rows to a multiple of ROW_CHUNK, as the generated code does).
     for col in c..width {
         let mut acc = m[start + col] * scale;
         for &(k, l) in terms {
@@ -538,7 +538,7 @@ mod tests {
                 for i in 0..3 {
                     let got = x[i * width + c];
                     assert!(
-                        (got - y[i]).abs() < 1e-15,
+                        (got - y[i]).abs() < 1e-14 * (1.0 + y[i].abs()),
                         "width {width}, column {c}: {got} against {}",
                         y[i]
                     );

@@ -2,9 +2,9 @@
 //! state x = (retained q, ẏ) and the inputs w, for the generated
 //! `rhs_jacobian`.
 //!
-//! Four candidates, each a set of expressions in the model's graph; the
-//! emitter lowers those within its size limits and keeps the one with the
-//! fewest operations per call:
+//! Four candidates, each a set of expressions in the model's graph (the
+//! world frame's in two forms); the emitter lowers those within its size
+//! limits and keeps the one of the lowest estimated cost per call:
 //!
 //! - **closed**: ∂f/∂x, ∂f/∂w, ∂M/∂x (lower triangle) and ∂q̇_r/∂x. At run
 //!   time ÿ = M⁻¹ f, then ∂ÿ/∂x_j = M⁻¹ (∂f/∂x_j − (∂M/∂x_j) ÿ), with M
@@ -28,7 +28,9 @@
 //!   derivatives of inverse dynamics built directly in the world frame
 //!   (Carpentier and Mansard's algorithm unrolled, [`super::tree::world`]),
 //!   ÿ solved from M = Jᵀ Yᶜ J by its factors in the graph, and each
-//!   column ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) there too: one program.
+//!   column ∂ÿ/∂c = M⁻¹ (∂τ/∂c − ∂Q/∂c) there too (one program), or each
+//!   column's right side ∂τ/∂c − ∂Q/∂c left with M's factors for the
+//!   emitted code to solve in loops over the columns.
 //!
 //! Each derivative is [`Graph::diff`](appell_symbolic::Graph::diff), which
 //! visits only the subexpressions that depend on the symbol: a joint's
@@ -148,8 +150,9 @@ pub struct WorldJacobian {
     /// [`FreeRoot`](super::tree::world::FreeRoot)).
     pub accelerations: Vec<Id>,
     /// Rows: the retained coordinates' rates, then ÿ; row-major over the
-    /// columns; `None` where solving every column in the graph would pass
-    /// the candidate's budget.
+    /// columns; `None` where the columns' solves in the graph could not be
+    /// built within what their right sides left of the candidate's budget
+    /// (the loops over [`unsolved`](Self::unsolved) stand alone then).
     pub derivatives: Option<Vec<Id>>,
     /// The same columns before their solves, for the emitter to solve in
     /// loops over the columns.

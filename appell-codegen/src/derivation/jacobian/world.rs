@@ -1,7 +1,8 @@
-//! The world frame's candidate ([`super::super::tree::world`]): ÿ and the
-//! reduced rhs's columns solved by M's factors in the graph, a free root's
-//! columns mapped back to its quaternion and slides; and the world frame's
-//! derivatives of inverse dynamics.
+//! The world frame's candidate ([`super::super::tree::world`]): ÿ solved
+//! by M's factors in the graph, the reduced rhs's columns' right sides left
+//! for the emitter's loops and solved by the same factors in the graph too,
+//! a free root's columns mapped back to its quaternion and slides; and the
+//! world frame's derivatives of inverse dynamics.
 
 use appell_symbolic::{Id, Symbol, SymbolicError};
 
@@ -88,10 +89,8 @@ struct RightSides {
     accelerations: Vec<Id>,
     /// What the emitter's loops solve.
     unsolved: UnsolvedColumns,
-    /// The symbols the columns are by: the model's coordinates, and the
-    /// Jacobian's columns.
-    coordinates: Vec<Symbol>,
-    symbols: Vec<Symbol>,
+    /// The symbols the columns are by.
+    at: Symbols,
 }
 
 /// The right sides ∂τ/∂c − ∂Q/∂c of every column from the world frame's
@@ -144,11 +143,9 @@ fn right_sides(
         let column = root.gravity.iter().map(|&x| g.neg(x));
         sides.push(column.collect::<Result<_, _>>()?);
     }
-    let symbols: Vec<Symbol> = columns.all().collect();
-    let coordinates: Vec<Symbol> = model.coords.iter().map(|c| c.1.q).collect();
     let at = Symbols {
-        coordinates: &coordinates,
-        columns: &symbols,
+        coordinates: model.coords.iter().map(|c| c.1.q).collect(),
+        columns: columns.all().collect(),
     };
     let mut a = super::super::tree::spatial::Algebra::new(g)?;
     let unsolved = unsolved(&mut a, &at, w, factor, &sides, derivatives)?;
@@ -162,26 +159,22 @@ fn right_sides(
         columns: sides,
         accelerations,
         unsolved,
-        coordinates,
-        symbols,
+        at,
     })
 }
 
 /// The reduced rhs's rows over the columns, each column of `sides` solved
 /// by M's factors in the graph after the retained coordinates' rates'
 /// derivatives; a free root's columns and rows mapped back to e and ṗ
-/// ([`quaternion_columns`], [`scaled_rows`]).
+/// ([`quaternion_columns`], then its rows scaled as
+/// [`UnsolvedColumns::rows`] says).
 fn solved_in_graph(
     model: &mut Model,
     w: &WorldDerivatives,
     sides: &RightSides,
 ) -> Result<Vec<Id>, SymbolicError> {
     let factor = w.factor.as_ref().expect("factors with the right sides");
-    let (l, n) = (w.accelerations.len(), sides.symbols.len());
-    let at = Symbols {
-        coordinates: &sides.coordinates,
-        columns: &sides.symbols,
-    };
+    let (l, n) = (w.accelerations.len(), sides.at.columns.len());
     let mut a = super::super::tree::spatial::Algebra::new(&mut model.g)?;
     let mut solved = sides.columns.clone();
     if factor.is_dense() {
@@ -203,9 +196,14 @@ fn solved_in_graph(
         }
     }
     let extra = solved.split_off(n);
-    let quaternions = quaternion_columns(&mut a, &at, w, &mut solved, &extra)?;
-    for (root, quaternion) in w.roots.iter().zip(&quaternions) {
-        scaled_rows(&mut a, root, quaternion, &mut solved, &w.accelerations)?;
+    quaternion_columns(&mut a, &sides.at, w, &mut solved, &extra)?;
+    for row in &sides.unsolved.rows {
+        for column in solved.iter_mut() {
+            column[row.speed] = a.g.mul(row.scale, column[row.speed])?;
+        }
+        for &(c, term) in &row.adds {
+            solved[c][row.speed] = a.g.add(solved[c][row.speed], term)?;
+        }
     }
     let mut derivatives = sides.unsolved.rates.clone();
     for k in 0..l {
@@ -215,9 +213,11 @@ fn solved_in_graph(
 }
 
 /// The symbols a free root's columns are found by.
-struct Symbols<'a> {
-    coordinates: &'a [Symbol],
-    columns: &'a [Symbol],
+struct Symbols {
+    /// The model's coordinates.
+    coordinates: Vec<Symbol>,
+    /// The Jacobian's columns.
+    columns: Vec<Symbol>,
 }
 
 /// The columns left unsolved for the emitted code (`columns`: the
@@ -272,7 +272,7 @@ fn unsolved(
 /// quaternion's columns are the turns by δθ = 2 vec(e* ⊗ δe) / s plus
 /// 2 e times d/ds: dÿ'/ds = ∂ÿ'/∂(gravity's scale) / s (the speeds s ṗ
 /// add nothing: ∂ÿ'/∂ṗ' is zero, a boost changing no force). S's own
-/// part is [`scaled_rows`]'. The columns by ṗ are zero.
+/// part, after the solve, is [`ScaledRow`]'s. The columns by ṗ are zero.
 fn quaternion_columns(
     a: &mut super::super::tree::spatial::Algebra,
     at: &Symbols,
@@ -325,28 +325,6 @@ fn quaternion_columns(
         out.push(quaternion);
     }
     Ok(out)
-}
-
-/// S on a free root's ṗ rows of the solved `columns`, and S's derivative
-/// (2 e ÿ', `accelerations` the nodes' ÿ') on the quaternion's columns
-/// (`quaternion`: each with its 2 eₖ).
-fn scaled_rows(
-    a: &mut super::super::tree::spatial::Algebra,
-    root: &super::super::tree::world::FreeRoot,
-    quaternion: &[(usize, Id)],
-    columns: &mut [Vec<Id>],
-    accelerations: &[Id],
-) -> Result<(), SymbolicError> {
-    for &i in &root.linear {
-        for column in columns.iter_mut() {
-            column[i] = a.g.mul(root.scale, column[i])?;
-        }
-        for &(c, doubled) in quaternion {
-            let from_s = a.g.mul(doubled, accelerations[i])?;
-            columns[c][i] = a.g.add(columns[c][i], from_s)?;
-        }
-    }
-    Ok(())
 }
 
 /// [`inverse_dynamics`]' partials by the world frame's derivatives, at the

@@ -13,7 +13,7 @@ use quote::{format_ident, quote};
 use super::super::code::{code, Code, Target};
 use super::super::{int, p, Emitter};
 use super::{Candidate, Layout, Roots};
-use crate::derivation::jacobian::{retained_rates, Jacobians, UnsolvedColumns};
+use crate::derivation::jacobian::{retained_rates, Jacobians, UnsolvedColumns, WorldJacobian};
 use appell_core::linalg::ROW_CHUNK;
 
 /// SIMD lanes the loops are assumed to fill when candidates are compared:
@@ -61,10 +61,15 @@ impl Offsets {
 
 impl Emitter<'_> {
     /// The loop candidate's roots: q̇ and ÿ, then (see [`Offsets`]) the
-    /// rates' rows, the right sides, L and the reciprocals.
-    pub(super) fn loop_roots(&self, u: &UnsolvedColumns, layout: &Layout, j: &Jacobians) -> Roots {
-        let (n, l) = (j.columns.len(), self.d.l);
-        let world = j.world.as_ref().expect("a world-frame candidate");
+    /// rates' rows, the right sides, L, the reciprocals and the scaled
+    /// rows' scales and terms.
+    pub(super) fn loop_roots(
+        &self,
+        world: &WorldJacobian,
+        layout: &Layout,
+        j: &Jacobians,
+    ) -> Roots {
+        let (n, l, u) = (j.columns.len(), self.d.l, &world.unsolved);
         let mut all = retained_rates(self.d);
         all.extend(&world.accelerations);
         let values = all.len();
@@ -94,9 +99,9 @@ impl Emitter<'_> {
         &self,
         roots: Roots,
         layout: &Layout,
-        u: &UnsolvedColumns,
+        world: &WorldJacobian,
     ) -> Candidate {
-        let p = p();
+        let (p, u) = (p(), &world.unsolved);
         let (l, width) = (self.d.l, layout.columns.len());
         let padded = width.div_ceil(ROW_CHUNK) * ROW_CHUNK;
         let at = Offsets::new(roots.values, layout.retained, l, width);
@@ -148,19 +153,18 @@ impl Emitter<'_> {
             }
         }
         // Forward: z_i = b_i − Σ_{k<i} L_ik z_k.
-        let one = quote!(<__T as #p::Scalar>::one());
         for i in 0..l {
             let terms: Vec<_> = (0..i)
                 .filter_map(|k| names[i][k].clone().map(|n| (k, n)))
                 .collect();
-            solve.row(i, &one, &terms, false);
+            solve.row(i, None, &terms);
         }
         // Back: y_i = z_i / d_i − Σ_{k>i} L_ki y_k.
         for i in (0..l).rev() {
             let terms: Vec<_> = (i + 1..l)
                 .filter_map(|k| names[k][i].clone().map(|n| (k, n)))
                 .collect();
-            solve.row(i, &program.outputs[at.reciprocals + i], &terms, true);
+            solve.row(i, Some(&program.outputs[at.reciprocals + i]), &terms);
         }
         body.extend(solve.body);
         body.extend(scaled_rows(u, layout, &program, at.rows, padded));
@@ -172,7 +176,7 @@ impl Emitter<'_> {
             // The free roots' rows scaled, and their added terms.
             looped: solve.looped + u.rows.iter().map(|r| padded + r.adds.len()).sum::<usize>(),
             // The scratch zeroed and copied out, and the calls.
-            overhead: l * padded + (solve.calls + u.rows.len()) * CALL,
+            overhead: l * (padded + width) + (solve.calls + u.rows.len()) * CALL,
         }
     }
 }
@@ -241,14 +245,17 @@ struct Solve<'a> {
 }
 
 impl Solve<'_> {
-    /// Row i (a position) as `scale` times itself less Σ L times row k
-    /// over `terms` (positions and the factor's entries); nothing where
-    /// it would leave the row as it is.
-    fn row(&mut self, i: usize, scale: &TokenStream, terms: &[(usize, TokenStream)], scaled: bool) {
-        if terms.is_empty() && !scaled {
+    /// Row i (a position) as `scale` (or one) times itself less Σ L times
+    /// row k over `terms` (positions and the factor's entries); nothing
+    /// where it would leave the row as it is.
+    fn row(&mut self, i: usize, scale: Option<&TokenStream>, terms: &[(usize, TokenStream)]) {
+        if terms.is_empty() && scale.is_none() {
             return;
         }
         let p = p();
+        let one = quote!(<__T as #p::Scalar>::one());
+        let scaled = scale.is_some();
+        let scale = scale.unwrap_or(&one);
         let row = int(self.order[i]);
         let pairs = terms.iter().map(|(k, l)| {
             let rk = int(self.order[*k]);
@@ -279,5 +286,6 @@ mod tests {
         assert_eq!(at.lower(2, 0), 19);
         assert_eq!(at.lower(2, 1), 20);
         assert_eq!(at.reciprocals, 21);
+        assert_eq!(at.rows, 24);
     }
 }

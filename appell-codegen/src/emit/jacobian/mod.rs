@@ -1,20 +1,24 @@
 //! `rhs_jacobian`: the reduced rhs and its Jacobians A = ∂rhs/∂state and
 //! B = ∂rhs/∂inputs in one call, from stage 14's derivatives.
 //!
-//! Of five candidates the cheapest is written: the closed form (one
+//! Of six candidates the cheapest is written: the closed form (one
 //! program for M, f, q̇ and their derivatives; M factored once by LDLᵀ; ÿ,
 //! then each column ∂ÿ/∂c = M⁻¹ (∂f/∂c − (∂M/∂c) ÿ) by the same factors,
 //! [`closed`]), the structured form (one program for the articulated-body
 //! algorithm's ÿ and its derivatives), inverse dynamics (a tree's recursive
 //! Newton–Euler differentiated at the articulated-body ÿ, each column
 //! −M⁻¹ ∂R, [`recursive`]), the world frame (one program: its derivatives
-//! of inverse dynamics, ÿ and every column solved by M's factors), or dual
+//! of inverse dynamics, ÿ and every column solved by M's factors), the
+//! world frame with its columns solved in loops over the columns
+//! ([`loops`]), or dual
 //! numbers (the model's own rhs evaluated
 //! in W-wide dual numbers, ⌈columns / W⌉ times, by the runtime's
 //! `rhs_jacobian_by_duals`: no code of its own). A symbolic one is written
 //! only within a size limit against the rhs's expressions (dual numbers
 //! cost about 1 + 2W expressions per rhs expression and pass); of those
-//! left, the one with the fewest operations once lowered. Parameter-only
+//! left, the one of the lowest estimated cost once lowered: its
+//! operations, those in loops counted [`loops::LANES`] to one, and the
+//! loops' calls and copies. Parameter-only
 //! work is not hoisted: the function needs no `Prepared`.
 
 mod closed;
@@ -127,6 +131,16 @@ impl Candidate {
         self.ops.total() + self.extra + self.looped.div_ceil(loops::LANES) + self.overhead
     }
 
+    /// Its operations, and those in loops, where it is compared with the
+    /// chosen one.
+    fn describe_total(&self) -> String {
+        if self.looped == 0 {
+            self.total().to_string()
+        } else {
+            format!("{} ({} in loops)", self.total(), self.looped)
+        }
+    }
+
     /// How `info().jacobian.form` counts it.
     fn describe_ops(&self) -> String {
         if self.looped == 0 {
@@ -223,8 +237,8 @@ impl Emitter<'_> {
     /// `rhs_jacobian` and its info: of the symbolic candidates with at
     /// most [`SIZE_LIMIT`] times the expressions of the rhs values they
     /// compute and fewer than the dual passes' estimate (any size with
-    /// `jacobian(on)`), the one with the fewest operations per call once
-    /// lowered; where none is left, or stage 14 has no candidate, the rhs
+    /// `jacobian(on)`), the one of the lowest estimated cost per call once
+    /// lowered ([`Candidate::cost`]); where none is left, or stage 14 has no candidate, the rhs
     /// in dual numbers; nothing with `jacobian(off)`.
     /// `articulated`: whether the rhs written is the articulated-body
     /// algorithm's (else the closed form's).
@@ -286,8 +300,8 @@ impl Emitter<'_> {
                 ));
             }
         }
-        // Each one left lowered; the fewest operations per call wins, a tie
-        // going to the earlier kind.
+        // Each one left lowered; the lowest estimated cost wins, a tie going
+        // to the earlier kind.
         let mut lowered: Vec<(Kind, Candidate)> = sized
             .into_iter()
             .map(|c| {
@@ -301,7 +315,7 @@ impl Emitter<'_> {
                     Kind::World => self.structured_candidate(c.roots, &layout),
                     Kind::WorldLoops => {
                         let world = j.world.as_ref().expect("a world-frame candidate");
-                        self.loop_candidate(c.roots, &layout, &world.unsolved)
+                        self.loop_candidate(c.roots, &layout, world)
                     }
                 };
                 (c.kind, candidate)
@@ -312,7 +326,7 @@ impl Emitter<'_> {
         let what = kind.describe();
         let against = lowered
             .iter()
-            .map(|(k, c)| format!("{} {}", k.name(), c.total()))
+            .map(|(k, c)| format!("{} {}", k.name(), c.describe_total()))
             .collect::<Vec<_>>();
         let against = if against.is_empty() {
             String::new()
@@ -411,7 +425,7 @@ impl Emitter<'_> {
                     values,
                 });
             }
-            let roots = self.loop_roots(&w.unsolved, layout, j);
+            let roots = self.loop_roots(w, layout, j);
             let total = size(&roots.all);
             out.push(Sized {
                 kind: Kind::WorldLoops,

@@ -47,7 +47,7 @@
 //!
 //! Forward-dynamics derivatives (fixed bases): where the model has a
 //! generated Jacobian (`info().jacobian`), or a twin with `jacobian(on)` in
-//! `jacobian.rs` (the Panda, the 8-link chain), [`jacobians`] times
+//! `jacobian.rs` (the Panda, the 8- to 64-link chains, Solo12), [`jacobians`] times
 //! `rhs_jacobian` (the generated rhs, A = ∂rhs/∂state and B = ∂rhs/∂inputs
 //! in one call) and `rhs_jacobian_dual` (the same three outputs by one
 //! `Dual64` evaluation of the rhs per state and input column, what
@@ -909,10 +909,22 @@ fn main() -> ExitCode {
             &jacobian::SpatialChain8Jacobian,
             &opts,
         ),
-        "spatial_chain_16" => bench(&spatial_chain::SpatialChain16, &opts),
-        "spatial_chain_32" => bench(&spatial_chain::SpatialChain32, &opts),
+        "spatial_chain_16" => with_twin(
+            &spatial_chain::SpatialChain16,
+            &jacobian::SpatialChain16Jacobian,
+            &opts,
+        ),
+        "spatial_chain_32" => with_twin(
+            &spatial_chain::SpatialChain32,
+            &jacobian::SpatialChain32Jacobian,
+            &opts,
+        ),
         #[cfg(feature = "large-models")]
-        "spatial_chain_64" => bench(&spatial_chain::SpatialChain64, &opts),
+        "spatial_chain_64" => with_twin(
+            &spatial_chain::SpatialChain64,
+            &jacobian::SpatialChain64Jacobian,
+            &opts,
+        ),
         "solo12" => with_twin(&floating::Solo12, &jacobian::Solo12Jacobian, &opts),
         "anymal_b" => bench(&floating::AnymalB, &opts),
         "go1" => bench(&floating::Go1, &opts),
