@@ -196,10 +196,47 @@ pub struct ModelInfo {
     pub equations: &'static str,
 }
 
+/// The name of one entry of the reduced state ([`ModelInfo::state_names`]):
+/// a retained coordinate, or a privileged speed. Displayed as the
+/// coordinate's name, or the speed's with `_dot` (the rate the state
+/// holds), the names the command line and the Python package print.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum StateName {
+    /// A retained coordinate q_r.
+    Coordinate(&'static str),
+    /// A privileged speed ẏ_k.
+    Speed(&'static str),
+}
+
+impl core::fmt::Display for StateName {
+    fn fmt(&self, f: &mut core::fmt::Formatter<'_>) -> core::fmt::Result {
+        match self {
+            StateName::Coordinate(name) => f.write_str(name),
+            StateName::Speed(name) => write!(f, "{name}_dot"),
+        }
+    }
+}
+
 impl ModelInfo {
     /// Length of the reduced state.
     pub fn state_len(&self) -> usize {
         self.retained.len() + self.speeds.len()
+    }
+
+    /// The reduced state's entries in order: the retained coordinates,
+    /// then the speeds.
+    ///
+    /// ```
+    /// use appell_core::__doc_model::Pendulum;
+    /// use appell_core::{Model, StateName};
+    /// let info = Pendulum::info();
+    /// let names: Vec<String> = info.state_names().map(|n| n.to_string()).collect();
+    /// assert_eq!(names, ["theta", "theta_dot"]);
+    /// assert_eq!(info.state_names().nth(1), Some(StateName::Speed("theta")));
+    /// ```
+    pub fn state_names(&self) -> impl Iterator<Item = StateName> + '_ {
+        let coordinates = self.retained.iter().map(|&r| StateName::Coordinate(r));
+        coordinates.chain(self.speeds.iter().map(|&s| StateName::Speed(s)))
     }
 
     /// Whether the scene asked for an output (`outputs(...)`), by name.

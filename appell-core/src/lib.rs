@@ -40,6 +40,8 @@ pub mod precision;
 mod scalar;
 
 pub use error::{check_len, ContactEvent, ContactViolation, ModelError};
-pub use info::{BodyInfo, ContactInfo, JacobianInfo, JointLimit, ModelInfo, OpCounts, RowSource};
+pub use info::{
+    BodyInfo, ContactInfo, JacobianInfo, JointLimit, ModelInfo, OpCounts, RowSource, StateName,
+};
 pub use model::{Model, SceneVisitor};
 pub use scalar::Scalar;

@@ -53,7 +53,7 @@ pub mod switch;
 
 pub use appell_core::{
     check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, JacobianInfo, JointLimit,
-    Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar, SceneVisitor,
+    Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar, SceneVisitor, StateName,
 };
 
 #[cfg(feature = "std")]

@@ -64,12 +64,7 @@ pub(super) fn info_json_dyn(model: &dyn DynModel) -> Result<Value, ModelError> {
         .zip(&values)
         .map(|(name, value)| json!({ "name": name, "value": finite_or_null(*value) }))
         .collect();
-    let state: Vec<String> = info
-        .retained
-        .iter()
-        .map(|r| r.to_string())
-        .chain(info.speeds.iter().map(|s| format!("{s}_dot")))
-        .collect();
+    let state: Vec<String> = info.state_names().map(|n| n.to_string()).collect();
     let bodies: Vec<Value> = info
         .bodies
         .iter()

@@ -149,12 +149,7 @@ fn info_dict<'py>(py: Python<'py>, info: &ModelInfo) -> PyResult<Bound<'py, PyDi
     d.set_item("cyclic", names(py, info.cyclic)?)?;
     d.set_item("ignorable", names(py, info.ignorable)?)?;
     d.set_item("retained", names(py, info.retained)?)?;
-    let state: Vec<String> = info
-        .retained
-        .iter()
-        .map(|r| r.to_string())
-        .chain(info.speeds.iter().map(|s| format!("{s}_dot")))
-        .collect();
+    let state: Vec<String> = info.state_names().map(|n| n.to_string()).collect();
     d.set_item("state", state)?;
     d.set_item("state_len", info.state_len())?;
     d.set_item("inputs", names(py, info.inputs)?)?;
