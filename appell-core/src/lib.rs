@@ -31,6 +31,8 @@
 #[path = "doc_model.rs"]
 pub mod __doc_model;
 pub mod dual;
+#[cfg(feature = "std")]
+pub mod dynamic;
 mod error;
 mod info;
 pub mod linalg;
@@ -45,3 +47,6 @@ pub use info::{
 };
 pub use model::{Model, SceneVisitor};
 pub use scalar::Scalar;
+
+#[cfg(feature = "std")]
+pub use dynamic::{DynModel, DynRhs};

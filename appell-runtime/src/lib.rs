@@ -32,8 +32,6 @@ pub mod constraint_forces;
 #[cfg(feature = "std")]
 pub mod contact_watch;
 #[cfg(feature = "std")]
-pub mod dynamic;
-#[cfg(feature = "std")]
 pub mod energy;
 #[cfg(feature = "std")]
 pub mod hybrid;
@@ -56,6 +54,8 @@ pub use appell_core::{
     Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar, SceneVisitor, StateName,
 };
 
+#[cfg(feature = "std")]
+pub use appell_core::dynamic;
 #[cfg(feature = "std")]
 pub use dynamic::{DynModel, DynRhs};
 

@@ -5,6 +5,7 @@ mod coefficients;
 mod control;
 mod dense;
 mod driver;
+mod jacobian;
 mod newton;
 mod settings;
 mod shared;
@@ -14,6 +15,7 @@ mod stats;
 
 pub(super) use control::{all_finite, wrms};
 pub(super) use dense::{Dense, EventG};
+pub(super) use jacobian::dual_jacobian;
 pub use settings::TrBdf2;
 pub(super) use shared::{
     check_problem, end_of_step, event_value, initial_outputs, initial_step, next_step,

@@ -2,10 +2,11 @@
 //! its Jacobian or for a [`Model`] (Jacobian by dual numbers).
 
 use super::dense::EventG;
+use super::dual_jacobian;
 use super::settings::TrBdf2;
 use super::shared::ProjectG;
 use super::stats::TrBdf2Solution;
-use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
+use crate::dynamic::{DynRhs, Prepared};
 use crate::integrate::solution::{IntegrateError, ProjectionFailed};
 use crate::integrate::watch::watched_slices;
 use crate::{check_len, Model, ModelError};

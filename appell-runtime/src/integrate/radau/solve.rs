@@ -4,8 +4,8 @@
 use super::control::REUSE_DUAL;
 use super::settings::Radau5;
 use super::stats::Radau5Solution;
-use crate::dynamic::{dual_jacobian, DynRhs, Prepared};
-use crate::integrate::implicit::{EventG, ProjectG};
+use crate::dynamic::{DynRhs, Prepared};
+use crate::integrate::implicit::{dual_jacobian, EventG, ProjectG};
 use crate::integrate::solution::{IntegrateError, ProjectionFailed};
 use crate::integrate::watch::watched_slices;
 use crate::{check_len, Model, ModelError};

@@ -1,7 +1,7 @@
 //! [`DynModel`]: a [`Model`] behind an object-safe interface, in `f64` and
 //! the dual numbers the oracle needs, so that tools written against it (the
 //! command line, the oracle, the contact forces, the accuracy sweep) are
-//! compiled once in this crate instead of once per model.
+//! compiled once instead of once per model.
 //!
 //! [`Model`]'s methods are generic over the [`Scalar`](crate::Scalar), which
 //! keeps a `Model` out of a trait object and makes every generic function
@@ -33,8 +33,8 @@ mod sealed {
 /// change under it.
 ///
 /// ```
-/// use appell_runtime::DynModel;
-/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// use appell_core::DynModel;
+/// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Oscillator { w: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
@@ -53,8 +53,8 @@ mod sealed {
 /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
 /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
 /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-/// #         appell_runtime::check_len("state", s, 2)?;
-/// #         appell_runtime::check_len("dstate", ds, 2)?;
+/// #         appell_core::check_len("state", s, 2)?;
+/// #         appell_core::check_len("dstate", ds, 2)?;
 /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
 /// #     }
 /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
@@ -68,16 +68,15 @@ mod sealed {
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::integrate::rk4_step_fn;
-/// use appell_runtime::num_dual::Dual64;
+/// use num_dual::Dual64;
 ///
-/// // x'' = −w² x as a trait object, integrated by a closure over it.
+/// // x'' = −w² x as a trait object: ẋ₂ = −w² x₁.
 /// let model: &dyn DynModel = &Oscillator { w: 2.0 };
 /// let rhs = model.dyn_prepare();
 /// assert_eq!(rhs.state_len(), 2);
-/// let mut f = |t: f64, x: &[f64; 2], dx: &mut [f64; 2]| rhs.rhs(t, x, &[], dx);
-/// let x = rk4_step_fn(&mut f, 0.0, 1e-3, &[1.0, 0.0]).unwrap();
-/// assert!((x[0] - 2e-3f64.cos()).abs() < 1e-12);
+/// let mut dx = [0.0; 2];
+/// rhs.rhs(0.0, &[1.0, 0.5], &[], &mut dx).unwrap();
+/// assert_eq!(dx, [0.5, -4.0]);
 ///
 /// // ∂ẋ₂/∂x₁ = −w² by a dual number.
 /// let mut d = [Dual64::from(0.0); 2];
@@ -130,8 +129,21 @@ pub trait DynRhs {
     fn rhs_pass(&self, t: f64, cases: &[(&[f64], &[f64])], dstate: &mut [f64]);
 }
 
-/// A model and its prepared values: the [`DynRhs`] of every [`Model`].
-pub(crate) struct Prepared<'a, M: Model> {
+/// A model and its prepared values: the [`DynRhs`] of every [`Model`], for
+/// tools that keep the model's type (what [`DynModel::dyn_prepare`] boxes).
+///
+/// ```
+/// use appell_core::__doc_model::Pendulum;
+/// use appell_core::dynamic::{DynRhs, Prepared};
+///
+/// // θ̈ = −(g/l) sin θ + τ at θ = 0, θ̇ = 1, τ = 0.5.
+/// let model = Pendulum { g_over_l: 9.81 };
+/// let rhs = Prepared::new(&model);
+/// let mut dx = [0.0; 2];
+/// rhs.rhs(0.0, &[0.0, 1.0], &[0.5], &mut dx).unwrap();
+/// assert_eq!(dx, [1.0, 0.5]);
+/// ```
+pub struct Prepared<'a, M: Model> {
     model: &'a M,
     real: M::Prepared<f64>,
     dual: M::Prepared<Dual64>,
@@ -139,7 +151,7 @@ pub(crate) struct Prepared<'a, M: Model> {
 
 impl<'a, M: Model> Prepared<'a, M> {
     /// Prepares `model` in `f64` and [`Dual64`].
-    pub(crate) fn new(model: &'a M) -> Self {
+    pub fn new(model: &'a M) -> Self {
         Prepared {
             model,
             real: model.prepare::<f64>(),
@@ -207,44 +219,6 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
     }
 }
 
-/// The Jacobian `∂f/∂x` of `rhs` (row-major n×n into its last argument)
-/// at `(t, x)` with `inputs` held constant: the model's generated
-/// [`Model::rhs_jacobian`] where it has one and `by_duals` is false, else
-/// exactly by forward-mode dual numbers, one [`DynRhs::rhs_dual`] per state
-/// component. What the implicit integrators use for a model.
-pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
-    rhs: &'a R,
-    inputs: &[f64],
-    by_duals: bool,
-) -> impl FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError> + 'a {
-    let n = rhs.state_len();
-    let inputs_d: Vec<Dual64> = inputs.iter().map(|&v| Dual64::from_re(v)).collect();
-    let mut xd = vec![Dual64::from_re(0.0); n];
-    let mut outd = vec![Dual64::from_re(0.0); n];
-    // The generated Jacobian's other outputs, allocated once.
-    let real_inputs = inputs.to_vec();
-    let (mut values, mut b) = (vec![0.0; n], vec![0.0; n * inputs.len()]);
-    move |t: f64, x: &[f64], j: &mut [f64]| {
-        if !by_duals && rhs.generated_jacobian(t, x, &real_inputs, &mut values, j, &mut b)? {
-            return Ok(());
-        }
-        let td = Dual64::from_re(t);
-        for (d, &v) in xd.iter_mut().zip(x) {
-            *d = Dual64::from_re(v);
-        }
-        for col in 0..n {
-            xd[col].eps = 1.0;
-            let r = rhs.rhs_dual(td, &xd, &inputs_d, &mut outd);
-            xd[col].eps = 0.0;
-            r?;
-            for (row, o) in outd.iter().enumerate() {
-                j[row * n + col] = o.eps;
-            }
-        }
-        Ok(())
-    }
-}
-
 /// The object-safe face of a [`Model`]: its metadata, parameters, reduced
 /// equations and kinematic description in `f64`, and the few methods the
 /// oracle evaluates in dual numbers ([`Dual64`], [`Dual2_64`]). Each method
@@ -253,12 +227,11 @@ pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
 ///
 /// Implemented for every [`Model`] (and only for them); a `&M` coerces to
 /// `&dyn DynModel`, so one function over `&dyn DynModel` serves every model
-/// and is compiled once. The command line ([`crate::cli`]) is written this
-/// way.
+/// and is compiled once. The command line is written this way.
 ///
 /// ```
-/// use appell_runtime::DynModel;
-/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// use appell_core::DynModel;
+/// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Oscillator { w: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
@@ -277,8 +250,8 @@ pub(crate) fn dual_jacobian<'a, R: DynRhs + ?Sized>(
 /// #     fn set_parameter(&mut self, name: &str, v: f64) -> bool { if name == "w" { self.w = v; true } else { false } }
 /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
 /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-/// #         appell_runtime::check_len("state", s, 2)?;
-/// #         appell_runtime::check_len("dstate", ds, 2)?;
+/// #         appell_core::check_len("state", s, 2)?;
+/// #         appell_core::check_len("dstate", ds, 2)?;
 /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
 /// #     }
 /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
