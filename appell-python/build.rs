@@ -17,6 +17,7 @@ const CRATES: &[&str] = &[
     "appell-trig",
     "appell-symbolic",
     "appell-core",
+    "appell-dynamics",
     "appell-runtime",
     "appell-codegen",
     "appell-derive",

@@ -4,15 +4,15 @@
 use super::error::OracleError;
 use super::kkt::{accelerations_with, lu_solve_checked};
 use super::layout::{finite_all, Layout};
-use crate::dynamic::DynModel;
-use crate::{check_len, Model};
+use appell_core::dynamic::DynModel;
+use appell_core::{check_len, Model};
 use nalgebra::{DMatrix, DVector};
 
 // Items the documentation links to.
 #[cfg(doc)]
 use super::accelerations;
 #[cfg(doc)]
-use crate::ModelInfo;
+use appell_core::ModelInfo;
 
 /// All coordinate rates q̇ from the privileged speeds `u` (one per
 /// [`ModelInfo::speeds`], in that order): the privileged rates are `u` and
@@ -128,7 +128,9 @@ pub fn reduced_rhs<M: Model>(
 }
 
 /// [`reduced_rhs`] of any [`DynModel`] (compiled once for `dyn DynModel`).
-pub(crate) fn reduced_rhs_dyn<K: DynModel + ?Sized>(
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub fn reduced_rhs_dyn<K: DynModel + ?Sized>(
     model: &K,
     t: f64,
     q_full: &[f64],

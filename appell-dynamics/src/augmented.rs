@@ -30,8 +30,8 @@
 //! # Example
 //!
 //! ```
-//! use appell_runtime::augmented::{Settings, integrate};
-//! # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+//! use appell_dynamics::augmented::{Settings, integrate};
+//! # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 //! # // A particle on the unit circle in (x, y) coordinates, with gravity:
 //! # // the holonomic constraint x² + y² − 1 = 0.
 //! # struct Ring { g: f64 }
@@ -91,8 +91,8 @@
 use nalgebra::{DMatrix, DVector};
 
 use crate::oracle::{full_dynamics, FullDynamics, OracleError};
-use crate::Model;
-use crate::ModelError;
+use appell_core::Model;
+use appell_core::ModelError;
 
 /// Settings of the augmented Lagrangian formulation.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -166,8 +166,8 @@ fn cholesky(a: DMatrix<f64>) -> Result<nalgebra::Cholesky<f64, nalgebra::Dyn>, O
 /// (some motion carries no mass).
 ///
 /// ```
-/// use appell_runtime::augmented::{accelerations, Settings};
-/// # use appell_runtime::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// use appell_dynamics::augmented::{accelerations, Settings};
+/// # use appell_core::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # // A particle on the unit circle in (x, y) coordinates, with gravity:
 /// # // the holonomic constraint x² + y² − 1 = 0.
 /// # struct Ring { g: f64 }
@@ -257,8 +257,8 @@ pub fn accelerations<M: Model>(
 /// [`ModelError::NonFinite`] when a correction is not finite.
 ///
 /// ```
-/// use appell_runtime::augmented::{project, Settings};
-/// # use appell_runtime::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// use appell_dynamics::augmented::{project, Settings};
+/// # use appell_core::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # // A particle on the unit circle in (x, y) coordinates, with gravity:
 /// # // the holonomic constraint x² + y² − 1 = 0.
 /// # struct Ring { g: f64 }

@@ -23,8 +23,8 @@
 //! the same on both sides of the switch.
 //!
 //! ```
-//! # use appell_runtime::{check_len, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar};
-//! # use appell_runtime::switch::switch_state;
+//! # use appell_core::{check_len, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar};
+//! # use appell_dynamics::switch::switch_state;
 //! # // A particle in the plane, free (speeds x, y) or on a rail y = 0.
 //! # macro_rules! particle {
 //! #     ($name:ident, $speeds:expr, $rows:expr, $sources:expr) => {
@@ -89,8 +89,8 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::dynamic::DynModel;
-use crate::{ModelError, ModelInfo};
+use appell_core::dynamic::DynModel;
+use appell_core::{ModelError, ModelInfo};
 
 /// Relative size below which the target's constraint residual counts as
 /// satisfied (no impulse), and below which a singular value of G M⁻¹ Gᵀ

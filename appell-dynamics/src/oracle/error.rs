@@ -1,10 +1,10 @@
 //! [`OracleError`]: why the oracle could not produce accelerations.
 
-use crate::ModelError;
+use appell_core::ModelError;
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::ModelInfo;
+use appell_core::ModelInfo;
 
 /// Why the oracle could not produce accelerations.
 #[derive(Clone, Debug, PartialEq)]

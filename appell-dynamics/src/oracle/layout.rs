@@ -3,9 +3,9 @@
 //! checks.
 
 use super::error::OracleError;
-use crate::dynamic::DynModel;
-use crate::Scalar;
-use crate::{ModelError, ModelInfo};
+use appell_core::dynamic::DynModel;
+use appell_core::Scalar;
+use appell_core::{ModelError, ModelInfo};
 use num_dual::Dual64;
 
 /// Coordinate index sets derived from a validated [`ModelInfo`].

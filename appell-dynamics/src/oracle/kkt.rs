@@ -4,8 +4,8 @@
 use super::assembly::{full_dynamics_with, FullDynamics};
 use super::error::OracleError;
 use super::layout::{finite_all, Layout};
-use crate::dynamic::DynModel;
-use crate::Model;
+use appell_core::dynamic::DynModel;
+use appell_core::Model;
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
 
@@ -13,7 +13,7 @@ use num_dual::Dual64;
 #[cfg(doc)]
 use super::full_dynamics;
 #[cfg(doc)]
-use crate::ModelInfo;
+use appell_core::ModelInfo;
 
 /// Relative size (in units of `dim · ε · scale`) below which an LU pivot
 /// counts as zero: a little above the rounding noise of the elimination.

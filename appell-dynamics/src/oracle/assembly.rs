@@ -5,9 +5,9 @@
 use super::error::OracleError;
 use super::layout::{finite_all, Geometry, Layout};
 use super::vec3::{cross, dot, map3, mat_vec, mul, mul_bt, vee};
-use crate::dynamic::DynModel;
-use crate::Scalar;
-use crate::{check_len, Model, ModelInfo};
+use appell_core::dynamic::DynModel;
+use appell_core::Scalar;
+use appell_core::{check_len, Model, ModelInfo};
 use num_dual::{Dual2_64, Dual64};
 
 /// The assembled full-coordinate equations at one state (see the module
@@ -307,7 +307,7 @@ fn generalized_forces(
 /// them (driven coordinates): an input `x` whose companion `x_rate` is an
 /// input too moves at it, and `x_rate` at `x_accel` when that is one;
 /// every other input is held (rate 0).
-fn input_duals(info: &crate::ModelInfo, inputs: &[f64]) -> Vec<Dual64> {
+fn input_duals(info: &appell_core::ModelInfo, inputs: &[f64]) -> Vec<Dual64> {
     let index = |name: &str| info.inputs.iter().position(|i| *i == name);
     info.inputs
         .iter()

@@ -10,15 +10,15 @@
 //! plane normal to N.z.
 
 use super::{norm, Friction};
-use crate::dynamic::DynModel;
 use crate::oracle::{finite_all as finite, OracleError};
-use crate::RowSource;
+use appell_core::dynamic::DynModel;
+use appell_core::RowSource;
 
 /// The ground's reaction on one foot held by the model or scene (see
 /// [`ConstraintForces::feet`](super::ConstraintForces::feet)).
 #[derive(Clone, Debug, PartialEq)]
 pub struct FootForce {
-    /// Index into [`Model::contact_links`](crate::Model::contact_links).
+    /// Index into [`Model::contact_links`](appell_core::Model::contact_links).
     pub contact: usize,
     /// The foot's link.
     pub link: &'static str,
@@ -38,7 +38,7 @@ impl FootForce {
     /// [`Friction::LiftOff`] when the ground does not push (F_z ≤ 0).
     ///
     /// ```
-    /// use appell_runtime::constraint_forces::{FootForce, Friction};
+    /// use appell_dynamics::constraint_forces::{FootForce, Friction};
     /// let foot = FootForce {
     ///     contact: 0,
     ///     link: "FL_FOOT",
@@ -60,7 +60,7 @@ impl FootForce {
     /// not tip over its edge.
     ///
     /// ```
-    /// use appell_runtime::constraint_forces::FootForce;
+    /// use appell_dynamics::constraint_forces::FootForce;
     /// // 100 N pushing straight up at (0.05, 0, 0), an ankle 0.1 above it
     /// // at (0, 0, 0.1): the moment about the ankle is (0, -5, 0).
     /// let foot = FootForce {

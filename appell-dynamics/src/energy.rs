@@ -17,9 +17,9 @@
 //! [`contact_forces`](crate::constraint_forces::contact_forces) output)
 //! times its coordinate's rate, which [`Model::input_power`] leaves out.
 
-use crate::dynamic::DynModel;
 use crate::motion::{first_rates, seeded_inputs};
-use crate::{Model, ModelError};
+use appell_core::dynamic::DynModel;
+use appell_core::{Model, ModelError};
 use num_dual::Dual64;
 
 /// The energies at one state, from [`energies`].
@@ -44,7 +44,7 @@ pub struct Energies {
 /// singular configuration, say).
 ///
 /// ```
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Drop { m: f64, g: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Drop", parameters: &["m", "g"], coordinates: &["z"], speeds: &["z"],
@@ -89,7 +89,7 @@ pub struct Energies {
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::energy::energies;
+/// use appell_dynamics::energy::energies;
 ///
 /// // A mass of 2 kg at height 3 m, rising at 1.5 m/s, pushed up with 5 N.
 /// let e = energies(&Drop { m: 2.0, g: 9.81 }, 0.0, &[3.0], &[1.5], &[5.0]).unwrap();
@@ -109,7 +109,9 @@ pub fn energies<M: Model>(
 }
 
 /// [`energies`] of any [`DynModel`] (compiled once for `dyn DynModel`).
-pub(crate) fn energies_dyn<K: DynModel + ?Sized>(
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub fn energies_dyn<K: DynModel + ?Sized>(
     model: &K,
     t: f64,
     q: &[f64],

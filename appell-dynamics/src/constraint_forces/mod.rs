@@ -54,14 +54,14 @@
 //! plane (the rolling disc past lean ±π/2) the normal turns over without
 //! an error. Contacts are one-sided in the world; that is checked outside
 //! the equations, from these forces: by the contact watch every
-//! integration of a model with contacts runs
-//! ([`crate::contact_watch`]), and in a hybrid run by the lift-off guard
-//! ([`crate::hybrid::Guard::lift_off`]).
+//! integration of a model with contacts runs (the integrators' module
+//! `contact_watch`), and in a hybrid run by the lift-off guard (the hybrid
+//! driver's `Guard::lift_off`).
 
-use crate::dynamic::DynModel;
 use crate::oracle::{self, finite_all as finite, mul, mul_bt, vee, OracleError};
-use crate::Scalar;
-use crate::{Model, ModelInfo, RowSource};
+use appell_core::dynamic::DynModel;
+use appell_core::Scalar;
+use appell_core::{Model, ModelInfo, RowSource};
 use nalgebra::{DMatrix, DVector};
 use num_dual::{Dual2_64, Dual64};
 
@@ -265,7 +265,9 @@ fn mat_vec(a: &[f64; 9], v: [f64; 3]) -> [f64; 3] {
 }
 /// Mass-centre acceleration, angular velocity and angular acceleration of
 /// every body along the motion (q̇, q̈), by second-order dual numbers.
-pub(crate) struct BodyMotion {
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub struct BodyMotion {
     /// Mass-centre positions.
     pub position: Vec<[f64; 3]>,
     /// Rotation matrices (row-major, columns the body axes in N).
@@ -353,7 +355,9 @@ pub fn contact_forces<M: Model>(
 }
 
 /// [`contact_forces`] of any [`DynModel`] (compiled once for `dyn DynModel`).
-pub(crate) fn contact_forces_dyn<K: DynModel + ?Sized>(
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub fn contact_forces_dyn<K: DynModel + ?Sized>(
     model: &K,
     t: f64,
     q: &[f64],
@@ -375,7 +379,7 @@ type RollingContact = (ContactForce, Option<[f64; 3]>, Option<f64>);
 fn rolling_contact(
     info: &ModelInfo,
     c: usize,
-    ci: &crate::ContactInfo,
+    ci: &appell_core::ContactInfo,
     points: &[[f64; 3]],
     directions: &[[f64; 3]],
     multipliers: &[f64],
@@ -464,7 +468,9 @@ fn rolling_contact(
 
 /// What [`contact_forces_parts`] found on the way: the motion, and each
 /// contact's normal direction where the declaration gives one.
-pub(crate) struct ContactParts {
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub struct ContactParts {
     /// q̇.
     pub qdot: Vec<f64>,
     /// The bodies' motion at the oracle's q̈.
@@ -486,7 +492,9 @@ pub(crate) struct ContactParts {
 /// [`contact_forces_dyn`], with the momentum balances for the normals the
 /// coordinates carry only when `balance` (a caller that has other
 /// unknown forces balances them all together).
-pub(crate) fn contact_forces_parts<K: DynModel + ?Sized>(
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub fn contact_forces_parts<K: DynModel + ?Sized>(
     model: &K,
     t: f64,
     q: &[f64],
@@ -770,7 +778,9 @@ fn balance_normals<K: DynModel + ?Sized>(
 /// Σ m a − Σ F (linear) and Σ (r × m a + I α + ω × I ω) − Σ (r × F + L)
 /// (angular), the applied loads and the `known` external forces (point,
 /// force) on the right; zero when those forces are all there is.
-pub(crate) struct MomentumResidual {
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub struct MomentumResidual {
     /// Linear, then angular, N components.
     pub residual: [f64; 6],
     /// The largest term that went into it, for relative tolerances.
@@ -781,7 +791,9 @@ pub(crate) struct MomentumResidual {
 // both callers (balance_normals here, sliding's balance_at) pass the q̇ and motion
 // contact_forces_parts already computed, so nothing is solved twice
 #[allow(clippy::too_many_arguments)]
-pub(crate) fn momentum_residual<K: DynModel + ?Sized>(
+// Shared with the integrators and the tools; not part of the API.
+#[doc(hidden)]
+pub fn momentum_residual<K: DynModel + ?Sized>(
     model: &K,
     t: f64,
     q: &[f64],

@@ -27,7 +27,7 @@
 //! the scalar.
 //!
 //! ```
-//! use appell_runtime::pinocchio::PinocchioMap;
+//! use appell_dynamics::pinocchio::PinocchioMap;
 //!
 //! // A free base named `root_joint` carrying one joint `hip`, as a model's
 //! // `info()` lists them.
@@ -58,8 +58,8 @@ use std::fmt;
 use std::string::String;
 use std::vec::Vec;
 
-use crate::check_len;
-use crate::{ModelError, Scalar};
+use appell_core::check_len;
+use appell_core::{ModelError, Scalar};
 
 /// Why a map cannot be made from a model's names.
 #[derive(Clone, Debug, PartialEq, Eq)]

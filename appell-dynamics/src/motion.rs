@@ -9,16 +9,16 @@
 //! ṫ = 1, q̇, u̇ and, for the commands of driven coordinates, their
 //! companion inputs (`x` changes at `x_rate`, `x_rate` at `x_accel`).
 
-use crate::dynamic::DynModel;
-use crate::{check_len, Model, ModelError, ModelInfo};
+use appell_core::dynamic::DynModel;
+use appell_core::{check_len, Model, ModelError, ModelInfo};
 use num_dual::Dual64;
 
 /// The rates of the motion at one state, from [`rates`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rates {
-    /// q̇ of every coordinate, in [`crate::ModelInfo::coordinates`] order.
+    /// q̇ of every coordinate, in [`appell_core::ModelInfo::coordinates`] order.
     pub qdot: Vec<f64>,
-    /// u̇ of the privileged speeds, in [`crate::ModelInfo::speeds`] order.
+    /// u̇ of the privileged speeds, in [`appell_core::ModelInfo::speeds`] order.
     pub udot: Vec<f64>,
     /// q̈ of every coordinate, the dependent ones included.
     pub qddot: Vec<f64>,
@@ -32,7 +32,7 @@ pub struct Rates {
 /// singular configuration, say).
 ///
 /// ```
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Drop { m: f64, g: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Drop", parameters: &["m", "g"], coordinates: &["z"], speeds: &["z"],
@@ -77,7 +77,7 @@ pub struct Rates {
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::motion::rates;
+/// use appell_dynamics::motion::rates;
 ///
 /// // A mass of 2 kg rising at 1.5 m/s, pushed up with 5 N.
 /// let r = rates(&Drop { m: 2.0, g: 9.81 }, 0.0, &[3.0], &[1.5], &[5.0]).unwrap();

@@ -46,8 +46,8 @@
 //! written by hand here:
 //!
 //! ```
-//! use appell_runtime::oracle::{accelerations, coordinate_rates, full_dynamics, reduced_rhs};
-//! use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+//! use appell_dynamics::oracle::{accelerations, coordinate_rates, full_dynamics, reduced_rhs};
+//! use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 //! # struct Pendulum { m: f64, l: f64, g: f64 }
 //! # static INFO: ModelInfo = ModelInfo {
 //! #     name: "Pendulum", parameters: &["m", "l", "g"], coordinates: &["theta"],
@@ -126,7 +126,7 @@
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::{Model, ModelInfo};
+use appell_core::{Model, ModelInfo};
 #[cfg(doc)]
 use num_dual::{Dual2_64, Dual64};
 
@@ -142,6 +142,8 @@ pub use error::OracleError;
 pub(crate) use kkt::accelerations_dyn;
 pub use kkt::{accelerations, OracleSolution};
 pub(crate) use layout::finite_all;
+pub(crate) use rates::driven_coordinate_rates_dyn;
+#[doc(hidden)]
+pub use rates::reduced_rhs_dyn;
 pub use rates::{coordinate_rates, reduced_rhs};
-pub(crate) use rates::{driven_coordinate_rates_dyn, reduced_rhs_dyn};
 pub(crate) use vec3::{mul, mul_bt, vee};
