@@ -18,6 +18,7 @@ const CRATES: &[&str] = &[
     "appell-symbolic",
     "appell-core",
     "appell-dynamics",
+    "appell-integrate",
     "appell-runtime",
     "appell-codegen",
     "appell-derive",
