@@ -19,6 +19,7 @@ const CRATES: &[&str] = &[
     "appell-core",
     "appell-dynamics",
     "appell-integrate",
+    "appell-linearize",
     "appell-runtime",
     "appell-codegen",
     "appell-derive",

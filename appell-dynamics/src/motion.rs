@@ -13,6 +13,22 @@ use appell_core::dynamic::DynModel;
 use appell_core::{check_len, Model, ModelError, ModelInfo};
 use num_dual::Dual64;
 
+/// One instant of a motion: the time and every coordinate, what the
+/// pictures of `animate` draw and a hybrid run samples.
+///
+/// ```
+/// use appell_dynamics::motion::Frame;
+/// let f = Frame { t: 0.5, q: vec![0.1, -0.2] };
+/// assert_eq!(f.q.len(), 2);
+/// ```
+#[derive(Clone, Debug, PartialEq)]
+pub struct Frame {
+    /// The time.
+    pub t: f64,
+    /// Every coordinate, in [`ModelInfo::coordinates`] order.
+    pub q: Vec<f64>,
+}
+
 /// The rates of the motion at one state, from [`rates`].
 #[derive(Clone, Debug, PartialEq)]
 pub struct Rates {

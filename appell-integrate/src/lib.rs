@@ -3,7 +3,9 @@
 //! Integration of the reduced equations: fixed-step and adaptive explicit
 //! methods without `std` and without allocation, and implicit methods for
 //! stiff models (with `std`), which also watch a model's one-sided
-//! contacts along the way ([`contact_watch`]).
+//! contacts along the way ([`contact_watch`]); and, with `std`, a watch
+//! over how near singular the dependent block of the constraints comes
+//! ([`conditioning`]).
 //!
 //! The classical fourth-order Runge–Kutta method on fixed-size arrays, generic
 //! over the [`Scalar`] so a trajectory can be integrated in `f32`, `f64` or
@@ -34,6 +36,8 @@
 
 use appell_core::{Model, ModelError, Scalar};
 
+#[cfg(feature = "std")]
+pub mod conditioning;
 #[cfg(feature = "std")]
 pub mod contact_watch;
 mod dop853;

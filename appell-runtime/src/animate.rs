@@ -70,16 +70,7 @@ pub use plot::{line_plot, Curve};
 use crate::contact_watch::ContactWatch;
 use crate::dynamic::{DynModel, DynRhs};
 use crate::{check_len, ModelError};
-
-/// One instant of a motion: the time and every coordinate.
-#[derive(Clone, Debug, PartialEq)]
-pub struct Frame {
-    /// The time.
-    pub t: f64,
-    /// Every coordinate, in [`ModelInfo::coordinates`](crate::ModelInfo)
-    /// order.
-    pub q: Vec<f64>,
-}
+pub use appell_dynamics::motion::Frame;
 
 /// The largest step [`simulate`] takes.
 pub const MAX_STEP: f64 = 1e-3;

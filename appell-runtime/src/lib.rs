@@ -26,14 +26,12 @@ pub mod animate;
 #[cfg(feature = "std")]
 pub mod cli;
 #[cfg(feature = "std")]
-pub mod conditioning;
-#[cfg(feature = "std")]
 pub mod hybrid;
 pub use appell_integrate as integrate;
 #[cfg(feature = "std")]
-pub use appell_integrate::contact_watch;
+pub use appell_integrate::{conditioning, contact_watch};
 #[cfg(feature = "std")]
-pub mod linearize;
+pub use appell_linearize as linearize;
 #[cfg(feature = "std")]
 pub mod sliding;
 

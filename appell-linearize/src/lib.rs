@@ -1,3 +1,5 @@
+//! # appell-linearize
+//!
 //! Linearization of a model's reduced equations, exactly, by dual numbers
 //! through the generic generated code: no symbolic Jacobian, no finite
 //! differences.
@@ -30,10 +32,10 @@
 //! 2×2 system in (x, ẋ):
 //!
 //! ```
-//! use appell_runtime::linearize::{
+//! use appell_linearize::{
 //!     eigenvalues, holonomic_unknowns, linearize, minimal_linearization, solve_holonomic,
 //! };
-//! # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+//! # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 //! # struct Ring { m: f64, l: f64, g: f64 }
 //! # static INFO: ModelInfo = ModelInfo {
 //! #     name: "Ring", parameters: &["m", "l", "g"], coordinates: &["x", "y"],
@@ -125,21 +127,28 @@
 //! The columns are therefore Dual64 (the measurements are in
 //! `docs/log.md`; `tests/linearize.rs` repeats the comparison on
 //! hand-written models in the ignored test `dual64_vs_dualsvec64_timing`).
+#![warn(missing_docs)]
+
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::Model;
+use appell_core::Model;
 #[cfg(doc)]
 use num_dual::Dual64;
 
 mod checks;
-pub(crate) mod discrete;
+// Shared with the command line; not part of the API.
+#[doc(hidden)]
+pub mod discrete;
 mod eigen;
 mod error;
 mod holonomic;
-pub(crate) mod jacobian;
+// Shared with the command line; not part of the API.
+#[doc(hidden)]
+pub mod jacobian;
 mod minimal;
-#[cfg(feature = "std")]
-pub(crate) mod newton_dyn;
+// Shared with the command line; not part of the API.
+#[doc(hidden)]
+pub mod newton_dyn;
 
 pub use discrete::{fixed_step, step_jacobian, FixedStep, StepLinearization};
 pub use eigen::eigenvalues;

@@ -1,12 +1,12 @@
 //! [`LinearizeError`]: why a linearization or a holonomic solve failed.
 
-use crate::ModelError;
+use appell_core::ModelError;
 
 // Items the documentation links to.
 #[cfg(doc)]
 use super::{check_holonomic, eigenvalues, minimal_linearization};
 #[cfg(doc)]
-use crate::ModelInfo;
+use appell_core::ModelInfo;
 
 /// Why a linearization, an eigenvalue computation or a constraint solve
 /// failed.
@@ -158,14 +158,14 @@ impl std::error::Error for LinearizeError {
 /// `|t, x| project_holonomic(&model, t, x, 1e-14, 20).map(|_| ()).map_err(Into::into)`.
 ///
 /// ```
-/// use appell_runtime::integrate::ProjectionFailed;
-/// use appell_runtime::linearize::LinearizeError;
+/// use appell_integrate::ProjectionFailed;
+/// use appell_linearize::LinearizeError;
 ///
 /// let e = LinearizeError::NotConverged { iterations: 20, residual: 1e-3 };
 /// let failed = ProjectionFailed::from(e);
 /// assert_eq!(failed.reason, "Newton's method did not bring the holonomic residuals below the tolerance");
 /// ```
-impl From<LinearizeError> for crate::integrate::ProjectionFailed {
+impl From<LinearizeError> for appell_integrate::ProjectionFailed {
     fn from(e: LinearizeError) -> Self {
         let reason = match e {
             LinearizeError::NotConverged { .. } => {
@@ -181,6 +181,6 @@ impl From<LinearizeError> for crate::integrate::ProjectionFailed {
             LinearizeError::NonFinite { .. } => "the projection met a non-finite value",
             _ => "the projection's arguments are invalid (state length, tolerance)",
         };
-        crate::integrate::ProjectionFailed { reason }
+        appell_integrate::ProjectionFailed { reason }
     }
 }

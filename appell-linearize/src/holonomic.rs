@@ -4,14 +4,14 @@
 
 use super::checks::{check_configuration, finite, indices};
 use super::error::LinearizeError;
-use crate::Scalar;
-use crate::{check_len, Model, ModelError};
+use appell_core::Scalar;
+use appell_core::{check_len, Model, ModelError};
 use nalgebra::{DMatrix, DVector};
 use num_dual::Dual64;
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::ModelInfo;
+use appell_core::ModelInfo;
 
 /// Singular values below this fraction of the largest entry of the full
 /// holonomic Jacobian count as zero.
@@ -314,7 +314,7 @@ fn unknowns_at<M: Model>(
 /// unchanged).
 ///
 /// ```
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Ring { l: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Ring", parameters: &["l"], coordinates: &["x", "y"],
@@ -351,7 +351,7 @@ fn unknowns_at<M: Model>(
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::linearize::project_holonomic;
+/// use appell_linearize::project_holonomic;
 ///
 /// // A particle on a circle of radius 1 in Cartesian coordinates, state
 /// // (x, y, ẋ), drifted off the circle.
@@ -379,7 +379,7 @@ pub fn project_holonomic<M: Model>(
 /// wrong length or not finite.
 ///
 /// ```
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar};
 /// # struct Servo;
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Servo", parameters: &[], coordinates: &["theta", "x"],
@@ -417,7 +417,7 @@ pub fn project_holonomic<M: Model>(
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::linearize::{driven_check_holonomic, driven_project_holonomic, project_holonomic};
+/// use appell_linearize::{driven_check_holonomic, driven_project_holonomic, project_holonomic};
 ///
 /// // A joint position-controlled to q_cmd = 0.5, state (theta, x, ẋ)
 /// // drifted off the command.
@@ -492,7 +492,7 @@ fn project_at<M: Model>(
 /// for. Errors also for wrong lengths and non-finite values.
 ///
 /// ```
-/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Ring { l: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Ring", parameters: &["l"], coordinates: &["x", "y"], speeds: &["x"],
@@ -524,7 +524,7 @@ fn project_at<M: Model>(
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::linearize::{check_holonomic, LinearizeError};
+/// use appell_linearize::{check_holonomic, LinearizeError};
 /// // A particle on a circle of radius 1, state (x, y, ẋ).
 /// assert!(check_holonomic(&Ring { l: 1.0 }, 0.0, &[0.6, -0.8, 0.3], 1e-12).is_ok());
 /// assert!(matches!(

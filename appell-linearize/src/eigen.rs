@@ -12,7 +12,7 @@ use nalgebra::DMatrix;
 /// Schur iteration does not converge (within `100 n` iterations).
 ///
 /// ```
-/// use appell_runtime::linearize::eigenvalues;
+/// use appell_linearize::eigenvalues;
 /// use nalgebra::DMatrix;
 ///
 /// // The undamped oscillator ẍ = −4 x: ±2i.

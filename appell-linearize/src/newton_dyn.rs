@@ -1,15 +1,15 @@
 //! Newton onto the holonomic constraints of a [`DynModel`]: the coordinates
 //! the constraints fix (a bicycle's pitch) solved from the others. The
-//! generic [`crate::linearize::solve_holonomic`] needs a [`Model`](crate::Model)
+//! generic [`crate::solve_holonomic`] needs a [`Model`](appell_core::Model)
 //! (it seeds dual numbers); this works on the object-safe model the command
 //! line holds, with the Jacobian read from the holonomic rows of D.
 
-use crate::dynamic::DynModel;
-use crate::{ModelError, ModelInfo, RowSource};
+use appell_core::dynamic::DynModel;
+use appell_core::{ModelError, ModelInfo, RowSource};
 use nalgebra::{DMatrix, DVector};
 
 /// Converged when every holonomic residual is at most this × (1 + max |q|).
-pub(crate) const TOLERANCE: f64 = 1e-12;
+pub const TOLERANCE: f64 = 1e-12;
 
 /// Newton steps before giving up.
 const MAX_ITERATIONS: usize = 50;
@@ -22,7 +22,7 @@ const RANK_RTOL: f64 = 1e-10;
 
 /// Why the coordinates could not be solved.
 #[derive(Debug)]
-pub(crate) enum OntoError {
+pub enum OntoError {
     /// The model failed (a singular configuration, wrong lengths, ..).
     Model(ModelError),
     /// No step brought the residuals under the tolerance.
@@ -77,7 +77,7 @@ fn holonomic_rows(info: &ModelInfo) -> Vec<usize> {
 }
 
 /// The holonomic residuals at `q` (zero coordinate rates).
-pub(crate) fn residuals(
+pub fn residuals(
     model: &dyn DynModel,
     t: f64,
     q: &[f64],
@@ -118,7 +118,7 @@ fn amax(x: &[f64]) -> f64 {
 /// holonomic constraints involve at `q`, and which constraints involve
 /// them: the columns and rows of the constraints' Jacobian, restricted to
 /// the candidates, that are not zero. Both ascending.
-pub(crate) fn involved(
+pub fn involved(
     model: &dyn DynModel,
     t: f64,
     q: &[f64],
@@ -149,7 +149,7 @@ pub(crate) fn involved(
 /// at most [`TOLERANCE`] × (1 + max |q|). Returns the largest of them left.
 /// The other constraints are not looked at: they do not involve the
 /// unknowns, and may be violated by the coordinates held.
-pub(crate) fn solve(
+pub fn solve(
     model: &dyn DynModel,
     t: f64,
     q: &mut [f64],

@@ -6,14 +6,14 @@ use super::checks::{check_configuration, finite, indices};
 use super::error::LinearizeError;
 use super::holonomic::{jacobian_at, svd, RANK_RTOL};
 use super::jacobian::{linearize, Linearization};
-use crate::{check_len, Model};
+use appell_core::{check_len, Model};
 use nalgebra::DMatrix;
 
 // Items the documentation links to.
 #[cfg(doc)]
 use super::solve_holonomic;
 #[cfg(doc)]
-use crate::ModelInfo;
+use appell_core::ModelInfo;
 
 /// What remains of the constraint derivatives on the independent coordinates
 /// after the elimination must be below this fraction of the Jacobian's scale.

@@ -1,7 +1,7 @@
 //! Argument checks shared by the linearizations and the holonomic solves.
 
 use super::error::LinearizeError;
-use crate::{check_len, ModelError, ModelInfo};
+use appell_core::{check_len, ModelError, ModelInfo};
 
 pub(super) fn finite(xs: &[f64], what: &'static str) -> Result<(), ModelError> {
     if xs.iter().all(|x| x.is_finite()) {

@@ -2,8 +2,8 @@
 //! [`Dual64`] evaluation per column.
 
 use super::checks::finite;
-use crate::ModelError;
-use crate::{check_len, Model, ModelInfo};
+use appell_core::ModelError;
+use appell_core::{check_len, Model, ModelInfo};
 use nalgebra::DMatrix;
 use num_dual::Dual64;
 
@@ -30,7 +30,7 @@ pub struct Linearization {
 
 /// The names of the reduced state: the retained coordinates, then the
 /// privileged speeds suffixed `_dot`.
-pub(crate) fn state_names(info: &ModelInfo) -> Vec<String> {
+pub fn state_names(info: &ModelInfo) -> Vec<String> {
     info.retained
         .iter()
         .map(|r| r.to_string())
@@ -82,8 +82,8 @@ pub fn linearize<M: Model>(
 /// without one. Errors as [`linearize`]'s.
 ///
 /// ```
-/// use appell_runtime::linearize::{dual_linearize, linearize};
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// use appell_linearize::{dual_linearize, linearize};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Oscillator { w: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"],
@@ -187,7 +187,7 @@ fn linearization(info: &ModelInfo, a: DMatrix<f64>, b: DMatrix<f64>) -> Lineariz
 /// evaluation when there is none, so that its error is still reported).
 /// The Jacobians of the rhs, of a step and of the command line's answers.
 #[allow(clippy::type_complexity)] // (values, A, B)
-pub(crate) fn dual_columns<E>(
+pub fn dual_columns<E>(
     state: &[f64],
     inputs: &[f64],
     mut f: impl FnMut(&[Dual64], &[Dual64]) -> Result<Vec<Dual64>, E>,

@@ -11,8 +11,8 @@
 //! a warning each time it passes a threshold, or stops the integration.
 //!
 //! ```
-//! use appell_runtime::conditioning::ConditionWatch;
-//! # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+//! use appell_integrate::conditioning::ConditionWatch;
+//! # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
 //! # struct Free;
 //! # static INFO: ModelInfo = ModelInfo {
 //! #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
@@ -39,7 +39,7 @@
 //! #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
 //! #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
 //! # }
-//! use appell_runtime::integrate::Dop853;
+//! use appell_integrate::Dop853;
 //!
 //! // A model without constraints has nothing to warn about.
 //! let model = Free;
@@ -53,9 +53,9 @@
 
 use nalgebra::DMatrix;
 
-use crate::dynamic::DynModel;
-use crate::integrate::ProjectionFailed;
-use crate::{check_len, ModelError};
+use crate::ProjectionFailed;
+use appell_core::dynamic::DynModel;
+use appell_core::{check_len, ModelError};
 
 /// The threshold [`ConditionWatch::new`] is usually given: κ(D′) = 1e8
 /// leaves about 8 of f64's 16 digits in the dependent rates.
@@ -65,12 +65,12 @@ pub const DEFAULT_THRESHOLD: f64 = 1e8;
 /// block of the constraint rows at `(t, q)` (every coordinate), by a
 /// singular value decomposition: 1 for a model without constraints,
 /// infinity where D′ is singular. The block is D's columns of the
-/// coordinates [`ModelInfo::dependent`](crate::ModelInfo::dependent)
+/// coordinates [`ModelInfo::dependent`](appell_core::ModelInfo::dependent)
 /// names, so a model whose speeds are quasi-velocities is measured in its
 /// coordinates' rates.
 ///
 /// Errors: a wrong length of `q`, a non-finite entry of D′, and any error
-/// of [`Model::constraint_rows`](crate::Model::constraint_rows).
+/// of [`Model::constraint_rows`](appell_core::Model::constraint_rows).
 pub fn dependent_block_condition<K: DynModel + ?Sized>(
     model: &K,
     t: f64,
@@ -135,7 +135,7 @@ fn dependent_block<K: DynModel + ?Sized>(
 /// passage: it must fall below again before the next); with
 /// [`ConditionWatch::stop_past_threshold`] the integration stops there
 /// instead, with
-/// [`IntegrateError::Projection`](crate::integrate::IntegrateError) saying
+/// [`IntegrateError::Projection`](crate::IntegrateError) saying
 /// why. Only accepted steps are checked, and an adaptive integrator's
 /// steps can jump across the narrow region around a dead centre where κ
 /// is large (the four-bar's κ ≈ 3.6/|θ|: above 1e3 only within 3.6e-3 rad
@@ -189,7 +189,7 @@ impl<'m, K: DynModel + ?Sized> ConditionWatch<'m, K> {
     /// `tests/hard_cases` the estimate is between a quarter and a half of
     /// κ(D′) (it is not κ, so a threshold may need adjusting).
     ///
-    /// [`Model::dependent_block_margin`]: crate::Model::dependent_block_margin
+    /// [`Model::dependent_block_margin`]: appell_core::Model::dependent_block_margin
     pub fn from_pivots(mut self) -> Self {
         self.pivots = true;
         self

@@ -16,14 +16,14 @@ use num_dual::Dual64;
 
 use super::checks::finite;
 use super::jacobian::{dual_columns, state_names};
-use crate::Scalar;
-use crate::{check_len, Model, ModelError};
+use appell_core::Scalar;
+use appell_core::{check_len, Model, ModelError};
 
 /// A fixed-step method of a controller loop.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum FixedStep {
     /// The classical fourth-order Runge–Kutta step, the inputs held over
-    /// it: the same arithmetic as [`rk4_step`](crate::integrate::rk4_step).
+    /// it: the same arithmetic as [`rk4_step`](appell_integrate::rk4_step).
     Rk4,
     /// Semi-implicit (symplectic) Euler: the speeds first, u⁺ = u + h u̇(t,
     /// q, u), then the retained coordinates at the new speeds, q⁺ = q + h
@@ -41,8 +41,8 @@ pub enum FixedStep {
 /// "state" }` when x⁺ is not finite.
 ///
 /// ```
-/// use appell_runtime::linearize::{fixed_step, FixedStep};
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// use appell_linearize::{fixed_step, FixedStep};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Pendulum { g: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Pendulum", parameters: &["g"], coordinates: &["theta"],
@@ -106,7 +106,7 @@ pub fn fixed_step<M: Model, T: Scalar>(
 /// `retained` components are coordinates and the rest speeds; x⁺ checked
 /// to be finite. What [`fixed_step`] takes for a model, and the command
 /// line for a `dyn` one.
-pub(crate) fn step_with<T: Scalar>(
+pub fn step_with<T: Scalar>(
     f: &mut impl FnMut(T, &[T], &mut [T]) -> Result<(), ModelError>,
     retained: usize,
     method: FixedStep,
@@ -126,7 +126,7 @@ pub(crate) fn step_with<T: Scalar>(
 }
 
 /// The classical RK4 step, in the order of operations of
-/// [`rk4_step_fn`](crate::integrate::rk4_step_fn).
+/// [`rk4_step_fn`](appell_integrate::rk4_step_fn).
 fn rk4<T: Scalar>(
     f: &mut impl FnMut(T, &[T], &mut [T]) -> Result<(), ModelError>,
     t: T,
@@ -197,7 +197,7 @@ pub struct StepLinearization {
     /// The state components: the retained coordinates, then the privileged
     /// speeds as `"{coordinate}_dot"` (as [`Linearization`](super::Linearization)).
     pub state_names: Vec<String>,
-    /// The inputs, in [`ModelInfo::inputs`](crate::ModelInfo::inputs) order.
+    /// The inputs, in [`ModelInfo::inputs`](appell_core::ModelInfo::inputs) order.
     pub input_names: Vec<String>,
 }
 
@@ -210,7 +210,7 @@ pub struct StepLinearization {
 /// model ([`Model::validate`]), and any error of the step.
 ///
 /// ```
-/// # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Pendulum { g: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Pendulum", parameters: &["g"], coordinates: &["theta"],
@@ -246,7 +246,7 @@ pub struct StepLinearization {
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::linearize::{step_jacobian, FixedStep};
+/// use appell_linearize::{step_jacobian, FixedStep};
 ///
 /// // The pendulum θ̈ = τ − g sin θ, one semi-implicit Euler step:
 /// // ω⁺ = ω + h (τ − g sin θ), θ⁺ = θ + h ω⁺.
@@ -330,13 +330,13 @@ fn chained<M: Model>(
 
 /// A generated rhs Jacobian at `(t, y)` with the inputs held: the rates,
 /// A and B (row-major) into the buffers.
-pub(crate) type StageJacobian<'a> =
+pub type StageJacobian<'a> =
     dyn FnMut(f64, &[f64], &mut [f64], &mut [f64], &mut [f64]) -> Result<(), ModelError> + 'a;
 
-/// [`chained`] for any source of stage Jacobians (`retained` coordinates
+/// `chained` for any source of stage Jacobians (`retained` coordinates
 /// lead the state, `ni` inputs): what the command line calls on a model
 /// it knows as a trait object.
-pub(crate) fn chained_with(
+pub fn chained_with(
     jacobian: &mut StageJacobian<'_>,
     retained: usize,
     method: FixedStep,
