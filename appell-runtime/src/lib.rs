@@ -18,36 +18,34 @@
 
 #[doc(hidden)]
 pub use appell_core::__doc_model;
+pub use appell_core::{
+    check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, JacobianInfo, JointLimit,
+    Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar, SceneVisitor, StateName,
+};
 pub use appell_core::{dual, linalg, physical, precision};
 #[cfg(feature = "std")]
-pub mod accuracy;
+pub use appell_core::{dynamic, DynModel, DynRhs};
+
+// The dynamics at one state.
 #[cfg(feature = "std")]
-pub mod animate;
+pub use appell_dynamics::{
+    augmented, constraint_forces, energy, motion, oracle, pinocchio, switch,
+};
+
+// Over time: integration (with its watches), hybrid runs, linearization.
 #[cfg(feature = "std")]
-pub mod cli;
+pub use appell_hybrid as hybrid;
 #[cfg(feature = "std")]
-pub mod hybrid;
+pub use appell_hybrid::sliding;
 pub use appell_integrate as integrate;
 #[cfg(feature = "std")]
 pub use appell_integrate::{conditioning, contact_watch};
 #[cfg(feature = "std")]
 pub use appell_linearize as linearize;
-#[cfg(feature = "std")]
-pub mod sliding;
 
-pub use appell_core::{
-    check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, JacobianInfo, JointLimit,
-    Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar, SceneVisitor, StateName,
-};
-
+// The tools.
 #[cfg(feature = "std")]
-pub use appell_core::dynamic;
-#[cfg(feature = "std")]
-pub use appell_dynamics::{
-    augmented, constraint_forces, energy, motion, oracle, pinocchio, switch,
-};
-#[cfg(feature = "std")]
-pub use dynamic::{DynModel, DynRhs};
+pub use appell_tools::{accuracy, animate, cli};
 
 /// nalgebra, the matrices of [`linearize`] and of the oracle, re-exported so
 /// that a user needs no dependency line of their own (nor to match its

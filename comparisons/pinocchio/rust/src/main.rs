@@ -649,7 +649,7 @@ fn twin<M: Model>(model: &M, opts: &Options) -> Result<(), String> {
 /// evaluation of the rhs per column of A and of B, seeded on that state
 /// component or input, as `appell::linearize` computed them before the
 /// generated `rhs_jacobian` (`dual_columns` in
-/// `appell-runtime/src/linearize/jacobian.rs`); the buffers `x`, `w`, `y`
+/// `appell-linearize/src/jacobian.rs`); the buffers `x`, `w`, `y`
 /// are allocated by the caller and `prepared` made once.
 // `prepared` and the dual buffers x, w, y are made once by `jacobians` and reused for every
 // state of the timed batch; the rest: rhs_jacobian's state, inputs and its three outputs in `out`

@@ -3,7 +3,7 @@
 //! geometry.
 //!
 //! [`simulate`] integrates every coordinate (cyclic ones included, with
-//! q̇ from [`Model::driven_coordinate_rates`](crate::Model::driven_coordinate_rates), so a driven coordinate moves
+//! q̇ from [`Model::driven_coordinate_rates`](appell_core::Model::driven_coordinate_rates), so a driven coordinate moves
 //! at its commanded rate) and returns evenly spaced
 //! [`Frame`]s; [`svg`] draws them. Each rigid body is its equivalent
 //! inertia ellipsoid (the uniform solid ellipsoid with the body's mass and
@@ -12,12 +12,12 @@
 //! each rolling contact's path a track on the ground, under a ground grid
 //! and a time readout. [`line_plot`] draws curves, such as eigenvalues
 //! against a parameter. A model with contacts is watched frame by frame
-//! ([`crate::contact_watch`]): a disc that falls flat stops the picture
+//! ([`appell_integrate::contact_watch`]): a disc that falls flat stops the picture
 //! where it would go through the floor.
 //!
 //! ```
-//! use appell_runtime::animate::{simulate, svg, SvgOptions};
-//! # use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+//! use appell_tools::animate::{simulate, svg, SvgOptions};
+//! # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 //! # /// A particle on a light rod (the pendulum of the `Model` docs).
 //! # struct Pendulum;
 //! # static INFO: ModelInfo = ModelInfo {
@@ -67,10 +67,10 @@ mod plot;
 pub use draw::{svg, SvgOptions, View};
 pub use plot::{line_plot, Curve};
 
-use crate::contact_watch::ContactWatch;
-use crate::dynamic::{DynModel, DynRhs};
-use crate::{check_len, ModelError};
+use appell_core::dynamic::{DynModel, DynRhs};
+use appell_core::{check_len, ModelError};
 pub use appell_dynamics::motion::Frame;
+use appell_integrate::contact_watch::ContactWatch;
 
 /// The largest step [`simulate`] takes.
 pub const MAX_STEP: f64 = 1e-3;
@@ -89,7 +89,7 @@ pub fn steps_needed(t0: f64, t_end: f64, frames: usize) -> f64 {
 /// `frames + 1` frames evenly spaced in time (the first at `t0`).
 ///
 /// Fourth-order Runge–Kutta on the full coordinates (q̇ from
-/// [`Model::coordinate_rates`](crate::Model::coordinate_rates), u̇ from [`Model::rhs`](crate::Model::rhs)), at most
+/// [`Model::coordinate_rates`](appell_core::Model::coordinate_rates), u̇ from [`Model::rhs`](appell_core::Model::rhs)), at most
 /// [`MAX_STEP`] per step ([`steps_needed`] steps in all): accurate enough
 /// for a picture, not a reference (use the adaptive integrators for that).
 ///
@@ -123,7 +123,7 @@ pub fn simulate<K: DynModel + ?Sized>(
 /// have the same `inputs`.
 ///
 /// ```
-/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Free;
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
@@ -150,8 +150,8 @@ pub fn simulate<K: DynModel + ?Sized>(
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
 /// # }
-/// use appell_runtime::animate::simulate_watched;
-/// use appell_runtime::contact_watch::ContactWatch;
+/// use appell_tools::animate::simulate_watched;
+/// use appell_integrate::contact_watch::ContactWatch;
 ///
 /// // A free particle has no contacts: every frame is checked, nothing found.
 /// let mut watch = ContactWatch::new(&Free).warn();

@@ -1,14 +1,14 @@
 //! The `info` subcommand: the model's metadata as JSON.
 
 use super::output::finite_or_null;
-use crate::dynamic::DynModel;
-use crate::{Model, ModelError};
+use appell_core::dynamic::DynModel;
+use appell_core::{Model, ModelError};
 use serde_json::{json, Value};
 
 /// The metadata printed by `info` (layout in the module documentation).
 ///
 /// ```
-/// # use appell_runtime::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Spin { i: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Spin", parameters: &["i"], coordinates: &["phi"], speeds: &["phi"],
@@ -25,7 +25,7 @@ use serde_json::{json, Value};
 /// #     type Prepared<T: Scalar> = ();
 /// #     fn info() -> &'static ModelInfo { &INFO }
 /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
-/// #         appell_runtime::check_len("out", out, 1)?; out[0] = self.i; Ok(())
+/// #         appell_core::check_len("out", out, 1)?; out[0] = self.i; Ok(())
 /// #     }
 /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
 /// #     fn prepare<T: Scalar>(&self) {}
@@ -41,7 +41,7 @@ use serde_json::{json, Value};
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// let info = appell_runtime::cli::info_json(&Spin { i: 0.25 }).unwrap();
+/// let info = appell_tools::cli::info_json(&Spin { i: 0.25 }).unwrap();
 /// assert_eq!(info["name"], "Spin");
 /// assert_eq!(info["parameters"][0]["value"], 0.25);
 /// assert_eq!(info["state"], serde_json::json!(["phi", "phi_dot"]));

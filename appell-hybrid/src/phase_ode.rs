@@ -7,8 +7,8 @@ use std::cell::RefCell;
 use num_dual::Dual64;
 
 use super::Phase;
-use crate::dynamic::DynRhs;
-use crate::ModelError;
+use appell_core::dynamic::DynRhs;
+use appell_core::ModelError;
 
 /// A phase's equations on every coordinate and its speeds, x = (q, u):
 /// q̇ from the coordinate rates, u̇ from the rhs on the reduced state.
@@ -73,7 +73,7 @@ impl<'p> PhaseOde<'p> {
     }
 
     /// ∂ẋ/∂x at `(t, x)` (row-major), the inputs held at their values: u̇'s
-    /// rows by the model's generated [`Model::rhs_jacobian`](crate::Model::rhs_jacobian)
+    /// rows by the model's generated [`Model::rhs_jacobian`](appell_core::Model::rhs_jacobian)
     /// where it has one and `by_duals` is false (the ignorable
     /// coordinates' columns are zero: u̇ does not read them), else by dual
     /// numbers as q̇'s always are ([`PhaseOde::dual_jacobian`]).
@@ -160,7 +160,7 @@ impl<'p> PhaseOde<'p> {
 mod tests {
     use super::super::Phase;
     use super::PhaseOde;
-    use crate::__doc_model::Pendulum;
+    use appell_core::__doc_model::Pendulum;
 
     /// A phase's Jacobian by the generated rhs_jacobian equals the one by
     /// dual numbers.

@@ -5,8 +5,8 @@
 use nalgebra::{Matrix2, Matrix3, SymmetricEigen, Vector3};
 
 use super::Frame;
-use crate::dynamic::DynModel;
-use crate::ModelError;
+use appell_core::dynamic::DynModel;
+use appell_core::ModelError;
 
 /// A body at one frame, in N.
 #[derive(Clone, Copy, Debug)]

@@ -44,7 +44,7 @@
 //! (a regularised Coulomb law in `friction(...)`); this module finds only
 //! its magnitude.
 //!
-//! [`crate::hybrid::Phase::state_inputs`] runs this at every evaluation of
+//! [`crate::Phase::state_inputs`] runs this at every evaluation of
 //! a phase: see [`normal_inputs`]. The guide's scenes page
 //! (`docs/guide/scenes.md`, "Sliding contacts") has a runnable example on
 //! a derived disc, and `tests/sliding_contacts.rs` checks it against
@@ -52,10 +52,10 @@
 
 use nalgebra::{DMatrix, DVector};
 
-use crate::constraint_forces::{contact_forces_parts, momentum_residual, Normal};
-use crate::dynamic::DynModel;
-use crate::oracle::OracleError;
-use crate::ModelError;
+use appell_core::dynamic::DynModel;
+use appell_core::ModelError;
+use appell_dynamics::constraint_forces::{contact_forces_parts, momentum_residual, Normal};
+use appell_dynamics::oracle::OracleError;
 
 /// A contact point's position at `(t, q)`, N components.
 pub type PointFn<'a> = Box<dyn Fn(f64, &[f64]) -> Result<[f64; 3], ModelError> + 'a>;
@@ -210,7 +210,7 @@ pub struct SlidingNormals {
     pub feedback: Vec<f64>,
     /// The normal forces at the scene's rolling contacts that no
     /// multiplier carries, solved together with the sliding ones (in
-    /// [`ModelInfo::contacts`](crate::ModelInfo::contacts) order, the
+    /// [`ModelInfo::contacts`](appell_core::ModelInfo::contacts) order, the
     /// contacts already known left out).
     pub rolling: Vec<f64>,
     /// The momentum balances' residual at the solution, relative to their
@@ -524,7 +524,7 @@ fn balance_at<K: DynModel + ?Sized>(
     extra: &[([f64; 3], [f64; 3])],
 ) -> Result<
     (
-        crate::constraint_forces::MomentumResidual,
+        appell_dynamics::constraint_forces::MomentumResidual,
         Vec<([f64; 3], [f64; 3])>,
     ),
     SlidingError,
@@ -565,7 +565,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
-/// A phase's [`state_inputs`](crate::hybrid::Phase::state_inputs): at
+/// A phase's [`state_inputs`](crate::Phase::state_inputs): at
 /// every evaluation, the normal forces of `contacts` in `model` (the
 /// phase's scene) from [`sliding_normals`], written into their inputs.
 /// A negative normal force (a contact that lifts off, here or at one of
@@ -575,7 +575,7 @@ fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 pub fn normal_inputs<'a>(
     model: &'a dyn DynModel,
     contacts: Vec<SlidingContact<'a>>,
-) -> crate::hybrid::StateInputs<'a> {
+) -> crate::StateInputs<'a> {
     Box::new(move |t, q, u, inputs: &mut [f64]| {
         let found = sliding_normals(model, t, q, u, inputs, &contacts)?;
         if found.forces.iter().chain(&found.rolling).any(|&n| n < 0.0) {

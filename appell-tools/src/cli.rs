@@ -20,9 +20,9 @@
 //! An example's `main` is just
 //!
 //! ```no_run
-//! # use appell_runtime::Model;
+//! # use appell_core::Model;
 //! # fn demo<M: Model>(model: M) -> std::process::ExitCode {
-//! appell_runtime::cli::run(model, |model| {
+//! appell_tools::cli::run(model, |model| {
 //!     // what the example does without a subcommand
 //!     Ok(())
 //! })
@@ -81,13 +81,13 @@
 //! With `--scene NAME` the scene's reduced equations answer, and the
 //! outputs its `outputs(...)` asked for are added: `"energies"`
 //! (`{"kinetic", "potential", "rate", "input_power"}`, see
-//! [`crate::energy::energies`]) and `"contact_forces"` (as `contacts`
+//! [`appell_dynamics::energy::energies`]) and `"contact_forces"` (as `contacts`
 //! answers). The full model declares no outputs.
 //!
 //! # `contacts`
 //!
 //! The same input lines (coordinates solved and the warning as for
-//! `eval`), answered by [`crate::constraint_forces`]:
+//! `eval`), answered by [`appell_dynamics::constraint_forces`]:
 //!
 //! ```text
 //! {"multipliers": [λ..], "rows": [{"source": "rolls at P, N.x", "multiplier": λ}, ..],
@@ -104,9 +104,9 @@
 //!
 //! The same input lines, and optionally `"step": {"method": "rk4" |
 //! "semi_implicit_euler", "h": 0.01}`, answered with the Jacobians of the
-//! reduced equations at that state (those of [`crate::linearize::linearize`])
+//! reduced equations at that state (those of [`appell_linearize::linearize`])
 //! or, with `step`, of one step of that method
-//! ([`crate::linearize::step_jacobian`]):
+//! ([`appell_linearize::step_jacobian`]):
 //!
 //! ```text
 //! {"state": [names], "inputs": [names], "rates": [ẋ..], "a": [[∂ẋ_i/∂x_j..]..], "b": [[∂ẋ_i/∂u_k..]..]}
@@ -136,9 +136,9 @@
 //! # `bench`
 //!
 //! Times [`Model::rhs`] (prepared once) and the oracle's
-//! [`reduced_rhs`](crate::oracle::reduced_rhs) over 256 fixed pseudo-random
+//! [`reduced_rhs`](appell_dynamics::oracle::reduced_rhs) over 256 fixed pseudo-random
 //! states and prints `{"rhs_ns": .., "oracle_ns": .., "ops": .., "states": ..}`
-//! (nanoseconds per call, [`OpCounts::total`](crate::OpCounts::total) of the
+//! (nanoseconds per call, [`OpCounts::total`](appell_core::OpCounts::total) of the
 //! rhs, number of states used). See [`bench()`].
 //!
 //! # `accuracy`
@@ -197,7 +197,7 @@
 
 // Items the documentation links to.
 #[cfg(doc)]
-use crate::{Model, ModelError, ModelInfo};
+use appell_core::{Model, ModelError, ModelInfo};
 
 mod animate;
 mod bench;

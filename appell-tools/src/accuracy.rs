@@ -12,11 +12,11 @@
 
 use std::time::Instant;
 
-use crate::dynamic::{DynRhs, Prepared};
-use crate::integrate::{
+use appell_core::dynamic::{DynRhs, Prepared};
+use appell_core::{Model, ModelError};
+use appell_integrate::{
     heun_step_fn, midpoint_step_fn, rk4_step_fn, Dop853, Dopri5, IntegrateError, Radau5, TrBdf2,
 };
-use crate::{Model, ModelError};
 
 /// An integrator and its setting.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -375,7 +375,7 @@ pub fn svg_chart(title: &str, points: &[Point]) -> String {
 /// legend.
 ///
 /// ```
-/// use appell_runtime::accuracy::svg_loglog;
+/// use appell_tools::accuracy::svg_loglog;
 /// let f64_line = vec![(100.0, 7.6e-7), (200.0, 4.7e-8), (400.0, 2.9e-9)];
 /// let f32_line = vec![(100.0, 5.3e-7), (200.0, 8.1e-7), (400.0, 6.9e-7)];
 /// let svg = svg_loglog("RK4", "steps", "error", &[("f64", f64_line), ("f32", f32_line)]);
@@ -514,7 +514,7 @@ pub fn csv(points: &[Point]) -> String {
 /// The names of the methods among `points`, in order of first appearance.
 ///
 /// ```
-/// use appell_runtime::accuracy::{method_names, Method, Point};
+/// use appell_tools::accuracy::{method_names, Method, Point};
 /// let p = |method| Point { method, error_final: 1e-6, error_max: 1e-6, seconds: 1e-5, rhs_calls: 40, steps: 10 };
 /// let points = [p(Method::Rk4(10)), p(Method::Dopri5(1e-6)), p(Method::Rk4(20))];
 /// assert_eq!(method_names(&points), ["rk4", "dopri5"]);

@@ -5,11 +5,11 @@
 //! rhs for a model without one.
 
 use super::input::{number, Point};
-use crate::dynamic::{DynModel, DynRhs};
-use crate::linearize::discrete::{chained_with, step_with};
-use crate::linearize::jacobian::{dual_columns, state_names};
-use crate::linearize::FixedStep;
-use crate::ModelInfo;
+use appell_core::dynamic::{DynModel, DynRhs};
+use appell_core::ModelInfo;
+use appell_linearize::discrete::{chained_with, step_with};
+use appell_linearize::jacobian::{dual_columns, state_names};
+use appell_linearize::FixedStep;
 use nalgebra::DMatrix;
 use num_dual::Dual64;
 use serde_json::{json, Map, Value};
@@ -97,14 +97,14 @@ fn generated(
     info: &ModelInfo,
     point: &Point,
     step: Option<(FixedStep, f64)>,
-) -> Result<Columns, crate::ModelError> {
+) -> Result<Columns, appell_core::ModelError> {
     let (x, w) = (&point.state[..], &point.inputs[..]);
     let (s, ni) = (x.len(), w.len());
     let mut jacobian = |t: f64, y: &[f64], v: &mut [f64], a: &mut [f64], b: &mut [f64]| match rhs
         .generated_jacobian(t, y, w, v, a, b)?
     {
         true => Ok(()),
-        false => Err(crate::ModelError::NotGenerated {
+        false => Err(appell_core::ModelError::NotGenerated {
             function: "rhs_jacobian",
         }),
     };
@@ -133,7 +133,7 @@ fn evaluate(
     x: &[Dual64],
     w: &[Dual64],
     step: Option<(FixedStep, f64)>,
-) -> Result<Vec<Dual64>, crate::ModelError> {
+) -> Result<Vec<Dual64>, appell_core::ModelError> {
     let t = Dual64::from_re(t);
     match step {
         None => {

@@ -7,8 +7,8 @@ use super::error::CliError;
 use super::eval::{eval_stream, Answer, EvalState};
 use super::info::info_json_dyn;
 use super::sweep::accuracy_dyn;
-use crate::dynamic::DynModel;
-use crate::{Model, ModelInfo};
+use appell_core::dynamic::DynModel;
+use appell_core::{Model, ModelInfo};
 use serde_json::json;
 use std::error::Error;
 use std::io::{BufRead, IsTerminal, Write};
@@ -17,14 +17,14 @@ use std::process::ExitCode;
 /// The usage text for `program` running model `info`.
 ///
 /// ```
-/// # use appell_runtime::{ModelInfo, OpCounts};
+/// # use appell_core::{ModelInfo, OpCounts};
 /// # let info = ModelInfo {
 /// #     name: "Pendulum", parameters: &[], coordinates: &[], speeds: &[], dependent: &[],
 /// #     cyclic: &[], ignorable: &[], retained: &[], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[],
 /// #     holonomic: 0, constraints: 0, bodies: &[], force_points: 0, torques: 0,
 /// #     form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts::default(), jacobian: None, equations: "",
 /// # };
-/// let text = appell_runtime::cli::usage("pendulum", &info);
+/// let text = appell_tools::cli::usage("pendulum", &info);
 /// assert!(text.starts_with("usage: pendulum [eval|contacts|jacobian|info|equations|bench|accuracy|animate|help]"));
 /// assert!(text.contains("Pendulum"));
 /// ```
@@ -101,7 +101,7 @@ pub fn run<M: Model>(
 /// `default_action` is called.
 ///
 /// ```
-/// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+/// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
 /// # struct Free { m: f64 }
 /// # static INFO: ModelInfo = ModelInfo {
 /// #     name: "Free", parameters: &["m"], coordinates: &["x"], speeds: &["x"],
@@ -117,20 +117,20 @@ pub fn run<M: Model>(
 /// #     type Prepared<T: Scalar> = T;
 /// #     fn info() -> &'static ModelInfo { &INFO }
 /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
-/// #         appell_runtime::check_len("out", out, 1)?; out[0] = self.m; Ok(())
+/// #         appell_core::check_len("out", out, 1)?; out[0] = self.m; Ok(())
 /// #     }
 /// #     fn set_parameter(&mut self, name: &str, v: f64) -> bool {
 /// #         if name == "m" { self.m = v; true } else { false }
 /// #     }
 /// #     fn prepare<T: Scalar>(&self) -> T { T::one() / T::from_f64(self.m) }
 /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-/// #         appell_runtime::check_len("state", s, 1)?; appell_runtime::check_len("dstate", ds, 1)?;
-/// #         appell_runtime::check_len("inputs", i, 1)?;
+/// #         appell_core::check_len("state", s, 1)?; appell_core::check_len("dstate", ds, 1)?;
+/// #         appell_core::check_len("inputs", i, 1)?;
 /// #         ds[0] = i[0] * *p; Ok(())
 /// #     }
 /// #     fn coordinate_rates<T: Scalar>(&self, _: T, q: &[T], u: &[T], qd: &mut [T]) -> Result<(), ModelError> {
-/// #         appell_runtime::check_len("q", q, 1)?; appell_runtime::check_len("u", u, 1)?;
-/// #         appell_runtime::check_len("qdot", qd, 1)?; qd[0] = u[0]; Ok(())
+/// #         appell_core::check_len("q", q, 1)?; appell_core::check_len("u", u, 1)?;
+/// #         appell_core::check_len("qdot", qd, 1)?; qd[0] = u[0]; Ok(())
 /// #     }
 /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
 /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
@@ -142,7 +142,7 @@ pub fn run<M: Model>(
 /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
 /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
 /// # }
-/// use appell_runtime::cli::{run_with, CliError};
+/// use appell_tools::cli::{run_with, CliError};
 ///
 /// let args: Vec<String> = ["free", "eval"].iter().map(|s| s.to_string()).collect();
 /// let mut stdin = &b"{\"q\": {}, \"u\": {\"x\": 1.5}, \"inputs\": {\"f\": 6.0}, \"params\": {\"m\": 2.0}}\n\

@@ -8,8 +8,8 @@ use super::input::{named, number, Point};
 use super::jacobian::{jacobian_answer, parse_step};
 use super::json::parse_object;
 use super::output::{contact_forces_json, finite_or_null, result_number};
-use crate::dynamic::DynModel;
-use crate::{Model, ModelError, ModelInfo};
+use appell_core::dynamic::DynModel;
+use appell_core::{Model, ModelError, ModelInfo};
 use serde_json::{json, Map, Value};
 use std::io::{BufRead, Write};
 
@@ -347,8 +347,9 @@ impl Outputs<'_> {
     fn of(&self, model: &dyn DynModel) -> Result<Map<String, Value>, String> {
         let mut out = Map::new();
         if self.energies {
-            let e = crate::energy::energies_dyn(model, self.t, self.q, self.u, self.inputs)
-                .map_err(|e| e.to_string())?;
+            let e =
+                appell_dynamics::energy::energies_dyn(model, self.t, self.q, self.u, self.inputs)
+                    .map_err(|e| e.to_string())?;
             out.insert(
                 "energies".into(),
                 json!({

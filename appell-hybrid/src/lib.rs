@@ -1,3 +1,5 @@
+//! # appell-hybrid
+//!
 //! A simulation that moves between scenes when an event says the physics
 //! changed: a foot lands or lifts off, a wheel starts or stops slipping.
 //!
@@ -41,17 +43,20 @@
 //! `tests/hybrid.rs` runs a hopping leg (flight and stance, the lift-off
 //! where the ground's normal force vanishes) against closed forms.
 
+#![warn(missing_docs)]
+
 use std::cell::RefCell;
 
-use crate::constraint_forces::{contact_forces_dyn, Normal};
-use crate::dynamic::DynModel;
-use crate::integrate::{Dop853, IntegrateError, Radau5};
-use crate::oracle::OracleError;
-use crate::switch::{impact_state, switch_state, SwitchError};
-use crate::ModelError;
+use appell_core::dynamic::DynModel;
+use appell_core::ModelError;
+use appell_dynamics::constraint_forces::{contact_forces_dyn, Normal};
+use appell_dynamics::oracle::OracleError;
+use appell_dynamics::switch::{impact_state, switch_state, SwitchError};
+use appell_integrate::{Dop853, IntegrateError, Radau5};
 use phase_ode::PhaseOde;
 
 mod phase_ode;
+pub mod sliding;
 
 /// A guard's value at `(t, q, u)`: every coordinate, the phase's speeds.
 pub type GuardFn<'a> = Box<dyn Fn(f64, &[f64], &[f64]) -> Result<f64, ModelError> + 'a>;
@@ -92,8 +97,8 @@ impl<'a> Guard<'a> {
 
     /// A lift-off guard: switches to phase `to` where the normal force at
     /// contact `contact` of `model` (its index in
-    /// [`ModelInfo::contacts`](crate::ModelInfo), of the phase's scene) comes
-    /// down through zero, from [`contact_forces`](crate::constraint_forces::contact_forces)
+    /// [`ModelInfo::contacts`](appell_core::ModelInfo), of the phase's scene) comes
+    /// down through zero, from [`contact_forces`](appell_dynamics::constraint_forces::contact_forces)
     /// at `inputs`. Every `rolls` contact is a two-sided equality in the
     /// equations, so this is how a hybrid run takes the ground's
     /// one-sidedness: the scene that holds the contact until the ground
@@ -104,7 +109,7 @@ impl<'a> Guard<'a> {
     /// own errors.
     ///
     /// ```
-    /// # use appell_runtime::{Model, ModelError, ModelInfo, OpCounts, Scalar};
+    /// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
     /// # struct Free;
     /// # static INFO: ModelInfo = ModelInfo {
     /// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
@@ -131,7 +136,7 @@ impl<'a> Guard<'a> {
     /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
     /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
     /// # }
-    /// use appell_runtime::hybrid::Guard;
+    /// use appell_hybrid::Guard;
     ///
     /// // A model without contacts: the guard names none, and says so.
     /// let guard = Guard::lift_off(1, &Free, 0, &[]);
@@ -150,11 +155,11 @@ impl<'a> Guard<'a> {
     /// A lift-off guard for a `contact(link, ...)` the phase's scene holds
     /// on level ground: switches to phase `to` where the ground's push on
     /// the link along N.z (the multiplier of the contact's
-    /// [`RowSource::Contact`](crate::RowSource::Contact) row of axis 2, from
-    /// [`contact_forces`](crate::constraint_forces::contact_forces) at
+    /// [`RowSource::Contact`](appell_core::RowSource::Contact) row of axis 2, from
+    /// [`contact_forces`](appell_dynamics::constraint_forces::contact_forces) at
     /// `inputs`) comes down through zero: a foot that would have to be
     /// pulled leaves the ground. `contact` indexes
-    /// [`Model::contact_links`](crate::Model::contact_links). Its reason
+    /// [`Model::contact_links`](appell_core::Model::contact_links). Its reason
     /// is `"lift-off"`; a scene that does not hold the contact is
     /// [`ModelError::Contact`].
     pub fn contact_lift_off(
@@ -168,7 +173,7 @@ impl<'a> Guard<'a> {
             .dyn_info()
             .row_sources
             .iter()
-            .position(|r| *r == crate::RowSource::Contact { contact, axis: 2 });
+            .position(|r| *r == appell_core::RowSource::Contact { contact, axis: 2 });
         Guard::new("lift-off", to, move |t, q: &[f64], u: &[f64]| {
             let row = row.ok_or(ModelError::Contact {
                 what: "the lift-off guard names a contact its scene does not hold",
@@ -183,11 +188,11 @@ impl<'a> Guard<'a> {
 
     /// A touchdown guard for a `contact(link, ...)` on level ground at
     /// height zero: switches to phase `to` where the link's origin (from
-    /// [`Model::contact_points`](crate::Model::contact_points) of `model`)
+    /// [`Model::contact_points`](appell_core::Model::contact_points) of `model`)
     /// comes down through N.z = 0. Give it [`Guard::impact`] with the scene
     /// that holds the contact, so the foot lands with the impulse that
     /// stops it. Its reason is `"touchdown"`; an index past
-    /// [`Model::contact_links`](crate::Model::contact_links) is
+    /// [`Model::contact_links`](appell_core::Model::contact_links) is
     /// [`ModelError::Contact`].
     pub fn touchdown(to: usize, model: &'a dyn DynModel, contact: usize) -> Self {
         // The contacts' points, allocated once: the guard runs every step.
@@ -330,7 +335,7 @@ pub struct SwitchRecord {
     pub reason: &'static str,
     /// The impulses: for a guard with an impact, the impact scene's rows'
     /// first, then those of each of the target's constraint rows (its
-    /// [`ModelInfo::row_sources`](crate::ModelInfo) order; none where
+    /// [`ModelInfo::row_sources`](appell_core::ModelInfo) order; none where
     /// nothing was imposed).
     pub impulses: Vec<f64>,
     /// Kinetic energy lost at the switch.
@@ -363,14 +368,15 @@ pub struct HybridRun {
 }
 
 impl HybridRun {
-    /// The samples as animation frames ([`crate::animate::svg`]), one per
+    /// The samples as animation frames (`appell::animate::svg`), one per
     /// instant: a switch's second sample (the same time, after the map)
     /// is left out.
-    pub fn frames(&self) -> Vec<crate::animate::Frame> {
-        let mut frames: Vec<crate::animate::Frame> = Vec::with_capacity(self.samples.len());
+    pub fn frames(&self) -> Vec<appell_dynamics::motion::Frame> {
+        let mut frames: Vec<appell_dynamics::motion::Frame> =
+            Vec::with_capacity(self.samples.len());
         for s in &self.samples {
             if frames.last().is_none_or(|f| s.t > f.t) {
-                frames.push(crate::animate::Frame {
+                frames.push(appell_dynamics::motion::Frame {
                     t: s.t,
                     q: s.q.clone(),
                 });
@@ -454,7 +460,7 @@ impl<'a> Hybrid<'a> {
     /// Radau5 as the integrator of every phase, for stiff ones (a stiff
     /// spring, a regularised friction law). The Jacobian of each phase's
     /// equations takes u̇'s rows from the phase model's generated
-    /// [`Model::rhs_jacobian`](crate::Model::rhs_jacobian) where it has one
+    /// [`Model::rhs_jacobian`](appell_core::Model::rhs_jacobian) where it has one
     /// (unless [`Radau5::jacobian_by_duals`]), and the rest by dual
     /// numbers, one pass per coordinate and speed (q̇'s rows only, where
     /// u̇'s are generated).

@@ -1,6 +1,6 @@
 //! [`CliError`]: why the command line failed.
 
-use crate::ModelError;
+use appell_core::ModelError;
 use std::error::Error;
 
 /// Why the command line failed.

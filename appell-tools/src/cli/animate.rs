@@ -6,7 +6,7 @@ use super::input::number;
 use super::json::parse_object;
 use super::progress::Bar;
 use crate::animate::{simulate_with_progress, steps_needed, svg, SvgOptions, View, MAX_STEP};
-use crate::dynamic::DynModel;
+use appell_core::dynamic::DynModel;
 use serde_json::{Map, Value};
 use std::io::Write;
 

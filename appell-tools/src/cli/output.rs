@@ -1,9 +1,9 @@
 //! Writing JSON output: numbers that may not be finite, and the constraint
 //! forces `contacts` answers.
 
-use crate::constraint_forces::{contact_forces_dyn, Friction, Normal, NormalSource};
-use crate::dynamic::DynModel;
-use crate::RowSource;
+use appell_core::dynamic::DynModel;
+use appell_core::RowSource;
+use appell_dynamics::constraint_forces::{contact_forces_dyn, Friction, Normal, NormalSource};
 use serde_json::{json, Value};
 
 /// A JSON number, or `null` for a value JSON cannot hold.

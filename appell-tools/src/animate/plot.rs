@@ -22,7 +22,7 @@ const COLOURS: [&str; 4] = ["#3b6ea5", "#c8553d", "#4f9d69", "#8e5ea2"];
 /// labels.
 ///
 /// ```
-/// use appell_runtime::animate::{line_plot, Curve};
+/// use appell_tools::animate::{line_plot, Curve};
 /// let square = Curve {
 ///     label: "x²".into(),
 ///     points: (0..=10).map(|i| (i as f64, (i * i) as f64)).collect(),

@@ -6,8 +6,8 @@ use std::fmt::Write;
 
 use super::geometry::{self, Pose, Projection, Scene};
 use super::Frame;
-use crate::dynamic::DynModel;
-use crate::ModelError;
+use appell_core::dynamic::DynModel;
+use appell_core::ModelError;
 
 /// How the motion is looked at.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -42,7 +42,7 @@ pub struct SvgOptions {
     /// ground moves under them): for vehicles that travel far.
     pub follow: bool,
     /// Lines drawn between two bodies' centres (indices into
-    /// [`ModelInfo::bodies`](crate::ModelInfo); None: N's origin O): a
+    /// [`ModelInfo::bodies`](appell_core::ModelInfo); None: N's origin O): a
     /// pendulum's massless links, a robot's chain.
     pub connectors: Vec<(Option<usize>, Option<usize>)>,
     /// Bodies whose centre's path is drawn (a wheel's track without a

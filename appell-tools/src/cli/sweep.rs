@@ -5,8 +5,8 @@ use super::input::{number, Point};
 use super::json::parse_object;
 use super::output::finite_or_null;
 use crate::accuracy::{standard_methods, Run};
-use crate::dynamic::{DynModel, DynRhs};
-use crate::Model;
+use appell_core::dynamic::{DynModel, DynRhs};
+use appell_core::Model;
 use serde_json::{json, Value};
 
 /// The largest reduced state `accuracy` handles (the integrators work on

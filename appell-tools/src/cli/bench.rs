@@ -2,8 +2,8 @@
 
 use super::error::CliError;
 use super::output::finite_or_null;
-use crate::dynamic::DynModel;
-use crate::Model;
+use appell_core::dynamic::DynModel;
+use appell_core::Model;
 use serde_json::{json, Value};
 use std::hint::black_box;
 use std::time::{Duration, Instant};
@@ -13,9 +13,9 @@ use std::time::{Duration, Instant};
 pub struct BenchReport {
     /// Median nanoseconds per call of the generated [`Model::rhs`].
     pub rhs_ns: f64,
-    /// Median nanoseconds per call of [`crate::oracle::reduced_rhs`].
+    /// Median nanoseconds per call of [`appell_dynamics::oracle::reduced_rhs`].
     pub oracle_ns: f64,
-    /// [`OpCounts::total`](crate::OpCounts::total) of the generated rhs.
+    /// [`OpCounts::total`](appell_core::OpCounts::total) of the generated rhs.
     pub ops: usize,
     /// Number of states timed (those where both succeeded).
     pub states: usize,
@@ -25,7 +25,7 @@ impl BenchReport {
     /// `{"rhs_ns": .., "oracle_ns": .., "ops": .., "states": ..}`.
     ///
     /// ```
-    /// use appell_runtime::cli::BenchReport;
+    /// use appell_tools::cli::BenchReport;
     /// let r = BenchReport { rhs_ns: 12.5, oracle_ns: 4000.0, ops: 40, states: 256 };
     /// assert_eq!(r.to_json()["oracle_ns"], 4000.0);
     /// ```
@@ -98,7 +98,7 @@ fn time_per_call(calls: usize, mut pass: impl FnMut()) -> f64 {
 }
 
 /// Times the generated [`Model::rhs`] (with [`Model::prepare`] done once)
-/// and the oracle's [`reduced_rhs`](crate::oracle::reduced_rhs) over
+/// and the oracle's [`reduced_rhs`](appell_dynamics::oracle::reduced_rhs) over
 /// [`BENCH_STATES`] pseudo-random states from [`BENCH_SEED`]: every
 /// coordinate (ignorable ones included, for the oracle), every privileged
 /// speed and every input uniform in [-1, 1], t = 0. States where either
@@ -136,7 +136,7 @@ pub(super) fn bench_dyn(model: &dyn DynModel) -> Result<BenchReport, CliError> {
         let mut state: Vec<f64> = retained.iter().map(|&i| q_full[i]).collect();
         state.extend_from_slice(&u);
         let rhs = prepared.rhs(0.0, &state, &inputs, &mut dstate);
-        let oracle = crate::oracle::reduced_rhs_dyn(model, 0.0, &q_full, &u, &inputs);
+        let oracle = appell_dynamics::oracle::reduced_rhs_dyn(model, 0.0, &q_full, &u, &inputs);
         match (rhs, oracle) {
             (Ok(()), Ok(_)) if dstate.iter().all(|x| x.is_finite()) => states.push(BenchState {
                 q_full,
@@ -164,7 +164,7 @@ pub(super) fn bench_dyn(model: &dyn DynModel) -> Result<BenchReport, CliError> {
     });
     let oracle_ns = time_per_call(states.len(), || {
         for s in &states {
-            let r = crate::oracle::reduced_rhs_dyn(
+            let r = appell_dynamics::oracle::reduced_rhs_dyn(
                 model,
                 black_box(0.0),
                 black_box(&s.q_full),

@@ -4,8 +4,8 @@
 //! reads a state (`eval`, `contacts`, `accuracy`, `animate`) goes through
 //! here.
 
-use crate::dynamic::DynModel;
-use crate::linearize::newton_dyn;
+use appell_core::dynamic::DynModel;
+use appell_linearize::newton_dyn;
 use serde_json::{json, Map, Value};
 
 /// How far, relative to 1 + max |q|, a holonomic residual may be from zero
