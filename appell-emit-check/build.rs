@@ -236,7 +236,7 @@ fn main() {
         let dx = g.diff(e, syms.all[2]).unwrap();
         let program = Program::lower(&g, &[e, dx]);
         let rust = program.to_rust(&g, &EmitOptions::default());
-        code.push_str(&rust.function(&format!("joint_{k}"), "::appell_runtime::Scalar", &all));
+        code.push_str(&rust.function(&format!("joint_{k}"), "::appell_core::Scalar", &all));
         let fused = program.to_rust(
             &g,
             &EmitOptions {
@@ -244,11 +244,11 @@ fn main() {
                 ..EmitOptions::default()
             },
         );
-        let fused_fn = fused.function(&format!("fused_{k}"), "::appell_runtime::Scalar", &all);
+        let fused_fn = fused.function(&format!("fused_{k}"), "::appell_core::Scalar", &all);
         code.push_str(&fused_fn);
         code.push_str(&rust.split_functions(
             &format!("split_{k}"),
-            "::appell_runtime::Scalar",
+            "::appell_core::Scalar",
             &params,
             &state,
         ));

@@ -22,7 +22,6 @@ const CRATES: &[&str] = &[
     "appell-integrate",
     "appell-linearize",
     "appell-tools",
-    "appell-runtime",
     "appell-codegen",
     "appell-derive",
 ];

@@ -241,7 +241,7 @@ fn main() {
          oscillates at 1e4 rad/s, a motion every method has to resolve to be accurate: on both the \
          explicit DOP853 is the cheapest way to accuracy, Radau5 costs a few times more, and \
          TR-BDF2 (order 2) falls far behind as the tolerance tightens. Where the fast modes decay \
-         (Van der Pol with μ = 1000, Robertson's kinetics: `cargo run --release -p appell-runtime \
+         (Van der Pol with μ = 1000, Robertson's kinetics: `cargo run --release -p appell-integrate \
          --example radau_vs_trbdf2`), Radau5 is the method.\n\n",
     );
     // Andrews' squeezer: the seven angles at 0.03 s, against DOP853 at

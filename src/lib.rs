@@ -105,11 +105,114 @@
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
+#[doc(hidden)]
+pub use appell_core::__doc_model;
+pub use appell_core::{
+    check_len, BodyInfo, ContactEvent, ContactInfo, ContactViolation, JacobianInfo, JointLimit,
+    Model, ModelError, ModelInfo, OpCounts, RowSource, Scalar, SceneVisitor, StateName,
+};
+pub use appell_core::{dual, linalg, physical, precision};
+#[cfg(feature = "std")]
+pub use appell_core::{dynamic, DynModel, DynRhs};
 pub use appell_derive::Appell;
-pub use appell_runtime::*;
+
+// The dynamics at one state.
+#[cfg(feature = "std")]
+pub use appell_dynamics::{
+    augmented, constraint_forces, energy, motion, oracle, pinocchio, switch,
+};
+
+// Over time: integration (with its watches), hybrid runs, linearization.
+#[cfg(feature = "std")]
+pub use appell_hybrid as hybrid;
+#[cfg(feature = "std")]
+pub use appell_hybrid::sliding;
+pub use appell_integrate as integrate;
+#[cfg(feature = "std")]
+pub use appell_integrate::{conditioning, contact_watch};
+#[cfg(feature = "std")]
+pub use appell_linearize as linearize;
+
+// The tools.
+#[cfg(feature = "std")]
+pub use appell_tools::{accuracy, animate, cli};
+
+/// nalgebra, the matrices of [`linearize`] and of the oracle, re-exported so
+/// that a user needs no dependency line of their own (nor to match its
+/// version).
+///
+/// ```
+/// use appell::nalgebra::DMatrix;
+/// let a = DMatrix::from_row_slice(2, 2, &[0.0, 1.0, -4.0, 0.0]);
+/// let eig = appell::linearize::eigenvalues(&a).unwrap();
+/// assert!(eig.iter().all(|&(re, im)| re.abs() < 1e-12 && (im.abs() - 2.0).abs() < 1e-12));
+/// ```
+#[cfg(feature = "std")]
+pub use nalgebra;
+
+/// num-dual, the dual numbers [`Scalar`] is implemented for (derivatives of
+/// every generated function), re-exported for the same reason.
+///
+/// ```
+/// use appell::{num_dual::Dual64, Scalar};
+/// let x = Dual64::new(0.5, 1.0);
+/// let y = x.sin();
+/// assert!((y.eps - 0.5_f64.cos()).abs() < 1e-15);
+/// ```
+#[cfg(feature = "std")]
+pub use num_dual;
+
+/// Items the generated code refers to; not a stable API.
+#[doc(hidden)]
+pub mod __private {
+    pub use crate::check_len;
+    pub use crate::dual::{inverse_dynamics_derivatives_by_duals, rhs_jacobian_by_duals};
+    pub use crate::linalg::{
+        check_pivot, constraint_scale, ldlt_solve, lu_factor, lu_solve, lu_substitute, max_abs,
+        pivot_margin, substitute_row,
+    };
+    pub use crate::physical::check_body;
+    pub use crate::{
+        BodyInfo, ContactInfo, JacobianInfo, JointLimit, Model, ModelError, ModelInfo, OpCounts,
+        RowSource, Scalar, SceneVisitor,
+    };
+    pub use core::result::Result::{self, Err, Ok};
+}
+
 /// The symbolic engine (interned expressions, differentiation, CSE, emission).
 #[cfg(feature = "std")]
 pub use appell_symbolic as symbolic;
+
+/// The names most programs use, in one import: the derive, the [`Model`]
+/// trait, its object-safe face [`DynModel`] and the [`Scalar`] trait, what
+/// a model says about itself and how its calls fail, and the integrators
+/// with their error.
+///
+/// ```
+/// use appell::prelude::*;
+///
+/// #[derive(Appell)]
+/// #[appell(coordinates(theta), speeds(theta), positive(l, m))]
+/// #[appell(point(P = O + l * sin(theta) * N.x - l * cos(theta) * N.y))]
+/// #[appell(particle(P, mass = m))]
+/// #[appell(gravity(-g * N.y))]
+/// struct Pendulum { l: f64, m: f64, g: f64 }
+///
+/// // A small swing for one period comes back where it started.
+/// let p = Pendulum { l: 1.0, m: 1.0, g: 9.81 };
+/// let period = 2.0 * std::f64::consts::PI * (1.0f64 / 9.81).sqrt();
+/// let end = Dop853::new().solve_model(&p, &[], 0.0, &[1e-3, 0.0], period).unwrap();
+/// assert!((end.x[0] - 1e-3).abs() < 1e-6);
+/// assert_eq!(Pendulum::info().state_len(), 2);
+/// ```
+pub mod prelude {
+    pub use crate::integrate::{Dop853, Dopri5, IntegrateError};
+    #[cfg(feature = "std")]
+    pub use crate::integrate::{Radau5, TrBdf2};
+    #[cfg(feature = "std")]
+    pub use crate::DynModel;
+    pub use crate::{Appell, Model, ModelError, ModelInfo, Scalar};
+}
 
 /// The task guides of `docs/guide/`, compiled here so that `cargo test`
 /// runs every code block on those pages.

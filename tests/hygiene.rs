@@ -24,7 +24,8 @@ mod shadowed {
     fn lu_solve() {}
     fn ldlt_solve() {}
     mod core {}
-    mod appell_runtime {}
+    mod appell_core {}
+    mod appell_integrate {}
 
     /// A sleigh (run-time elimination path) and a constant mass matrix
     /// (hoisted factorization path) in one shadowed module.

@@ -9,11 +9,14 @@
 //!   model says about itself) and [`ModelError`] (how its calls fail);
 //! - the checks of physical bodies ([`physical`]) and the small dense
 //!   solves the generated code calls, with their operation counts
-//!   ([`linalg`]).
+//!   ([`linalg`]);
+//! - with `std`, [`DynModel`], a model behind an object-safe face
+//!   ([`dynamic`]).
 //!
-//! The integrators, the oracle, linearization and the command line build on
-//! this crate in `appell-runtime`; the derive (`appell-codegen`) depends on
-//! this crate alone. It is `no_std` when the default `std` feature is off
+//! The oracle (`appell-dynamics`), the integrators (`appell-integrate`),
+//! linearization (`appell-linearize`), hybrid runs (`appell-hybrid`) and
+//! the command line (`appell-tools`) build on this crate; the derive
+//! (`appell-codegen`) depends on this crate alone. It is `no_std` when the default `std` feature is off
 //! (plain-float math then comes from `libm`).
 //!
 //! ```

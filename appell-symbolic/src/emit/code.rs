@@ -47,7 +47,7 @@ pub struct EmitOptions {
 }
 
 /// The defaults: generic code over a scalar `T` implementing
-/// `::appell_runtime::Scalar`, constants through its `from_f64`, shared
+/// `::appell_core::Scalar`, constants through its `from_f64`, shared
 /// subexpressions bound once, parameter-only work hoisted, every symbol in
 /// stage 0 and read by its name, no fused products.
 ///
@@ -57,7 +57,7 @@ pub struct EmitOptions {
 /// assert_eq!(o.scalar, ScalarType::named("T"));
 /// assert_eq!(
 ///     o.constant,
-///     ConstantForm::FromF64 { scalar_trait: RustPath::absolute(&["appell_runtime", "Scalar"]) }
+///     ConstantForm::FromF64 { scalar_trait: RustPath::absolute(&["appell_core", "Scalar"]) }
 /// );
 /// assert!(o.cse && o.hoist_parameters && !o.fused);
 /// ```
@@ -66,7 +66,7 @@ impl Default for EmitOptions {
         EmitOptions {
             scalar: ScalarType::named("T"),
             constant: ConstantForm::FromF64 {
-                scalar_trait: RustPath::absolute(&["appell_runtime", "Scalar"]),
+                scalar_trait: RustPath::absolute(&["appell_core", "Scalar"]),
             },
             cse: true,
             hoist_parameters: true,

@@ -41,14 +41,14 @@ fn ident(name: &str) -> Ident {
 }
 
 /// A path to a type or trait, such as `T`, `f64` or
-/// `::appell_runtime::Scalar`: identifiers separated by `::`, optionally
+/// `::appell_core::Scalar`: identifiers separated by `::`, optionally
 /// starting at the crate root.
 ///
 /// ```
 /// use appell_symbolic::RustPath;
 /// assert_eq!(RustPath::local("T").to_string(), "T");
-/// let scalar = RustPath::absolute(&["appell_runtime", "Scalar"]);
-/// assert_eq!(scalar.to_string(), "::appell_runtime::Scalar");
+/// let scalar = RustPath::absolute(&["appell_core", "Scalar"]);
+/// assert_eq!(scalar.to_string(), "::appell_core::Scalar");
 /// ```
 #[derive(Clone, Debug, PartialEq, Eq, Hash)]
 pub struct RustPath {
@@ -164,9 +164,9 @@ impl ToTokens for ScalarType {
 /// ```
 /// use appell_symbolic::{ConstantForm, RustPath};
 /// // Generic code converts through the scalar trait:
-/// // `<T as ::appell_runtime::Scalar>::from_f64(0.5)`.
+/// // `<T as ::appell_core::Scalar>::from_f64(0.5)`.
 /// let generic = ConstantForm::FromF64 {
-///     scalar_trait: RustPath::absolute(&["appell_runtime", "Scalar"]),
+///     scalar_trait: RustPath::absolute(&["appell_core", "Scalar"]),
 /// };
 /// // Code over plain `f64` writes the literal with its type: `0.5_f64`.
 /// let concrete = ConstantForm::F64Literal;

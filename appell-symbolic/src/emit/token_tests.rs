@@ -70,7 +70,7 @@ fn constants_parentheses_and_negative_literals() {
     let h = g.parse("sin(x) * (-2.5) * y + cos(x)/(x-y)").unwrap();
     let p = Program::lower(&g, &[e, f, h]);
     let t = p.to_tokens(&g, &EmitOptions::default());
-    let from_f64 = |lit: &str| format!("< T as :: appell_runtime :: Scalar > :: from_f64 ({lit})");
+    let from_f64 = |lit: &str| format!("< T as :: appell_core :: Scalar > :: from_f64 ({lit})");
     assert_eq!(
         strings(&t.body),
         [
@@ -125,13 +125,13 @@ fn float_literals_are_built_from_their_value() {
     let (generic, concrete) = (&variants[0], &variants[4]);
     let c = p.to_rust(&g, generic);
     let t = p.to_tokens(&g, generic);
-    let from_f64 = |lit: &str| format!("< T as :: appell_runtime :: Scalar > :: from_f64 ({lit})");
+    let from_f64 = |lit: &str| format!("< T as :: appell_core :: Scalar > :: from_f64 ({lit})");
     assert_eq!(
         c.body,
         [
-            "let kf: T = <T as ::appell_runtime::Scalar>::from_f64(1e-20);",
-            "let kf_2: T = <T as ::appell_runtime::Scalar>::from_f64(2.5);",
-            "let kf_3: T = <T as ::appell_runtime::Scalar>::from_f64(1e20);",
+            "let kf: T = <T as ::appell_core::Scalar>::from_f64(1e-20);",
+            "let kf_2: T = <T as ::appell_core::Scalar>::from_f64(2.5);",
+            "let kf_3: T = <T as ::appell_core::Scalar>::from_f64(1e20);",
         ]
     );
     assert_eq!(

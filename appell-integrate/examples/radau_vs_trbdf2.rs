@@ -6,7 +6,7 @@
 //! 1e-6 and 1e-8 (interpolated log-log between the two runs of the sweep
 //! around it).
 //!
-//! Run with `cargo run --release -p appell-runtime --example radau_vs_trbdf2`.
+//! Run with `cargo run --release -p appell-integrate --example radau_vs_trbdf2`.
 //!
 //! * Van der Pol with μ = 1000 in Hairer & Wanner's scaling (time divided
 //!   by μ, ε = 1/μ² = 1e-6): `y1' = y2`, `ε y2' = (1 − y1²) y2 − y1` from
@@ -15,8 +15,8 @@
 //! * Robertson's chemical kinetics from `(1, 0, 0)` over `[0, 1e5]`,
 //!   `atol = 1e-6 rtol` (y2 is of order 1e-5 … 1e-8).
 
-use appell_runtime::integrate::{IntegrateError, Radau5, TrBdf2};
-use appell_runtime::ModelError;
+use appell_core::ModelError;
+use appell_integrate::{IntegrateError, Radau5, TrBdf2};
 use std::time::Instant;
 
 type R = Result<(), ModelError>;

@@ -1,13 +1,16 @@
+//! # appell-test-models
+//!
 //! Hand-written `Model` implementations with known closed forms, shared by
-//! the integration tests (the derive macro is not used here, so the oracle is
-//! tested against independent hand derivations).
+//! the integration tests of the integrators, the oracle, linearization and
+//! the command line (the derive macro is not used here, so the oracle is
+//! tested against independent hand derivations). Not published.
 //!
 //! Every model's `rhs` implements its closed-form reduced equations; the
 //! kinematic description (`body_poses`, `constraint_rows`, `load_*`) is what
 //! the oracle sees.
 #![allow(dead_code)]
 
-use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 
 /// Rotation about N.z by `a`, row-major, columns are the body axes in N.
 pub fn rot_z<T: Scalar>(a: T) -> [T; 9] {

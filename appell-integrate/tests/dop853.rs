@@ -3,11 +3,9 @@
 //! typed errors, work compared with `Dopri5`, and integration of a
 //! hand-written `Model`.
 
-mod common;
-
-use appell_runtime::integrate::{Dop853, Dopri5, IntegrateError, Stats};
-use appell_runtime::{Model, ModelError};
-use common::*;
+use appell_core::{Model, ModelError};
+use appell_integrate::{Dop853, Dopri5, IntegrateError, Stats};
+use appell_test_models::*;
 use num_dual::Dual64;
 use std::f64::consts::PI;
 

@@ -1,10 +1,8 @@
 //! The model command line, driven through its testable core.
 
-mod common;
-
-use appell_runtime::cli::{bench, info_json, run_with, CliError, Evaluator, BENCH_STATES};
-use appell_runtime::Model;
-use common::*;
+use appell_core::Model;
+use appell_test_models::*;
+use appell_tools::cli::{bench, info_json, run_with, CliError, Evaluator, BENCH_STATES};
 use serde_json::{json, Value};
 
 const PENDULUM: Pendulum = Pendulum {

@@ -1,13 +1,11 @@
 //! The oracle against hand derivations: closed forms, multipliers, the
 //! acceleration-level constraints, energy balance, and errors.
 
-mod common;
-
-use appell_runtime::oracle::{
+use appell_core::{Model, ModelError};
+use appell_dynamics::oracle::{
     accelerations, coordinate_rates, full_dynamics, reduced_rhs, OracleError,
 };
-use appell_runtime::{Model, ModelError};
-use common::*;
+use appell_test_models::*;
 use num_dual::Dual64;
 use std::f64::consts::PI;
 

@@ -1,11 +1,9 @@
 //! Fixed-step RK4 over hand-written models: order of accuracy, exact
 //! solutions, scalar genericity and error reporting.
 
-mod common;
-
-use appell_runtime::integrate::{rk4, rk4_step, rk4_step_fn};
-use appell_runtime::{Model, ModelError};
-use common::*;
+use appell_core::{Model, ModelError};
+use appell_integrate::{rk4, rk4_step, rk4_step_fn};
+use appell_test_models::*;
 use num_dual::Dual64;
 
 const PENDULUM: Pendulum = Pendulum {

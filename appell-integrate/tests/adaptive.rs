@@ -2,14 +2,12 @@
 //! orders of convergence, tolerance proportionality, dense output, events,
 //! typed errors, and integration of a hand-written `Model`.
 
-mod common;
-
-use appell_runtime::integrate::{
+use appell_core::{Model, ModelError};
+use appell_integrate::{
     heun_step, heun_step_fn, midpoint_step, midpoint_step_fn, rk4_step_fn, Dopri5, IntegrateError,
     Stats,
 };
-use appell_runtime::{Model, ModelError};
-use common::*;
+use appell_test_models::*;
 use num_dual::Dual64;
 use std::f64::consts::PI;
 
@@ -548,8 +546,7 @@ fn dopri5_integrates_a_model() {
         .unwrap();
     let p = PENDULUM.prepare::<f64>();
     for (t, x) in out {
-        let r =
-            appell_runtime::integrate::rk4(&PENDULUM, &p, 0.0, &x0, t / 2000.0, 2000, &[]).unwrap();
+        let r = appell_integrate::rk4(&PENDULUM, &p, 0.0, &x0, t / 2000.0, 2000, &[]).unwrap();
         assert!(err2(&x, &r) < 1e-9, "t = {t}: {x:?} vs {r:?}");
     }
 }

@@ -5,17 +5,15 @@
 //!
 //! The timing of Dual64 columns against one DualSVec64 pass is the ignored
 //! test `dual64_vs_dualsvec64_timing`:
-//! `cargo test -p appell-runtime --release --test linearize -- --ignored --nocapture`.
+//! `cargo test -p appell-linearize --release --test linearize -- --ignored --nocapture`.
 
-mod common;
-
-use appell_runtime::linalg::ldlt_solve;
-use appell_runtime::linearize::{
+use appell_core::linalg::ldlt_solve;
+use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
+use appell_linearize::{
     eigenvalues, holonomic_unknowns, linearize, minimal_linearization, solve_holonomic,
     Linearization, LinearizeError,
 };
-use appell_runtime::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
-use common::*;
+use appell_test_models::*;
 use nalgebra::DMatrix;
 use num_dual::DualSVec64;
 use std::f64::consts::PI;
@@ -1107,7 +1105,7 @@ fn eliminated_coordinate_and_fixed_speed_together() {
 /// generated code does for a coupled mass matrix. Unlike generated code, it
 /// calls sin and cos 2N² times (generated code computes each once), which
 /// favours the vector pass: on derived models the two are much closer (see
-/// the `appell_runtime::linearize` documentation).
+/// the `appell_linearize` documentation).
 #[derive(Clone, Copy, Debug)]
 struct Chain<const N: usize, const ROTOR: bool>;
 

@@ -3,10 +3,8 @@
 //! typed errors. The models are hand-written `impl Model`s whose only
 //! meaningful methods are `info`, `prepare` and `rhs`.
 
-use appell_runtime::integrate::{
-    Dopri5, IntegrateError, ProjectionFailed, Radau5, TrBdf2, TrBdf2Stats,
-};
-use appell_runtime::{check_len, Model, ModelError, ModelInfo, OpCounts, Scalar};
+use appell_core::{check_len, Model, ModelError, ModelInfo, OpCounts, Scalar};
+use appell_integrate::{Dopri5, IntegrateError, ProjectionFailed, Radau5, TrBdf2, TrBdf2Stats};
 
 fn unused() -> Result<(), ModelError> {
     Err(ModelError::NonFinite { what: "unused" })
@@ -329,7 +327,7 @@ impl Model for Singular {
 
 const LAMBDA: f64 = 1000.0;
 
-fn dopri5_stiff(tol: f64) -> (f64, appell_runtime::integrate::Stats) {
+fn dopri5_stiff(tol: f64) -> (f64, appell_integrate::Stats) {
     let model = StiffLinear { lambda: LAMBDA };
     let sol = Dopri5::new()
         .rtol(tol)
