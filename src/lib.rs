@@ -102,6 +102,24 @@
 //!
 //! The model language is described in `docs/model-language.md`; every
 //! example in `examples/` gets the model command line ([`cli`]) for free.
+//!
+//! ## Where things are
+//!
+//! [`prelude`] imports the names most programs use. Each group of modules
+//! below is a crate of its own, re-exported here:
+//!
+//! - the interface (`appell-core`, also without `std`): [`Model`],
+//!   [`Scalar`], [`ModelInfo`], [`ModelError`], [`linalg`], [`dual`],
+//!   [`precision`], and with `std` [`DynModel`] ([`dynamic`]);
+//! - the dynamics at one state (`appell-dynamics`): [`oracle`],
+//!   [`constraint_forces`], [`augmented`], [`motion`], [`energy`],
+//!   [`switch`], [`pinocchio`];
+//! - the integrators (`appell-integrate`, the explicit ones also without
+//!   `std`): [`integrate`] (RK4, Heun, midpoint, Dopri5, DOP853, TR-BDF2,
+//!   Radau5), with [`contact_watch`] and [`conditioning`];
+//! - [`linearize`] (`appell-linearize`), [`hybrid`] and [`sliding`]
+//!   (`appell-hybrid`);
+//! - the tools (`appell-tools`): [`cli`], [`animate`], [`accuracy`].
 #![cfg_attr(not(feature = "std"), no_std)]
 #![warn(missing_docs)]
 
