@@ -109,7 +109,7 @@ pub fn energies<M: Model>(
 }
 
 /// [`energies`] of any [`DynModel`] (compiled once for `dyn DynModel`).
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub fn energies_dyn<K: DynModel + ?Sized>(
     model: &K,

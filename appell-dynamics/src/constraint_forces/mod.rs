@@ -265,7 +265,7 @@ fn mat_vec(a: &[f64; 9], v: [f64; 3]) -> [f64; 3] {
 }
 /// Mass-centre acceleration, angular velocity and angular acceleration of
 /// every body along the motion (q̇, q̈), by second-order dual numbers.
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub struct BodyMotion {
     /// Mass-centre positions.
@@ -355,7 +355,7 @@ pub fn contact_forces<M: Model>(
 }
 
 /// [`contact_forces`] of any [`DynModel`] (compiled once for `dyn DynModel`).
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub fn contact_forces_dyn<K: DynModel + ?Sized>(
     model: &K,
@@ -468,7 +468,7 @@ fn rolling_contact(
 
 /// What [`contact_forces_parts`] found on the way: the motion, and each
 /// contact's normal direction where the declaration gives one.
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub struct ContactParts {
     /// q̇.
@@ -492,7 +492,7 @@ pub struct ContactParts {
 /// [`contact_forces_dyn`], with the momentum balances for the normals the
 /// coordinates carry only when `balance` (a caller that has other
 /// unknown forces balances them all together).
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub fn contact_forces_parts<K: DynModel + ?Sized>(
     model: &K,
@@ -778,7 +778,7 @@ fn balance_normals<K: DynModel + ?Sized>(
 /// Σ m a − Σ F (linear) and Σ (r × m a + I α + ω × I ω) − Σ (r × F + L)
 /// (angular), the applied loads and the `known` external forces (point,
 /// force) on the right; zero when those forces are all there is.
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub struct MomentumResidual {
     /// Linear, then angular, N components.
@@ -791,7 +791,7 @@ pub struct MomentumResidual {
 // both callers (balance_normals here, sliding's balance_at) pass the q̇ and motion
 // contact_forces_parts already computed, so nothing is solved twice
 #[allow(clippy::too_many_arguments)]
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub fn momentum_residual<K: DynModel + ?Sized>(
     model: &K,

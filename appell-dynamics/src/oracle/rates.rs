@@ -128,7 +128,7 @@ pub fn reduced_rhs<M: Model>(
 }
 
 /// [`reduced_rhs`] of any [`DynModel`] (compiled once for `dyn DynModel`).
-// Shared with the integrators and the tools; not part of the API.
+// Shared with the crates built on this one; not part of the API.
 #[doc(hidden)]
 pub fn reduced_rhs_dyn<K: DynModel + ?Sized>(
     model: &K,

@@ -415,7 +415,7 @@ impl Radau5 {
 
     /// Whether [`Radau5::jacobian_by_duals`] is set: for drivers that pass
     /// their own Jacobian (the hybrid driver's phases).
-    // Shared with the accuracy sweep and the hybrid driver; not part of the API.
+    // Shared with the hybrid driver; not part of the API.
     #[doc(hidden)]
     pub const fn wants_duals(&self) -> bool {
         self.jacobian_by_duals

@@ -551,7 +551,7 @@ impl Radau5 {
 
     /// [`Radau5::solve_model_at`] of a prepared rhs (the accuracy sweep's,
     /// compiled once for `dyn DynRhs`).
-    // Shared with the accuracy sweep and the hybrid driver; not part of the API.
+    // Shared with the accuracy sweep; not part of the API.
     #[doc(hidden)]
     pub fn solve_prepared_at<R: DynRhs + ?Sized>(
         &self,
