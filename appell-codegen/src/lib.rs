@@ -105,7 +105,7 @@ pub fn expand_with(
     // The full derivation, then each scene's from it (its effects' loads
     // only: kinematics, M and the elimination are shared).
     let derived = model.and_then(|k| derivation::derive_with(&cx, k, options));
-    let tokens = derived.map(|mut d| emit::emit(&mut d, &ast.vis));
+    let tokens = derived.map(|d| emit::emit(&d, &ast.vis));
     match cx.check() {
         Ok(()) => tokens.expect("no errors means a derivation"),
         Err(err) => {

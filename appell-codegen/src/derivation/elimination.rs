@@ -17,7 +17,7 @@ use super::speeds::SpeedDefinitions;
 use super::structure::{structural_solution, unmatched_column};
 use crate::algebra::expanded;
 use crate::ctxt::Ctxt;
-use crate::model::Model;
+use crate::model::{ConstraintSet, Model};
 
 /// The numeric remainder of the elimination, S X = R with X the free
 /// unknowns' rows of [B | b].
@@ -58,12 +58,13 @@ pub struct SolvedRates {
 pub fn eliminate(
     cx: &Ctxt,
     model: &mut Model,
+    set: &ConstraintSet,
     d: &[Id],
     d0: &[Id],
     speeds: &SpeedDefinitions,
 ) -> Result<Option<SolvedRates>, SymbolicError> {
     let n = model.coords.len();
-    let l = model.speed_specs.len();
+    let l = set.speed_specs.len();
     let m = d0.len();
     let dependent = &speeds.dependent;
     let quasi = speeds.quasi;
@@ -88,7 +89,7 @@ pub fn eliminate(
             for &c in dependent {
                 dp.push(d[r * n + c]);
             }
-            for &k in &model.speeds {
+            for &k in &set.speeds {
                 rhs.push(g.neg(d[r * n + k])?);
             }
             rhs.push(g.neg(d0[r])?);
@@ -96,7 +97,7 @@ pub fn eliminate(
     }
     // Quaternion rates in closed form; the rest of the system without them.
     let quaternions = model.quaternions.clone();
-    let norms = unit_norms(g, &quaternions, &model.coords, &model.holonomic)?;
+    let norms = unit_norms(g, &quaternions, &model.coords, &set.holonomic)?;
     let closed = if quasi {
         closed_form_blocks(g, (&quaternions, &norms), dependent, &dp, &rhs, l)?
     } else {
@@ -109,7 +110,7 @@ pub fn eliminate(
     if let Some(col) = unmatched_column(g, &dp, k_unknowns) {
         let name = model.coords[dependent[col]].0.to_string();
         cx.error_spanned_by(
-            &model.speeds_at,
+            &set.speeds_at,
             format!("with these privileged speeds the constraints cannot determine the rate of `{name}`: the dependent block D' is structurally singular; choose other speeds"),
         );
         return Ok(None);
@@ -144,7 +145,7 @@ pub fn eliminate(
         Err(SymbolicError::StructurallySingular { column }) => {
             let name = model.coords[dependent[column]].0.to_string();
             cx.error_spanned_by(
-                &model.speeds_at,
+                &set.speeds_at,
                 format!("with these privileged speeds the constraints cannot determine the rate of `{name}` (D' is singular after elimination); choose other speeds"),
             );
             Ok(None)
@@ -554,13 +555,14 @@ mod tests {
         "#;
         let (mut model, calculus) = testing::model_and_calculus(src);
         let cx = Ctxt::new();
-        let rows = super::super::rows::constraint_rows(&cx, &mut model, &calculus)
+        let set = model.constraints.clone();
+        let rows = super::super::rows::constraint_rows(&cx, &mut model, &set, &calculus)
             .unwrap()
             .unwrap();
-        let speeds = super::super::speeds::speed_definitions(&cx, &mut model, &rows)
+        let speeds = super::super::speeds::speed_definitions(&cx, &mut model, &set, &rows)
             .unwrap()
             .unwrap();
-        let solved = eliminate(&cx, &mut model, &rows.d, &rows.d0, &speeds).unwrap();
+        let solved = eliminate(&cx, &mut model, &set, &rows.d, &rows.d0, &speeds).unwrap();
         assert!(solved.is_none());
         let err = cx.check().expect_err("an error").to_string();
         assert!(err.contains("cannot determine the rate of `z`"), "{err}");

@@ -3,7 +3,7 @@
 //!
 //! | stage | module | input → output |
 //! | --- | --- | --- |
-//! | 1. velocity constraints D q̇ + d = 0 (eq. 25) | [`rows`] | `Model` → [`ConstraintRows`] |
+//! | 1. velocity constraints D q̇ + d = 0 (eq. 25) | [`rows`] | `Model`, [`ConstraintSet`] → [`ConstraintRows`] |
 //! | 2. privileged speeds, u = W q̇ + w | [`speeds`] | rows → [`SpeedDefinitions`] |
 //! | 3. elimination of the unknown rates (eqs. 27-29) | [`elimination`] | D, d, speeds → [`SolvedRates`] |
 //! | 4. q̇ = C ẏ + c (eqs. 30-31) | [`speed_map`] | solved rates → [`SpeedMap`], [`Rates`] |
@@ -29,6 +29,12 @@
 //! [`algebra`](crate::algebra) holds the vector helpers, [`probe`](crate::probe) the
 //! numeric identity and rank tests, [`structure`] the sparsity analysis of
 //! square systems, [`text`] the readable equations.
+//!
+//! The stages take the constraints and privileged speeds they derive
+//! with, a [`ConstraintSet`]: the model's own ([`Model::constraints`]) or
+//! a scene's ([`ConstraintSet::of_scene`]); the [`Derivation`] keeps it
+//! ([`Derivation::constraint_set`]) for the stages after it and the
+//! emitter.
 //!
 //! Every expression lives in the model's one graph, whose node ids follow
 //! construction order and decide the order of terms in sums: the stages run
@@ -178,9 +184,11 @@ pub struct Derivation {
     /// against the closed form's; where they cost less, `equations` holds
     /// them and `closed_form` is false.
     pub projection: Option<Projection>,
-    /// A scene's own constraints and speeds, where they differ from the
-    /// model's (the emitter puts them in place for its implementation).
-    pub own_constraints: Option<ConstraintSet>,
+    /// The constraints and privileged speeds it was derived with: the
+    /// model's, or a scene's own.
+    pub constraint_set: ConstraintSet,
+    /// Whether they are a scene's own, where they differ from the model's.
+    pub own_constraints: bool,
     /// The derivatives of the reduced rhs (stage 14); `None` until the
     /// stage ran.
     pub jacobians: Option<jacobian::Jacobians>,
@@ -249,7 +257,8 @@ pub fn derive(cx: &Ctxt, kinematics: Kinematics) -> Option<Derived> {
 pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Option<Derived> {
     let Kinematics { mut model, twin } = kinematics;
     let scenes_twin = twin.clone();
-    let mut full = complete(cx, &mut model, twin, options)?;
+    let set = model.constraints.clone();
+    let mut full = complete(cx, &mut model, &set, twin, options)?;
     let mut jacobians = jacobian::differentiate(&mut model, &full);
     jacobians.inverse = jacobian::inverse_dynamics(&mut model, &full);
     full.jacobians = Some(jacobians);
@@ -271,21 +280,23 @@ pub fn derive_with(cx: &Ctxt, kinematics: Kinematics, options: &Options) -> Opti
     })
 }
 
-/// Stages 1 to 13 of `model` as it stands (its constraints and speeds);
+/// Stages 1 to 13 of `model` with the constraints and speeds of `set`;
 /// errors go to `cx`.
 fn complete(
     cx: &Ctxt,
     model: &mut Model,
+    set: &ConstraintSet,
     twin: Option<Twin>,
     options: &Options,
 ) -> Option<Derivation> {
-    match Calculus::new(model, twin).and_then(|calculus| stages(cx, model, calculus, options)) {
+    match Calculus::new(model, twin).and_then(|calculus| stages(cx, model, set, calculus, options))
+    {
         Ok(Some(d)) => {
-            let mut d = d.finish(model);
+            let mut d = d.finish(model, set);
             d.structured = if options.closed_form_only {
                 Err(String::new())
             } else {
-                structured_form(model, &d.reduction.ignorable)
+                structured_form(model, set, &d.reduction.ignorable)
             };
             if !options.closed_form_only {
                 if let Err(e) = project(model, &mut d) {
@@ -309,25 +320,30 @@ fn complete(
     }
 }
 
-/// Whether the model as it stands is its plain tree: a scene that holds
+/// Whether the model under `set` is its plain tree: a scene that holds
 /// contacts (or names speeds of its own) makes it a constrained one.
-fn plain_now(model: &Model, spec: &tree_spec::TreeSpec) -> bool {
-    let same_speeds = model.speed_specs.len() == model.declared_speeds.len()
-        && model
+fn plain_under(model: &Model, set: &ConstraintSet, spec: &tree_spec::TreeSpec) -> bool {
+    let own = &model.constraints.speed_specs;
+    let same_speeds = set.speed_specs.len() == own.len()
+        && set
             .speed_specs
             .iter()
-            .zip(&model.declared_speeds)
+            .zip(own)
             .all(|(a, b)| a.name == b.name);
-    spec.plain.is_ok() && model.nonholonomic.is_empty() && same_speeds
+    spec.plain.is_ok() && set.nonholonomic.is_empty() && same_speeds
 }
 
 /// The structured form of a plain tree of joints (stage 13), the
 /// `ignorable` coordinates fixed at zero in its accelerations; else why
 /// there is none.
-fn structured_form(model: &mut Model, ignorable: &[usize]) -> Result<tree::Structured, String> {
+fn structured_form(
+    model: &mut Model,
+    set: &ConstraintSet,
+    ignorable: &[usize],
+) -> Result<tree::Structured, String> {
     let spec = model.tree.clone()?;
     spec.plain.clone()?;
-    if !plain_now(model, &spec) {
+    if !plain_under(model, set, &spec) {
         return Err("the scene holds contacts".into());
     }
     tree::structured(model, &spec, ignorable)
@@ -407,11 +423,11 @@ struct Stages {
 }
 
 impl Stages {
-    fn finish(self, model: &Model) -> Derivation {
+    fn finish(self, model: &Model, set: &ConstraintSet) -> Derivation {
         let mut d = Derivation {
             n: model.coords.len(),
             m: self.constraints.d0.len(),
-            l: model.speed_specs.len(),
+            l: set.speed_specs.len(),
             constraints: self.constraints,
             velocity_residuals: self.velocity_residuals,
             speeds: self.speeds,
@@ -426,7 +442,8 @@ impl Stages {
             text: String::new(),
             structured: Err(String::new()),
             projection: None,
-            own_constraints: None,
+            constraint_set: set.clone(),
+            own_constraints: false,
             jacobians: None,
         };
         d.text = text::equations_text(model, &d);
@@ -438,25 +455,28 @@ impl Stages {
 fn stages(
     cx: &Ctxt,
     model: &mut Model,
+    set: &ConstraintSet,
     mut calculus: Calculus,
     options: &Options,
 ) -> Result<Option<Stages>, SymbolicError> {
-    let Some(constraints) = rows::constraint_rows(cx, model, &calculus)? else {
+    let Some(constraints) = rows::constraint_rows(cx, model, set, &calculus)? else {
         return Ok(None);
     };
-    let Some(speeds) = speeds::speed_definitions(cx, model, &constraints)? else {
+    let Some(speeds) = speeds::speed_definitions(cx, model, set, &constraints)? else {
         return Ok(None);
     };
-    let Some(solved) = elimination::eliminate(cx, model, &constraints.d, &constraints.d0, &speeds)?
+    let Some(solved) =
+        elimination::eliminate(cx, model, set, &constraints.d, &constraints.d0, &speeds)?
     else {
         return Ok(None);
     };
-    let (mut map, mut rates) = speed_map::speed_map(model, &speeds, &solved, &calculus)?;
+    let (mut map, mut rates) = speed_map::speed_map(model, set, &speeds, &solved, &calculus)?;
     let mut elimination = match solved.schur {
         Some(schur) => Elimination::Numeric(numeric::numeric_elimination(
             model,
             schur,
             numeric::NumericInputs {
+                set,
                 rows: &constraints,
                 dependent: &speeds.dependent,
                 map: &map,
@@ -470,25 +490,25 @@ fn stages(
     let large_tree = model.tree.clone().ok().filter(|spec| {
         !options.closed_form_only && tree::moving_links(spec) >= tree::STRUCTURED_ONLY_LINKS
     });
-    let plain = large_tree
-        .as_ref()
-        .filter(|spec| plain_now(model, spec) && matches!(elimination, Elimination::Symbolic));
+    let plain = large_tree.as_ref().filter(|spec| {
+        plain_under(model, set, spec) && matches!(elimination, Elimination::Symbolic)
+    });
     // A large tree whose scene holds contacts: its recursions projected
     // onto the scene's speeds.
     let contacts = large_tree
         .as_ref()
-        .filter(|spec| spec.plain.is_ok() && !plain_now(model, spec));
+        .filter(|spec| spec.plain.is_ok() && !plain_under(model, set, spec));
     let projected = match contacts {
         Some(spec) => {
-            let own = model.declared_speeds.clone();
-            tree::projected::in_speeds(model, spec, &map, &rates.reduced, &own)?
+            let own = model.constraints.speed_specs.clone();
+            tree::projected::in_speeds(model, set, spec, &map, &rates.reduced, &own)?
         }
         None => None,
     };
     let (mut equations, mut energies, folded_lines) = match (plain.cloned(), projected) {
         (Some(spec), _) => {
             let s = tree::controller(model, &spec)?;
-            let (equations, energies) = tree::equations::equations(model, &s)?;
+            let (equations, energies) = tree::equations::equations(model, set, &s)?;
             (equations, energies, None)
         }
         (None, Some(p)) => {

@@ -22,7 +22,7 @@ use super::energies::Energies;
 use super::loads::Equations;
 use super::rows::ConstraintRows;
 use super::speed_map::{Rates, SpeedMap};
-use crate::model::Model;
+use crate::model::{ConstraintSet, Model};
 use crate::probe::same_function;
 
 /// How the dependent speeds are obtained.
@@ -77,6 +77,8 @@ impl NumericElimination {
 
 /// What stage 5 reads besides the Schur complement.
 pub struct NumericInputs<'a> {
+    /// The constraints and speeds derived with.
+    pub set: &'a ConstraintSet,
     /// Stage 1's rows.
     pub rows: &'a ConstraintRows,
     /// The unknowns' coordinates.
@@ -97,18 +99,19 @@ pub fn numeric_elimination(
     uncut: &mut Substitution,
 ) -> Result<NumericElimination, SymbolicError> {
     let NumericInputs {
+        set,
         rows,
         dependent,
         map,
         vanishing,
     } = inputs;
-    let l = model.speed_specs.len();
+    let l = set.speed_specs.len();
     let k = schur.k;
     let k_unknowns = dependent.len();
     let coordinate_rates = model.coordinate_rates();
     let (mut s_mat, mut s_rhs) = (schur.s, schur.r);
     if !schur.row_ops.is_empty() {
-        let speed_cols: Vec<Symbol> = model
+        let speed_cols: Vec<Symbol> = set
             .speeds
             .iter()
             .map(|&sp| model.coords[sp].1.rate)

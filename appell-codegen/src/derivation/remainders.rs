@@ -101,8 +101,8 @@ pub fn remainders(
     let g = &mut model.g;
     let zero = g.int(0)?;
     let mut zero_accels = Substitution::new();
-    for spec in &model.speed_specs {
-        zero_accels.insert(spec.accel, zero);
+    for &accel in &map.accels {
+        zero_accels.insert(accel, zero);
     }
     let mut dependent_remainders = Vec::new();
     for &d in dependent {

@@ -19,7 +19,7 @@ use proc_macro2::TokenStream;
 use super::Calculus;
 use crate::algebra::{cross, dot, expanded, Vec3};
 use crate::ctxt::Ctxt;
-use crate::model::Model;
+use crate::model::{Constraint, ConstraintSet, Model, Rolling};
 use crate::probe::same_function;
 
 pub use appell_core::RowSource;
@@ -74,26 +74,32 @@ struct Row {
 pub fn constraint_rows(
     cx: &Ctxt,
     model: &mut Model,
+    set: &ConstraintSet,
     calculus: &Calculus,
 ) -> Result<Option<ConstraintRows>, SymbolicError> {
-    let (holonomic, mut rows) = holonomic_rows(cx, model, calculus);
-    rows.extend(nonholonomic_rows(model, calculus));
+    let (holonomic, mut rows) = holonomic_rows(cx, model, &set.holonomic, calculus);
+    rows.extend(nonholonomic_rows(&set.nonholonomic, calculus));
     let mut contacts = Vec::new();
-    for contact in 0..model.rolling.len() {
-        let (motion, rolling) = rolling_rows(cx, model, calculus, contact)?;
+    for contact in 0..set.rolling.len() {
+        let (motion, rolling) = rolling_rows(cx, model, calculus, &set.rolling, contact)?;
         contacts.push(motion);
         rows.extend(rolling);
     }
-    complete_contacts(model, calculus, &mut rows, &mut contacts)?;
+    complete_contacts(model, &set.rolling, calculus, &mut rows, &mut contacts)?;
     let out = linear_rows(cx, model, rows, holonomic, contacts);
     Ok(if cx.has_errors() { None } else { Some(out) })
 }
 
 /// The time derivatives of the holonomic constraints.
-fn holonomic_rows(cx: &Ctxt, model: &mut Model, calculus: &Calculus) -> (Vec<Id>, Vec<Row>) {
+fn holonomic_rows(
+    cx: &Ctxt,
+    model: &mut Model,
+    constraints: &[Constraint],
+    calculus: &Calculus,
+) -> (Vec<Id>, Vec<Row>) {
     let mut holonomic = Vec::new();
     let mut rows = Vec::new();
-    for (index, c) in model.holonomic.iter().enumerate() {
+    for (index, c) in constraints.iter().enumerate() {
         holonomic.push(c.residual);
         let bad: Vec<String> = model
             .g
@@ -134,9 +140,9 @@ fn holonomic_rows(cx: &Ctxt, model: &mut Model, calculus: &Calculus) -> (Vec<Id>
 }
 
 /// The nonholonomic constraints, as written.
-fn nonholonomic_rows(model: &Model, calculus: &Calculus) -> Vec<Row> {
+fn nonholonomic_rows(constraints: &[Constraint], calculus: &Calculus) -> Vec<Row> {
     let mut rows = Vec::new();
-    for (index, c) in model.nonholonomic.iter().enumerate() {
+    for (index, c) in constraints.iter().enumerate() {
         let as_written = calculus
             .twin
             .as_ref()
@@ -162,9 +168,10 @@ fn rolling_rows(
     cx: &Ctxt,
     model: &mut Model,
     calculus: &Calculus,
+    rolling: &[Rolling],
     contact: usize,
 ) -> Result<(ContactMotion, Vec<Row>), SymbolicError> {
-    let r = &model.rolling[contact];
+    let r = &rolling[contact];
     let body = &model.bodies[r.body];
     let omega = model.frames[body.frame.expect("rigid")].omega;
     let g = &mut model.g;
@@ -271,12 +278,13 @@ fn rolling_rows(
 /// lowest of the rim) completes the contact.
 fn complete_contacts(
     model: &mut Model,
+    rolling: &[Rolling],
     calculus: &Calculus,
     rows: &mut [Row],
     contacts: &mut [ContactMotion],
 ) -> Result<(), SymbolicError> {
     for row in rows.iter_mut().filter(|r| r.holonomic) {
-        for (contact, r) in model.rolling.iter().enumerate() {
+        for (contact, r) in rolling.iter().enumerate() {
             let Some([d0, d1]) = r.along.as_deref() else {
                 continue;
             };
@@ -423,7 +431,8 @@ mod tests {
     fn rows_of(src: &str) -> (Model, ConstraintRows) {
         let (mut model, calculus) = testing::model_and_calculus(src);
         let cx = Ctxt::new();
-        let rows = constraint_rows(&cx, &mut model, &calculus)
+        let set = model.constraints.clone();
+        let rows = constraint_rows(&cx, &mut model, &set, &calculus)
             .expect("rows")
             .expect("no errors");
         cx.check().expect("no errors");
@@ -494,7 +503,8 @@ mod tests {
             "#,
         );
         let cx = Ctxt::new();
-        let rows = constraint_rows(&cx, &mut model, &calculus).expect("no engine error");
+        let set = model.constraints.clone();
+        let rows = constraint_rows(&cx, &mut model, &set, &calculus).expect("no engine error");
         assert!(rows.is_none());
         let err = cx.check().expect_err("an error").to_string();
         assert!(
@@ -537,7 +547,8 @@ mod tests {
             "#,
         );
         let cx = Ctxt::new();
-        let out = constraint_rows(&cx, &mut model, &calculus);
+        let set = model.constraints.clone();
+        let out = constraint_rows(&cx, &mut model, &set, &calculus);
         assert!(out.is_err() || cx.has_errors());
         let _ = cx.check();
     }

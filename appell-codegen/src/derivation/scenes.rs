@@ -100,7 +100,8 @@ fn scene_derivation(
         },
         structured: Err("a scene uses the closed form".into()),
         projection: None,
-        own_constraints: None,
+        constraint_set: full.constraint_set.clone(),
+        own_constraints: full.own_constraints,
         closed_form: full.closed_form,
         energies: Energies {
             kinetic: full.energies.kinetic,
@@ -121,8 +122,8 @@ fn scene_derivation(
 
 /// Derives `scene`, which leaves some of the model's constraints out or
 /// names its own speeds: stages 1 to 13 again with its constraints and
-/// speeds in place of the model's (and the twin's constraints likewise),
-/// then its effects' loads as for any scene. The model is left as it was.
+/// speeds ([`ConstraintSet::of_scene`]) instead of the model's (and the
+/// twin's constraints likewise), then its effects' loads as for any scene.
 pub fn derive_constrained_scene(
     cx: &Ctxt,
     model: &mut Model,
@@ -130,15 +131,13 @@ pub fn derive_constrained_scene(
     scene: &Scene,
     options: &Options,
 ) -> Option<Derivation> {
-    let mut own = ConstraintSet::of_scene(model, scene)?;
+    let own = ConstraintSet::of_scene(model, scene)?;
     let twin = twin.map(|t| own.twin(t, scene));
     // The scene's own errors, each named with the scene (and not mistaken
     // for an earlier scene's by the stages' checks).
     let scene_cx = Ctxt::new();
-    own.swap(model);
-    let d = complete(&scene_cx, model, twin, options)
+    let d = complete(&scene_cx, model, &own, twin, options)
         .and_then(|full| derive_scene(&scene_cx, model, &full, scene));
-    own.swap(model);
     match scene_cx.check() {
         Err(errors) => {
             for e in errors {
@@ -155,7 +154,7 @@ pub fn derive_constrained_scene(
         Ok(()) => {}
     }
     d.map(|mut d| {
-        d.own_constraints = Some(own);
+        d.own_constraints = true;
         d
     })
 }
@@ -201,7 +200,7 @@ mod tests {
         let (full, (_, sliding)) = (&derived.full, &derived.scenes[0]);
         assert_eq!((full.m, full.l), (1, 1));
         assert_eq!((sliding.m, sliding.l), (0, 2));
-        assert!(sliding.own_constraints.is_some());
+        assert!(sliding.own_constraints);
         let mut g = derived.model.g.clone();
         assert_agrees(&mut g, sliding.equations.mass[0], "m");
         assert_agrees(&mut g, sliding.equations.mass[3], "j");
@@ -209,7 +208,10 @@ mod tests {
         assert_agrees(&mut g, sliding.equations.forcing[1], "0");
         // The model is left with its own constraint and speed.
         assert_eq!(
-            (derived.model.rolling.len(), derived.model.speed_specs.len()),
+            (
+                derived.model.constraints.rolling.len(),
+                derived.model.constraints.speed_specs.len()
+            ),
             (1, 1)
         );
     }

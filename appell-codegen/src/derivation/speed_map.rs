@@ -18,7 +18,7 @@ use appell_symbolic::{Id, RateRules, Substitution, Symbol, SymbolicError};
 use super::elimination::SolvedRates;
 use super::speeds::SpeedDefinitions;
 use super::Calculus;
-use crate::model::Model;
+use crate::model::{ConstraintSet, Model};
 
 /// C, c and q̇ = C ẏ + c.
 #[derive(Clone)]
@@ -48,19 +48,20 @@ pub struct Rates {
 /// Stage 4.
 pub fn speed_map(
     model: &mut Model,
+    set: &ConstraintSet,
     speeds: &SpeedDefinitions,
     solved: &SolvedRates,
     calculus: &Calculus,
 ) -> Result<(SpeedMap, Rates), SymbolicError> {
     let n = model.coords.len();
-    let l = model.speed_specs.len();
+    let l = set.speed_specs.len();
     let g = &mut model.g;
     let zero = g.int(0)?;
     let one = g.int(1)?;
     let mut c = vec![zero; n * l];
     let mut c0 = vec![zero; n];
     if !speeds.quasi {
-        for (k, &s) in model.speeds.iter().enumerate() {
+        for (k, &s) in set.speeds.iter().enumerate() {
             c[s * l + k] = one;
         }
     }
@@ -70,8 +71,8 @@ pub fn speed_map(
         }
         c0[r] = solved.x[i * (l + 1) + l];
     }
-    let speed_rates: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
-    let accels: Vec<Symbol> = model.speed_specs.iter().map(|s| s.accel).collect();
+    let speed_rates: Vec<Symbol> = set.speed_specs.iter().map(|s| s.symbol).collect();
+    let accels: Vec<Symbol> = set.speed_specs.iter().map(|s| s.accel).collect();
     let mut qdot = Vec::with_capacity(n);
     for r in 0..n {
         let mut terms = vec![c0[r]];
@@ -86,7 +87,7 @@ pub fn speed_map(
     for (r, (_, coord)) in model.coords.iter().enumerate() {
         reduced = reduced.with(coord.q, qdot[r]);
     }
-    for spec in model.speed_specs.iter().filter(|s| s.definition.is_some()) {
+    for spec in set.speed_specs.iter().filter(|s| s.definition.is_some()) {
         let a = g.sym(spec.accel)?;
         reduced = reduced.with(spec.symbol, a);
     }

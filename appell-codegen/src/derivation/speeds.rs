@@ -12,7 +12,7 @@ use appell_symbolic::{Id, SymbolKind, SymbolicError};
 
 use super::rows::ConstraintRows;
 use crate::ctxt::Ctxt;
-use crate::model::{Model, SpeedSpec};
+use crate::model::{Constraint, ConstraintSet, Model, SpeedSpec};
 use crate::probe::dependent_row;
 use appell_core::RowSource;
 
@@ -33,7 +33,12 @@ pub struct SpeedDefinitions {
 /// What to say of a constraint row that the others already imply. Two
 /// rolling contacts are the likely case: wheels on one axle each told not
 /// to slip sideways give the same row twice.
-fn dependent_row_message(model: &Model, rows: &ConstraintRows, row: usize) -> String {
+fn dependent_row_message(
+    model: &Model,
+    set: &ConstraintSet,
+    rows: &ConstraintRows,
+    row: usize,
+) -> String {
     let plain = "this constraint row is a linear combination of the others (the velocity constraints are linearly dependent); drop it, or give a rolling contact `along = [...]` directions";
     let RowSource::Rolling { contact, .. } = rows.sources[row] else {
         return plain.to_string();
@@ -44,7 +49,7 @@ fn dependent_row_message(model: &Model, rows: &ConstraintRows, row: usize) -> St
     if !others {
         return plain.to_string();
     }
-    let body = &model.bodies[model.rolling[contact].body].name;
+    let body = &model.bodies[set.rolling[contact].body].name;
     format!(
         "this row of `{body}`'s rolling contact is a linear combination of the other contacts' rows (the velocity constraints are linearly dependent): wheels on one axle share the row that keeps the axle from sliding sideways; keep it on one wheel and give this one only its rolling direction, e.g. `along = [A.x]` with A.x the direction the wheel rolls along"
     )
@@ -54,23 +59,24 @@ fn dependent_row_message(model: &Model, rows: &ConstraintRows, row: usize) -> St
 pub fn speed_definitions(
     cx: &Ctxt,
     model: &mut Model,
+    set: &ConstraintSet,
     rows: &ConstraintRows,
 ) -> Result<Option<SpeedDefinitions>, SymbolicError> {
     let n = model.coords.len();
     let m = rows.d0.len();
-    let l = model.speed_specs.len();
-    let quasi = model.speed_specs.iter().any(|s| s.definition.is_some());
+    let l = set.speed_specs.len();
+    let quasi = set.speed_specs.iter().any(|s| s.definition.is_some());
     let (zero, one) = (model.g.int(0)?, model.g.int(1)?);
     let mut w = Vec::with_capacity(l * n);
     let mut w0 = Vec::with_capacity(l);
-    for spec in model.speed_specs.clone() {
+    for spec in set.speed_specs.clone() {
         match (spec.coordinate, spec.definition) {
             (Some(r), _) => {
                 w.extend((0..n).map(|c| if c == r { one } else { zero }));
                 w0.push(zero);
             }
             (None, Some(def)) => {
-                if let Some((row, rest)) = quasi_velocity_row(cx, model, &spec, def) {
+                if let Some((row, rest)) = quasi_velocity_row(cx, model, set, &spec, def) {
                     w.extend(row);
                     w0.push(rest);
                 }
@@ -82,12 +88,12 @@ pub fn speed_definitions(
         return Ok(None);
     }
     if let Some(row) = dependent_row(&model.g, &rows.d, n, m) {
-        cx.error_spanned_by(&rows.at[row], dependent_row_message(model, rows, row));
+        cx.error_spanned_by(&rows.at[row], dependent_row_message(model, set, rows, row));
         return Ok(None);
     }
     if m >= n {
         cx.error_spanned_by(
-            &model.speeds_at,
+            &set.speeds_at,
             format!(
                 "the model has no degree of freedom: its {m} velocity constraint(s) fix all {n} coordinate(s), so no speed is independent and nothing moves; drop a constraint or add a coordinate"
             ),
@@ -96,7 +102,7 @@ pub fn speed_definitions(
     }
     if !model.speeds_declared {
         cx.error_spanned_by(
-            &model.speeds_at,
+            &set.speeds_at,
             format!(
                 "the model declares no `speeds(...)`: its {m} velocity constraint(s) on {n} coordinates leave {} independent speed(s); name the coordinates whose rates they are",
                 n - m
@@ -114,7 +120,7 @@ pub fn speed_definitions(
             )
         };
         cx.error_spanned_by(
-            &model.speeds_at,
+            &set.speeds_at,
             format!(
                 "{l} privileged speed(s) with {m} velocity constraint(s) on {n} coordinates: the constraints leave {} independent speed(s), so `speeds(...)` must name {}{joints}",
                 n.saturating_sub(m),
@@ -127,9 +133,9 @@ pub fn speed_definitions(
         let mut full = rows.d.clone();
         full.extend(&w);
         if let Some(row) = dependent_row(&model.g, &full, n, n) {
-            let name = &model.speed_specs[row.saturating_sub(m).min(l - 1)].name;
+            let name = &set.speed_specs[row.saturating_sub(m).min(l - 1)].name;
             cx.error_spanned_by(
-                &model.speeds_at,
+                &set.speeds_at,
                 format!("the speeds' definitions are not invertible: with the constraints they do not determine the coordinate rates ([D; W] is singular; `{name}` depends on the others)"),
             );
             return Ok(None);
@@ -138,9 +144,9 @@ pub fn speed_definitions(
     let dependent: Vec<usize> = if quasi {
         (0..n).collect()
     } else {
-        (0..n).filter(|i| !model.speeds.contains(i)).collect()
+        (0..n).filter(|i| !set.speeds.contains(i)).collect()
     };
-    check_holonomic_involve_dependent(cx, model, &dependent);
+    check_holonomic_involve_dependent(cx, model, &set.holonomic, &dependent);
     if cx.has_errors() {
         return Ok(None);
     }
@@ -157,6 +163,7 @@ pub fn speed_definitions(
 fn quasi_velocity_row(
     cx: &Ctxt,
     model: &mut Model,
+    set: &ConstraintSet,
     spec: &SpeedSpec,
     def: Id,
 ) -> Option<(Vec<Id>, Id)> {
@@ -175,7 +182,7 @@ fn quasi_velocity_row(
         .collect();
     if !bad.is_empty() {
         cx.error_spanned_by(
-            &model.speeds_at,
+            &set.speeds_at,
             format!(
                 "the quasi-velocity `{}` cannot depend on {}; to prescribe a speed by an input, write it as a constraint (`nonholonomic(dt(q) == input)`) and leave that rate out of `speeds(...)`",
                 spec.name,
@@ -188,7 +195,7 @@ fn quasi_velocity_row(
         Ok(form) => {
             if form.coefficients.iter().all(|c| model.g.is_zero(*c)) {
                 cx.error_spanned_by(
-                    &model.speeds_at,
+                    &set.speeds_at,
                     format!(
                         "the quasi-velocity `{}` involves no coordinate rate",
                         spec.name
@@ -200,13 +207,13 @@ fn quasi_velocity_row(
         }
         Err(SymbolicError::NonLinear { symbol, .. }) => {
             cx.error_spanned_by(
-                &model.speeds_at,
+                &set.speeds_at,
                 format!("the quasi-velocity `{}` must be linear in the coordinate rates (Method III), and it is not linear in `{symbol}`", spec.name),
             );
             None
         }
         Err(e) => {
-            cx.error_spanned_by(&model.speeds_at, e);
+            cx.error_spanned_by(&set.speeds_at, e);
             None
         }
     }
@@ -214,8 +221,13 @@ fn quasi_velocity_row(
 
 /// A holonomic constraint among privileged coordinates only would restrict
 /// the privileged speeds, which must stay independent.
-fn check_holonomic_involve_dependent(cx: &Ctxt, model: &Model, dependent: &[usize]) {
-    for c in &model.holonomic {
+fn check_holonomic_involve_dependent(
+    cx: &Ctxt,
+    model: &Model,
+    holonomic: &[Constraint],
+    dependent: &[usize],
+) {
+    for c in holonomic {
         let involves_dependent = dependent
             .iter()
             .any(|&i| model.g.depends_on(c.residual, model.coords[i].1.q));
@@ -237,10 +249,11 @@ mod tests {
     fn definitions(src: &str) -> (Model, Option<SpeedDefinitions>, Result<(), String>) {
         let (mut model, calculus) = testing::model_and_calculus(src);
         let cx = Ctxt::new();
-        let rows = constraint_rows(&cx, &mut model, &calculus)
+        let set = model.constraints.clone();
+        let rows = constraint_rows(&cx, &mut model, &set, &calculus)
             .expect("rows")
             .expect("no errors");
-        let speeds = speed_definitions(&cx, &mut model, &rows).expect("no engine error");
+        let speeds = speed_definitions(&cx, &mut model, &set, &rows).expect("no engine error");
         let checked = cx.check().map_err(|e| e.to_string());
         (model, speeds, checked)
     }

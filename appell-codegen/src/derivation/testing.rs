@@ -144,13 +144,14 @@ pub fn solve(
 ) {
     let (mut model, calculus) = model_and_calculus(src);
     let cx = Ctxt::new();
-    let rows = rows::constraint_rows(&cx, &mut model, &calculus)
+    let set = model.constraints.clone();
+    let rows = rows::constraint_rows(&cx, &mut model, &set, &calculus)
         .expect("rows")
         .expect("no errors");
-    let speeds = speeds::speed_definitions(&cx, &mut model, &rows)
+    let speeds = speeds::speed_definitions(&cx, &mut model, &set, &rows)
         .expect("speeds")
         .expect("no errors");
-    let solved = elimination::eliminate(&cx, &mut model, &rows.d, &rows.d0, &speeds)
+    let solved = elimination::eliminate(&cx, &mut model, &set, &rows.d, &rows.d0, &speeds)
         .expect("elimination")
         .expect("no errors");
     cx.check().expect("no errors");
@@ -160,14 +161,16 @@ pub fn solve(
 /// Stages 1 to 5 of `src`.
 pub fn run(src: &str) -> Run {
     let (mut model, mut calculus, rows, speeds, solved) = solve(src);
+    let set = model.constraints.clone();
     let (map, mut rates) =
-        speed_map::speed_map(&mut model, &speeds, &solved, &calculus).expect("speed map");
+        speed_map::speed_map(&mut model, &set, &speeds, &solved, &calculus).expect("speed map");
     let elimination = match solved.schur {
         Some(schur) => Elimination::Numeric(
             numeric::numeric_elimination(
                 &mut model,
                 schur,
                 NumericInputs {
+                    set: &set,
                     rows: &rows,
                     dependent: &speeds.dependent,
                     map: &map,

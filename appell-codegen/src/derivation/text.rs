@@ -49,13 +49,14 @@ pub fn equations_text(model: &Model, d: &Derivation) -> String {
         "coordinates q: {}",
         (0..d.n).map(name).collect::<Vec<_>>().join(", ")
     );
-    let speeds: Vec<String> = model
+    let speeds: Vec<String> = d
+        .constraint_set
         .speed_specs
         .iter()
         .map(|sp| g.symbol_name(sp.symbol).to_string())
         .collect();
     let _ = writeln!(s, "privileged speeds: {}", speeds.join(", "));
-    for (k, sp) in model.speed_specs.iter().enumerate() {
+    for (k, sp) in d.constraint_set.speed_specs.iter().enumerate() {
         if let Some(def) = sp.definition {
             let _ = writeln!(s, "  {} = {} (quasi-velocity)", speeds[k], show(def));
         }
@@ -132,7 +133,8 @@ fn dependent_speeds(s: &mut String, model: &Model, d: &Derivation, speeds: &[Str
 /// counted on one line, not listed: a large tree's M has hundreds of them.
 fn mass_and_forcing(s: &mut String, model: &Model, d: &Derivation, speeds: &[String]) {
     let g = &model.g;
-    let accels: Vec<String> = model
+    let accels: Vec<String> = d
+        .constraint_set
         .speed_specs
         .iter()
         .map(|sp| g.symbol_name(sp.accel).to_string())

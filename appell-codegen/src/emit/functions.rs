@@ -644,7 +644,11 @@ impl Emitter<'_> {
         let chk = |arg: &str, len: usize| self.check(arg, len);
         let chk_q = chk("__q", n);
         let (forces, torques) = (self.forces(), self.torques());
-        let (nf, nt, nc) = (forces.len(), torques.len(), model.rolling.len());
+        let (nf, nt, nc) = (
+            forces.len(),
+            torques.len(),
+            self.d.constraint_set.rolling.len(),
+        );
         let (zero, identity) = unit_entries(model);
         let mut geo_roots = Vec::new();
         for f in &forces {
@@ -674,15 +678,17 @@ impl Emitter<'_> {
         );
         // Contact points, then the direction of every rolling row.
         let mut contact_roots = Vec::new();
-        for r in &model.rolling {
+        for r in &self.d.constraint_set.rolling {
             contact_roots.extend(r.contact);
         }
         for src in &d.constraints.sources {
             match *src {
-                RowSource::Rolling { contact, direction } => match &model.rolling[contact].along {
-                    Some(dirs) => contact_roots.extend(dirs[direction]),
-                    None => contact_roots.extend(identity[direction]),
-                },
+                RowSource::Rolling { contact, direction } => {
+                    match &self.d.constraint_set.rolling[contact].along {
+                        Some(dirs) => contact_roots.extend(dirs[direction]),
+                        None => contact_roots.extend(identity[direction]),
+                    }
+                }
                 _ => contact_roots.extend([zero; 3]),
             }
         }
@@ -734,7 +740,7 @@ impl Emitter<'_> {
             .iter()
             .map(|&r| self.coord(r).to_string())
             .collect();
-        names.extend(model.speed_specs.iter().map(|sp| {
+        names.extend(self.d.constraint_set.speed_specs.iter().map(|sp| {
             let name = self.model.g.symbol_name(sp.symbol).to_string();
             match sp.coordinate {
                 Some(_) => name,

@@ -33,14 +33,21 @@ impl Emitter<'_> {
             quote!(#p::BodyInfo { name: #name, rigid: #rigid })
         });
         let row_sources = self.row_sources();
-        let contacts = model.rolling.iter().map(|r| {
+        let contacts = self.d.constraint_set.rolling.iter().map(|r| {
             let (body, point, along) = (int(r.body), &r.point, r.along.is_some());
             quote!(#p::ContactInfo { body: #body, point: #point, along: #along })
         });
         let name = self.info_name();
         let params = strings(model.params.iter().map(|p| p.ident.to_string()).collect());
         let all = names(&(0..d.n).collect::<Vec<_>>());
-        let speeds = strings(model.speed_specs.iter().map(|sp| sp.name.clone()).collect());
+        let speeds = strings(
+            self.d
+                .constraint_set
+                .speed_specs
+                .iter()
+                .map(|sp| sp.name.clone())
+                .collect(),
+        );
         let dependent = names(&d.speeds.dependent);
         let cyclic = names(&d.reduction.cyclic);
         let ignorable = names(&d.reduction.ignorable);
@@ -120,11 +127,15 @@ impl Emitter<'_> {
             .iter()
             .zip(&d.constraints.at)
             .map(|(r, at)| match *r {
-                RowSource::Holonomic { index } if driven(model.holonomic[index].residual) => {
+                RowSource::Holonomic { index }
+                    if driven(self.d.constraint_set.holonomic[index].residual) =>
+                {
                     let (i, c) = (int(index), label("holonomic", at));
                     quote!(#p::RowSource::Driven { holonomic: true, index: #i, constraint: #c })
                 }
-                RowSource::Nonholonomic { index } if driven(model.nonholonomic[index].residual) => {
+                RowSource::Nonholonomic { index }
+                    if driven(self.d.constraint_set.nonholonomic[index].residual) =>
+                {
                     let (i, c) = (int(index), label("nonholonomic", at));
                     quote!(#p::RowSource::Driven { holonomic: false, index: #i, constraint: #c })
                 }

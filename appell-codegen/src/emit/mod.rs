@@ -186,10 +186,16 @@ impl Emitter<'_> {
     fn bind_u(&self, slice: &str) -> TokenStream {
         let slice = self.ident(slice);
         let g = &self.model.g;
-        let binds = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
-            let (u, k) = (self.ident(g.symbol_name(spec.symbol)), int(k));
-            quote!(let #u = #slice[#k];)
-        });
+        let binds = self
+            .d
+            .constraint_set
+            .speed_specs
+            .iter()
+            .enumerate()
+            .map(|(k, spec)| {
+                let (u, k) = (self.ident(g.symbol_name(spec.symbol)), int(k));
+                quote!(let #u = #slice[#k];)
+            });
         quote!(#(#binds)*)
     }
 
@@ -202,13 +208,19 @@ impl Emitter<'_> {
             let (q, k) = (self.coord(r), int(k));
             quote!(let #q = __state[#k];)
         });
-        let state_u = self.model.speed_specs.iter().enumerate().map(|(k, spec)| {
-            let (u, k) = (
-                self.ident(g.symbol_name(spec.symbol)),
-                int(retained.len() + k),
-            );
-            quote!(let #u = __state[#k];)
-        });
+        let state_u = self
+            .d
+            .constraint_set
+            .speed_specs
+            .iter()
+            .enumerate()
+            .map(|(k, spec)| {
+                let (u, k) = (
+                    self.ident(g.symbol_name(spec.symbol)),
+                    int(retained.len() + k),
+                );
+                quote!(let #u = __state[#k];)
+            });
         quote!(#(#state_q)* #(#state_u)*)
     }
 
@@ -251,21 +263,12 @@ fn camel(s: &str) -> String {
 /// The `Model` implementations: the full model's, and one per scene on a
 /// generated newtype (`{Model}{Scene}(pub Model)`), all in one `const _`
 /// block; the scene types are declared beside the struct.
-pub fn emit(derived: &mut Derived, vis: &syn::Visibility) -> TokenStream {
+pub fn emit(derived: &Derived, vis: &syn::Visibility) -> TokenStream {
     let p = p();
     let mut body = full_implementation(derived);
     let mut decls = TokenStream::new();
     for k in 0..derived.scenes.len() {
-        // A scene with constraints or speeds of its own is emitted with
-        // them in the model's place.
-        let mut own = derived.scenes[k].1.own_constraints.clone();
-        if let Some(o) = own.as_mut() {
-            o.swap(&mut derived.model);
-        }
         let (decl, implementation) = scene_implementation(derived, k, vis);
-        if let Some(o) = own.as_mut() {
-            o.swap(&mut derived.model);
-        }
         decls.extend(decl);
         body.extend(implementation);
     }

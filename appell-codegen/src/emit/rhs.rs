@@ -91,7 +91,7 @@ impl Emitter<'_> {
             // A large tree's scene: M and f from the tree's recursions, for
             // a scene that holds contacts in the tree's own speeds and
             // projected onto the scene's.
-            let form = if self.d.own_constraints.is_some() {
+            let form = if self.d.own_constraints {
                 format!("structured: M by the composite-rigid-body algorithm and f by recursive Newton–Euler over the joint tree, in its own speeds and projected onto the scene's (the dependent joints' rates from the scene's constraints), {flat_total} operations per call")
             } else {
                 format!("structured: M by the composite-rigid-body algorithm and f by recursive Newton–Euler over the joint tree, solved by LDLᵀ, {flat_total} operations per call")

@@ -6,7 +6,7 @@ use syn::Ident;
 
 use appell_symbolic::{Coordinate, Graph, Id, RateRules, Symbol, SymbolKind, SymbolicError};
 
-use super::{Cut, Frame, Mat3, Model, Param, Point, SpeedSpec, Vec3};
+use super::{ConstraintSet, Cut, Frame, Mat3, Model, Param, Point, SpeedSpec, Vec3};
 use crate::ast::*;
 use crate::ctxt::{did_you_mean, Ctxt};
 
@@ -100,10 +100,14 @@ pub(super) fn build_in(
         name: ast.name.clone(),
         params: b.params,
         coords: b.coords,
-        speeds,
-        declared_speeds: speed_specs.clone(),
-        speed_specs,
-        speeds_at,
+        constraints: ConstraintSet {
+            holonomic,
+            nonholonomic,
+            rolling,
+            speeds,
+            speed_specs,
+            speeds_at,
+        },
         speeds_declared: ast.speeds.is_some(),
         inputs: b.inputs,
         input_rates,
@@ -111,9 +115,6 @@ pub(super) fn build_in(
         frames: b.frames,
         points: b.points,
         bodies,
-        holonomic,
-        nonholonomic,
-        rolling,
         contacts,
         joint_limits: ast.joint_limits.clone(),
         forces: loads.forces,

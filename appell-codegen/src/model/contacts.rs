@@ -277,7 +277,7 @@ mod tests {
         // The rows are the foot's velocity along N's axes; the model
         // itself holds none of them.
         assert_eq!(model.contacts[0].rows.len(), 3);
-        assert!(model.nonholonomic.is_empty());
+        assert!(model.constraints.nonholonomic.is_empty());
         // j3, j2 and j1 pitch about parallel axes: the foot's sideways
         // row needs the roll j0, and j1 keeps its speed.
         let (speeds, _) = model.scenes[0].speeds.clone().expect("speeds");

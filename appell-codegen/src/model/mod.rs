@@ -184,9 +184,10 @@ impl Scene {
     }
 }
 
-/// The constraints and privileged speeds a scene is derived with, where
-/// they differ from the model's: its constraints are those without an
-/// effect or of an effect it names, its speeds its own `speeds(...)`.
+/// The constraints and privileged speeds a derivation takes: the model's
+/// own ([`Model::constraints`]), or a scene's where they differ from the
+/// model's (its constraints are those without an effect or of an effect
+/// it names, its speeds its own `speeds(...)`).
 #[derive(Clone)]
 pub struct ConstraintSet {
     /// Holonomic constraints.
@@ -199,7 +200,7 @@ pub struct ConstraintSet {
     pub speeds: Vec<usize>,
     /// The privileged speeds.
     pub speed_specs: Vec<SpeedSpec>,
-    /// The tokens of the scene's `speeds(...)`, for errors.
+    /// The tokens of the `speeds(...)` they come from, for errors.
     pub speeds_at: proc_macro2::TokenStream,
 }
 
@@ -207,29 +208,30 @@ impl ConstraintSet {
     /// `scene`'s constraints and speeds, or None when they are the model's.
     pub fn of_scene(model: &Model, scene: &Scene) -> Option<ConstraintSet> {
         let keeps = |e: &Option<String>| scene.keeps_constraint(e);
-        let drops = model
+        let own = &model.constraints;
+        let drops = own
             .holonomic
             .iter()
-            .chain(&model.nonholonomic)
+            .chain(&own.nonholonomic)
             .any(|c| !keeps(&c.effect))
-            || model.rolling.iter().any(|r| !keeps(&r.effect));
+            || own.rolling.iter().any(|r| !keeps(&r.effect));
         if !drops && scene.speeds.is_none() && scene.contacts(&model.contacts).is_empty() {
             return None;
         }
         let (speed_specs, speeds_at) = scene
             .speeds
             .clone()
-            .unwrap_or_else(|| (model.speed_specs.clone(), model.speeds_at.clone()));
+            .unwrap_or_else(|| (own.speed_specs.clone(), own.speeds_at.clone()));
         let kept = |list: &[Constraint]| -> Vec<Constraint> {
             list.iter().filter(|c| keeps(&c.effect)).cloned().collect()
         };
         Some(ConstraintSet {
-            holonomic: kept(&model.holonomic),
-            nonholonomic: kept(&model.nonholonomic)
+            holonomic: kept(&own.holonomic),
+            nonholonomic: kept(&own.nonholonomic)
                 .into_iter()
                 .chain(held_rows(&model.contacts, scene))
                 .collect(),
-            rolling: model
+            rolling: own
                 .rolling
                 .iter()
                 .filter(|r| keeps(&r.effect))
@@ -239,17 +241,6 @@ impl ConstraintSet {
             speed_specs,
             speeds_at,
         })
-    }
-
-    /// Exchanges these constraints and speeds with `model`'s: once to
-    /// derive or emit the scene, once more to restore the model.
-    pub fn swap(&mut self, model: &mut Model) {
-        std::mem::swap(&mut self.holonomic, &mut model.holonomic);
-        std::mem::swap(&mut self.nonholonomic, &mut model.nonholonomic);
-        std::mem::swap(&mut self.rolling, &mut model.rolling);
-        std::mem::swap(&mut self.speeds, &mut model.speeds);
-        std::mem::swap(&mut self.speed_specs, &mut model.speed_specs);
-        std::mem::swap(&mut self.speeds_at, &mut model.speeds_at);
     }
 
     /// `twin` with `scene`'s constraints only.
@@ -304,16 +295,10 @@ pub struct Model {
     pub params: Vec<Param>,
     /// Coordinates in declaration order.
     pub coords: Vec<(Ident, Coordinate)>,
-    /// Indices (into `coords`) of the coordinates whose rates are privileged
-    /// speeds (Method II).
-    pub speeds: Vec<usize>,
-    /// All privileged speeds, in order.
-    pub speed_specs: Vec<SpeedSpec>,
-    /// The model's own privileged speeds, which a scene's derivation does
-    /// not swap: a tree's recursions run in them.
-    pub declared_speeds: Vec<SpeedSpec>,
-    /// The tokens of `speeds(...)`, for errors.
-    pub speeds_at: proc_macro2::TokenStream,
+    /// The model's own constraints and privileged speeds: the set the
+    /// full derivation takes, and the one a tree's recursions run in (a
+    /// scene takes its own, [`ConstraintSet::of_scene`]).
+    pub constraints: ConstraintSet,
     /// Whether the model names its speeds (`speeds(...)` or joints); the
     /// speeds stage says what to name when it does not.
     pub speeds_declared: bool,
@@ -332,12 +317,6 @@ pub struct Model {
     pub points: Vec<Point>,
     /// Bodies and particles.
     pub bodies: Vec<Body>,
-    /// Holonomic constraints f(q, t) = 0.
-    pub holonomic: Vec<Constraint>,
-    /// Nonholonomic constraints, linear in the rates.
-    pub nonholonomic: Vec<Constraint>,
-    /// Rolling contacts.
-    pub rolling: Vec<Rolling>,
     /// `contact(...)`s: held only in the scenes that name their effects.
     pub contacts: Vec<Contact>,
     /// The URDF's joint limits: joint, lower, upper, velocity, effort.
@@ -491,9 +470,9 @@ pub fn build(cx: &Ctxt, ast: &ModelAst) -> Option<Kinematics> {
             Some(Twin {
                 frames: t.frames,
                 bodies: t.bodies,
-                holonomic: t.holonomic,
-                nonholonomic: t.nonholonomic,
-                rolling: t.rolling,
+                holonomic: t.constraints.holonomic,
+                nonholonomic: t.constraints.nonholonomic,
+                rolling: t.constraints.rolling,
                 contacts: t.contacts,
                 cuts,
             })

@@ -247,15 +247,15 @@ pub fn lower_triangle(m: &[Id], l: usize) -> Vec<Id> {
         .collect()
 }
 
-/// The columns of `d`'s Jacobian in `model` as it stands (a scene's speeds
-/// in place).
+/// The columns of `d`'s Jacobian: the retained coordinates, then the
+/// privileged speeds it was derived in (a scene's own, where it has them).
 pub fn columns(model: &Model, d: &Derivation) -> Columns {
     let state = d
         .reduction
         .retained
         .iter()
         .map(|&r| model.coords[r].1.q)
-        .chain(model.speed_specs.iter().map(|s| s.symbol))
+        .chain(d.constraint_set.speed_specs.iter().map(|s| s.symbol))
         .collect();
     let inputs = model.inputs.iter().map(|(_, s)| *s).collect();
     Columns { state, inputs }
@@ -309,7 +309,12 @@ fn recursive(
     let spec = model.tree.clone()?;
     let residual = super::tree::residual(model, &spec, &d.reduction.ignorable)
         .map_err(|e| format!("the residual failed: {e}"))?;
-    let accels: Vec<Symbol> = model.speed_specs.iter().map(|s| s.accel).collect();
+    let accels: Vec<Symbol> = d
+        .constraint_set
+        .speed_specs
+        .iter()
+        .map(|s| s.accel)
+        .collect();
     let rates = retained_rates(d);
     let mass = lower_triangle(&residual.mass, d.l);
     let g = &mut model.g;
@@ -356,7 +361,7 @@ pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, St
             .coords
             .iter()
             .map(|c| c.1.q)
-            .chain(model.speed_specs.iter().map(|s| s.symbol))
+            .chain(d.constraint_set.speed_specs.iter().map(|s| s.symbol))
             .collect(),
         inputs: Vec::new(),
     };
@@ -364,7 +369,7 @@ pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, St
     let g = &mut model.g;
     let allowed = budget(g, &s.inverse, forced);
     let differentiated = within_budget(g, allowed, |g| derivatives(g, &s.inverse, &columns));
-    let Ok(world) = world_inverse_dynamics(model, allowed) else {
+    let Ok(world) = world_inverse_dynamics(model, d, allowed) else {
         return differentiated;
     };
     // The one with fewer expressions beside Q's.

@@ -86,7 +86,13 @@ fn a_tree_gets_the_inverse_dynamics_candidate() {
     assert_eq!(value(r.rates[2]), 1.0);
     // The derivatives read ÿ as the articulated-body algorithm's, not
     // as symbols.
-    let accels: Vec<Symbol> = derived.model.speed_specs.iter().map(|s| s.accel).collect();
+    let accels: Vec<Symbol> = derived
+        .model
+        .constraints
+        .speed_specs
+        .iter()
+        .map(|s| s.accel)
+        .collect();
     for &e in &r.forcing {
         let deps = g.dependencies(e);
         assert!(accels.iter().all(|&s| !deps.contains(s)));

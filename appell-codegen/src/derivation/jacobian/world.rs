@@ -111,7 +111,12 @@ fn right_sides(
             found: "accelerations given".to_string(),
         })?;
     let l = d.l;
-    let speeds: Vec<Symbol> = model.speed_specs.iter().map(|s| s.symbol).collect();
+    let speeds: Vec<Symbol> = d
+        .constraint_set
+        .speed_specs
+        .iter()
+        .map(|s| s.symbol)
+        .collect();
     let rates = retained_rates(d);
     let g = &mut model.g;
     let derivatives = self::derivatives(g, &rates, columns)?;
@@ -330,13 +335,18 @@ fn quaternion_columns(
 /// [`inverse_dynamics`]' partials by the world frame's derivatives, at the
 /// acceleration symbols (a tree of one-axis joints on a fixed root), within `allowed` new
 /// expressions.
-pub(super) fn world_inverse_dynamics(model: &mut Model, allowed: usize) -> Result<Vec<Id>, String> {
+pub(super) fn world_inverse_dynamics(
+    model: &mut Model,
+    d: &Derivation,
+    allowed: usize,
+) -> Result<Vec<Id>, String> {
     budgeted(
         model,
         |m| &mut m.g,
         allowed,
         |model| {
-            let accels: Vec<Id> = model
+            let accels: Vec<Id> = d
+                .constraint_set
                 .speed_specs
                 .iter()
                 .map(|s| model.g.sym(s.accel))

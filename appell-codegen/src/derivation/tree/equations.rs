@@ -9,16 +9,17 @@ use appell_symbolic::{Id, SymbolicError};
 
 use super::Structured;
 use crate::derivation::{Energies, Equations};
-use crate::model::Model;
+use crate::model::{ConstraintSet, Model};
 
 /// The tree's M, f and energies.
 pub fn equations(
     model: &mut Model,
+    set: &ConstraintSet,
     s: &Structured,
 ) -> Result<(Equations, Energies), SymbolicError> {
-    let l = model.speed_specs.len();
+    let l = set.speed_specs.len();
     let g = &mut model.g;
-    let speeds: Vec<Id> = model
+    let speeds: Vec<Id> = set
         .speed_specs
         .iter()
         .map(|sp| g.sym(sp.symbol))

@@ -58,9 +58,10 @@ pub struct Parts {
 }
 
 impl Parts {
-    /// The model's symbols.
+    /// The model's symbols, in its own privileged speeds (a plain tree's:
+    /// [`Model::constraints`]).
     pub fn new(model: &mut Model) -> R<Parts> {
-        let speeds = model.speed_specs.clone();
+        let speeds = model.constraints.speed_specs.clone();
         Parts::with_speeds(model, &speeds)
     }
 

@@ -24,7 +24,7 @@ use super::recursions::Recursions;
 use super::spatial::Algebra;
 use crate::derivation::SpeedMap;
 use crate::model::tree::TreeSpec;
-use crate::model::{Model, SpeedSpec};
+use crate::model::{ConstraintSet, Model, SpeedSpec};
 
 type R<T> = Result<T, SymbolicError>;
 
@@ -77,7 +77,7 @@ pub fn projected(
     map: &SpeedMap,
     fixed: &[usize],
 ) -> R<Projected> {
-    let (n, l) = (model.coords.len(), model.speed_specs.len());
+    let (n, l) = (model.coords.len(), map.speed_rates.len());
     let parts = Parts::new(model)?;
     let g = &mut model.g;
     let driving = model.input_rates.clone();
@@ -123,21 +123,22 @@ pub fn projected(
 /// coordinate's rate (a ball's angular velocity the scene does not keep).
 pub fn in_speeds(
     model: &mut Model,
+    set: &ConstraintSet,
     spec: &TreeSpec,
     map: &SpeedMap,
     reduced: &RateRules,
     tree_speeds: &[SpeedSpec],
 ) -> R<Option<InSpeeds>> {
-    let (n, l) = (tree_speeds.len(), model.speed_specs.len());
+    let (n, l) = (tree_speeds.len(), set.speed_specs.len());
     let parts = Parts::with_speeds(model, tree_speeds)?;
     let g = &mut model.g;
     let (zero, one) = (g.int(0)?, g.int(1)?);
     let mut c = vec![zero; n * l];
     let mut u = Vec::with_capacity(n);
     for (i, t) in tree_speeds.iter().enumerate() {
-        if let Some(k) = model.speed_specs.iter().position(|s| s.name == t.name) {
+        if let Some(k) = set.speed_specs.iter().position(|s| s.name == t.name) {
             c[i * l + k] = one;
-            u.push(g.sym(model.speed_specs[k].symbol)?);
+            u.push(g.sym(set.speed_specs[k].symbol)?);
         } else if let Some(r) = t.coordinate {
             c[i * l..(i + 1) * l].copy_from_slice(&map.c[r * l..(r + 1) * l]);
             u.push(map.qdot[r]);
@@ -146,7 +147,7 @@ pub fn in_speeds(
         }
     }
     let mut at_rest = Substitution::new();
-    for s in &model.speed_specs {
+    for s in &set.speed_specs {
         at_rest.insert(s.accel, zero);
     }
     let rates = g.time_derivatives(&u, reduced)?;

@@ -52,7 +52,7 @@ fn state(d: &Derived, seed: u64) -> Vec<(String, f64)> {
         out.push((q.to_string(), 3.0 * next()));
         out.push((g.symbol_name(c.rate).to_string(), next()));
     }
-    for s in &d.model.speed_specs {
+    for s in &d.model.constraints.speed_specs {
         out.push((g.symbol_name(s.symbol).to_string(), next()));
         out.push((g.symbol_name(s.accel).to_string(), next()));
     }
@@ -138,7 +138,7 @@ fn agrees_with_the_closed_form(src: &str, links: usize, speeds: usize) {
             .collect();
         let value0 = |e| g.eval_named(e, &zero_inputs).expect("evaluates");
         let accel: Vec<f64> = (0..l)
-            .map(|k| lookup(&at, g.symbol_name(d.model.speed_specs[k].accel)))
+            .map(|k| lookup(&at, g.symbol_name(d.model.constraints.speed_specs[k].accel)))
             .collect();
         let ydd: Vec<f64> = s.accelerations.iter().map(|&e| value(e)).collect();
         // T from the links' velocities, the large trees' energy, against
@@ -173,6 +173,7 @@ fn agrees_with_the_closed_form(src: &str, links: usize, speeds: usize) {
                 .iter()
                 .map(|&(n, v)| {
                     if d.model
+                        .constraints
                         .speed_specs
                         .iter()
                         .any(|sp| g.symbol_name(sp.symbol) == n)
@@ -281,6 +282,7 @@ fn the_residual_vanishes_at_the_articulated_body_accelerations() {
         let g = &d.model.g;
         let accels: Vec<&str> = d
             .model
+            .constraints
             .speed_specs
             .iter()
             .map(|sp| g.symbol_name(sp.accel))
@@ -364,6 +366,7 @@ fn the_world_frame_derivatives_agree_with_differentiation() {
         let r = super::residual(&mut d.model, &spec, &[]).expect("residual");
         let accels: Vec<appell_symbolic::Id> = d
             .model
+            .constraints
             .speed_specs
             .iter()
             .map(|s| d.model.g.sym(s.accel))
@@ -385,7 +388,13 @@ fn the_world_frame_derivatives_agree_with_differentiation() {
             factor.inverse(&mut a).expect("M⁻¹")
         };
         let l = d.full.l;
-        let speeds: Vec<_> = d.model.speed_specs.iter().map(|s| s.symbol).collect();
+        let speeds: Vec<_> = d
+            .model
+            .constraints
+            .speed_specs
+            .iter()
+            .map(|s| s.symbol)
+            .collect();
         let coordinates: Vec<_> = w
             .coordinates
             .iter()
