@@ -18,7 +18,6 @@ pub(super) use dense::{Dense, EventG};
 pub(super) use jacobian::dual_jacobian;
 pub use settings::TrBdf2;
 pub(super) use shared::{
-    check_problem, end_of_step, event_value, initial_outputs, initial_step, next_step,
-    project_state, ProjectG,
+    check_problem, derivative, error_scale, initial_step, next_step, Hooks, ProjectG,
 };
 pub use stats::{TrBdf2Solution, TrBdf2Stats};

@@ -32,13 +32,12 @@ where
     K: Sink<T, S>,
 {
     let dir = check_problem(set, P::BETA_CLOSED, t0, x0, t_end, sink)?;
-    let n_out = sink.len();
 
     let mut stats = Stats::default();
     let mut t = t0;
     let mut x = *x0;
     let mut next_out = 0;
-    while next_out < n_out && sink.time(next_out) == t0 {
+    while next_out < sink.len() && sink.time(next_out) == t0 {
         sink.put(next_out, &x);
         next_out += 1;
     }
@@ -62,18 +61,7 @@ where
         if steps >= set.max_steps {
             return Err(IntegrateError::TooManySteps { t, steps });
         }
-        let h_floor = set
-            .h_min
-            .max(16.0 * f64::EPSILON * t.abs())
-            .max(f64::MIN_POSITIVE);
-        let remaining = (t_end - t).abs();
-        let last = 1.01 * h >= remaining;
-        if !last && h < h_floor {
-            return Err(IntegrateError::StepSizeTooSmall { t, h });
-        }
-        if last {
-            h = remaining;
-        }
+        let (h_floor, last) = step_size(set, t, t_end, &mut h)?;
         steps += 1;
         let hs = dir * h;
         let t_new = if last { t_end } else { t + hs };
@@ -103,35 +91,12 @@ where
             }
             last_rejected = false;
 
-            // Event at the end of the step.
-            let mut crossed = false;
-            let mut g_new = 0.0;
-            if let Some(g) = event.as_mut() {
-                g_new = event_value(g, t_new, &x_new, t)?;
-                crossed = g_old != 0.0 && (g_new == 0.0 || (g_new > 0.0) != (g_old > 0.0));
-            }
-            // The dense output only when the step contains an output time
-            // or a crossing strictly inside it.
-            let need_dense = (crossed && g_new != 0.0)
-                || (next_out < n_out && (sink.time(next_out) - t_new) * dir < 0.0);
-            let dense = if need_dense {
-                Some(st.dense(&mut f, t, hs, &x, &x_new, &mut stats)?)
-            } else {
-                None
-            };
-
-            let stop: Option<(f64, [T; S])> = if crossed {
-                let (g, d, tol) = (event.as_mut(), dense.as_ref(), set.event_tol);
-                Some(event_stop(tol, g, d, (t, g_old), (t_new, g_new), x_new)?)
-            } else {
-                None
-            };
+            let step = Accepted::new(t, hs, t_new, &x, x_new);
+            let outputs = (&mut *sink, &mut next_out, dir);
+            let (g_new, stop) = close_step(
+                &mut st, &mut f, set, &mut event, outputs, step, g_old, &mut stats,
+            )?;
             g_old = g_new;
-
-            // Outputs up to the end of the step (or the event).
-            let t_stop = stop.as_ref().map_or(t_new, |s| s.0);
-            let d = dense.as_ref();
-            put_outputs(sink, &mut next_out, t, t_stop, t_new, &x_new, d, dir)?;
             let h_next = if set.adaptive {
                 h_new.min(h_max)
             } else {
@@ -165,6 +130,118 @@ where
             h = shrunk_step::<P, T, S>(fac11, h);
         }
     }
+}
+
+/// The size of the step from `t`: `h`, or what is left to `t_end` when
+/// that is within 1% of it (the last step); with the smallest size allowed
+/// at `t`, below which a step that is not the last is
+/// [`IntegrateError::StepSizeTooSmall`]. Returns the floor and whether the
+/// step is the last.
+fn step_size(
+    set: &Settings,
+    t: f64,
+    t_end: f64,
+    h: &mut f64,
+) -> Result<(f64, bool), IntegrateError> {
+    let h_floor = set
+        .h_min
+        .max(16.0 * f64::EPSILON * t.abs())
+        .max(f64::MIN_POSITIVE);
+    let remaining = (t_end - t).abs();
+    let last = 1.01 * *h >= remaining;
+    if !last && *h < h_floor {
+        return Err(IntegrateError::StepSizeTooSmall { t, h: *h });
+    }
+    if last {
+        *h = remaining;
+    }
+    Ok((h_floor, last))
+}
+
+/// Where an event stopped the run: its time and state.
+type Stop<T, const S: usize> = (f64, [T; S]);
+
+/// A step accepted from `(t, x)` to `(t_new, x_new)`, of signed size `hs`.
+struct Accepted<'a, T, const S: usize> {
+    t: f64,
+    hs: f64,
+    t_new: f64,
+    x: &'a [T; S],
+    x_new: [T; S],
+}
+
+impl<'a, T, const S: usize> Accepted<'a, T, S> {
+    fn new(t: f64, hs: f64, t_new: f64, x: &'a [T; S], x_new: [T; S]) -> Self {
+        Accepted {
+            t,
+            hs,
+            t_new,
+            x,
+            x_new,
+        }
+    }
+}
+
+/// After an accepted step: the event function at its end and, where it
+/// changed sign from `g_old` in the step, where the event stops the run;
+/// the outputs up to the end of the step (or the event) written into the
+/// sink from its next output on. The dense output is built only when the
+/// step holds an output time or a crossing strictly inside it.
+#[allow(clippy::too_many_arguments)] // the stages, the rhs, the hooks and the step
+fn close_step<P, T, F, K, const S: usize>(
+    st: &mut P,
+    f: &mut F,
+    set: &Settings,
+    event: &mut Option<&mut EventFn<'_, T, S>>,
+    (sink, next_out, dir): (&mut K, &mut usize, f64),
+    step: Accepted<'_, T, S>,
+    g_old: f64,
+    stats: &mut Stats,
+) -> Result<(f64, Option<Stop<T, S>>), IntegrateError>
+where
+    P: EmbeddedPair<T, S>,
+    T: Scalar,
+    F: FnMut(T, &[T; S], &mut [T; S]) -> Result<(), ModelError>,
+    K: Sink<T, S>,
+{
+    let Accepted {
+        t,
+        hs,
+        t_new,
+        x,
+        x_new,
+    } = step;
+    let mut crossed = false;
+    let mut g_new = 0.0;
+    if let Some(g) = event.as_mut() {
+        g_new = event_value(g, t_new, &x_new, t)?;
+        crossed = g_old != 0.0 && (g_new == 0.0 || (g_new > 0.0) != (g_old > 0.0));
+    }
+    let need_dense = (crossed && g_new != 0.0)
+        || (*next_out < sink.len() && (sink.time(*next_out) - t_new) * dir < 0.0);
+    let dense = if need_dense {
+        Some(st.dense(f, t, hs, x, &x_new, stats)?)
+    } else {
+        None
+    };
+    let stop: Option<Stop<T, S>> = if crossed {
+        let (g, d, tol) = (event.as_mut(), dense.as_ref(), set.event_tol);
+        Some(event_stop(tol, g, d, (t, g_old), (t_new, g_new), x_new)?)
+    } else {
+        None
+    };
+    let t_stop = stop.as_ref().map_or(t_new, |s| s.0);
+    put_outputs(
+        sink,
+        next_out,
+        t,
+        t_stop,
+        t_new,
+        &x_new,
+        dense.as_ref(),
+        dir,
+    )?;
+    Ok((g_new, stop))
 }
 
 /// Checks the problem before the first step: the settings (`beta_closed` as

@@ -27,6 +27,26 @@ pub(super) struct Hermite<'a> {
     pub(super) f1: &'a [f64],
 }
 
+impl<'a> Hermite<'a> {
+    /// The cubic from `(x0, f0)` at `t` to `(x1, f1)` at `t1`.
+    pub(super) fn between(
+        t: f64,
+        t1: f64,
+        (x0, f0): (&'a [f64], &'a [f64]),
+        (x1, f1): (&'a [f64], &'a [f64]),
+    ) -> Self {
+        Hermite {
+            t,
+            t1,
+            h: t1 - t,
+            x0,
+            f0,
+            x1,
+            f1,
+        }
+    }
+}
+
 /// The dense output of one accepted step, as the end of a step needs it
 /// (events and outputs). Shared by the implicit integrators.
 pub(crate) trait Dense {

@@ -5,8 +5,7 @@ use super::dense::{EventG, Hermite};
 use super::newton::{newton_tolerance, Iteration, Newton, JAC_SLOW};
 use super::settings::TrBdf2;
 use super::shared::{
-    check_problem, end_of_step, event_value, initial_outputs, initial_step, next_step,
-    project_state, ProjectG,
+    check_problem, derivative, error_scale, initial_step, next_step, Hooks, ProjectG,
 };
 use super::stages::Stages;
 use super::stats::{TrBdf2Solution, TrBdf2Stats};
@@ -29,8 +28,8 @@ impl TrBdf2 {
         x0: &[f64],
         t_end: f64,
         out: &mut [(f64, Vec<f64>)],
-        mut event: Option<&mut EventG<'_>>,
-        mut project: Option<&mut ProjectG<'_>>,
+        event: Option<&mut EventG<'_>>,
+        project: Option<&mut ProjectG<'_>>,
     ) -> Result<TrBdf2Solution, IntegrateError>
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
@@ -42,21 +41,13 @@ impl TrBdf2 {
         let mut stats = TrBdf2Stats::default();
         let mut t = t0;
         let mut x = x0.to_vec();
-        let mut next_out = initial_outputs(out, t0, &x);
-        let mut g_old = match event.as_mut() {
-            Some(g) => event_value(g, t, &x, t)?,
-            None => 0.0,
-        };
+        let mut hooks = Hooks::start(out, event, self.event_tol, project, (t0, &x))?;
         if t_end == t0 {
-            return Ok(solution(t, x, stats, 0.0, false, next_out));
+            return Ok(solution(t, x, stats, 0.0, false, hooks.next_out));
         }
 
         let mut f0 = vec![0.0; n];
-        stats.rhs_calls += 1;
-        f(t, &x, &mut f0)?;
-        if !all_finite(&f0) {
-            return Err(IntegrateError::NonFinite { t });
-        }
+        derivative(&mut f, t, &x, &mut f0, &mut stats.rhs_calls)?;
         let h_max = self.h_max.unwrap_or(f64::INFINITY).min((t_end - t0).abs());
         let mut sk: Vec<f64> = x.iter().map(|v| self.atol + self.rtol * v.abs()).collect();
         let mut h = initial_step(self.h_init, &x, &f0, &sk, h_max);
@@ -64,8 +55,8 @@ impl TrBdf2 {
         let mut it = Iteration::new(n);
         let kappa = newton_tolerance(self.rtol);
         let mut steps = 0usize;
-        let mut rejected_last = false;
-        let mut failure_non_finite = false;
+        // The last step was rejected; a non-finite value was why.
+        let (mut rejected_last, mut failure_non_finite) = (false, false);
         let mut st = Stages::new(n);
 
         loop {
@@ -113,83 +104,63 @@ impl TrBdf2 {
             };
 
             // Error estimate, filtered by the iteration matrix.
+            // Error estimate, filtered by the iteration matrix.
             let err = st.error(&it, hs, &x, &f0, self.atol, self.rtol);
-            if !all_finite(&st.y3) {
+            if let Some((non_finite, factor)) = self.rejection(err, &st.y3) {
                 stats.rejected += 1;
-                rejected_last = true;
-                failure_non_finite = true;
-                h *= FAC_NEWTON;
-                continue;
-            }
-
-            let accept = !self.adaptive || err <= 1.0;
-            if !accept {
-                stats.rejected += 1;
-                rejected_last = true;
-                failure_non_finite = !err.is_finite();
-                h *= rejected_factor(err);
+                (rejected_last, failure_non_finite) = (true, non_finite);
+                h *= factor;
                 continue;
             }
             stats.accepted += 1;
 
-            let dense = Hermite {
-                t,
-                t1: t_new,
-                h: t_new - t,
-                x0: &x,
-                f0: &f0,
-                x1: &st.y3,
-                f1: &st.f3,
-            };
-            let stop = end_of_step(
-                self.event_tol,
-                &mut event,
-                &dense,
-                &mut g_old,
-                out,
-                &mut next_out,
-                dir,
-            )?;
-            if let Some((te, xe)) = stop {
-                return Ok(solution(te, xe, stats, h, true, next_out));
+            let dense = Hermite::between(t, t_new, (&x, &f0), (&st.y3, &st.f3));
+            if let Some((te, xe)) = hooks.end_of_step(&dense, dir)? {
+                return Ok(solution(te, xe, stats, h, true, hooks.next_out));
             }
 
             t = t_new;
             x.copy_from_slice(&st.y3);
             f0.copy_from_slice(&st.f3);
-            if let Some(p) = project.as_mut() {
-                // Back onto the manifold; a moved state needs its own
-                // derivative (one rhs call) and event value.
-                if project_state(p, t, &mut x, &mut st.scratch)? {
-                    stats.rhs_calls += 1;
-                    f(t, &x, &mut f0)?;
-                    if !all_finite(&f0) {
-                        return Err(IntegrateError::NonFinite { t });
-                    }
-                    if let Some(g) = event.as_mut() {
-                        g_old = event_value(g, t, &x, t)?;
-                    }
-                }
-            }
-            for i in 0..n {
-                sk[i] = self.atol + self.rtol * x[i].abs();
-            }
-            it.fresh = false;
-            if theta > JAC_SLOW {
-                it.have_jac = false;
-            }
-            let fac = accepted_factor(err, rejected_last);
-            rejected_last = false;
-            failure_non_finite = false;
-            let h_new = if self.adaptive {
-                (h * fac).min(h_max)
-            } else {
-                self.h_init.map_or(h, f64::abs).min(h_max)
-            };
+            // Back onto the manifold; a moved state needs its own
+            // derivative (one rhs call) and event value.
+            hooks.project(&mut f, (t, &mut x), &mut f0, &mut stats.rhs_calls)?;
+            error_scale(&mut sk, &x, self.atol, self.rtol);
+            it.after_acceptance(theta > JAC_SLOW);
+            let h_new = self.accepted_step(h, h_max, err, rejected_last);
+            (rejected_last, failure_non_finite) = (false, false);
             if last {
-                return Ok(solution(t, x, stats, h_new, false, next_out));
+                return Ok(solution(t, x, stats, h_new, false, hooks.next_out));
             }
             h = h_new;
+        }
+    }
+}
+
+impl TrBdf2 {
+    /// Whether an attempted step is rejected: its new state `y3` not finite
+    /// (then the step shrinks by the Newton failure's factor), or, adaptive,
+    /// its error norm over 1. Returns whether for a non-finite value, and
+    /// the factor of the step size.
+    fn rejection(&self, err: f64, y3: &[f64]) -> Option<(bool, f64)> {
+        let within = err <= 1.0;
+        if !all_finite(y3) {
+            Some((true, FAC_NEWTON))
+        } else if self.adaptive && !within {
+            Some((!err.is_finite(), rejected_factor(err)))
+        } else {
+            None
+        }
+    }
+
+    /// The size of the step after an accepted one of size `h` with error
+    /// norm `err`: grown by the controller (not past `h_max`), or
+    /// `h_init` (else `h`) in a run without step-size control.
+    fn accepted_step(&self, h: f64, h_max: f64, err: f64, rejected_last: bool) -> f64 {
+        if self.adaptive {
+            (h * accepted_factor(err, rejected_last)).min(h_max)
+        } else {
+            self.h_init.map_or(h, f64::abs).min(h_max)
         }
     }
 }

@@ -84,6 +84,16 @@ impl Iteration {
         Ok(())
     }
 
+    /// After an accepted step: the Jacobian is no longer fresh, and is
+    /// recomputed for the next step when Newton's iteration converged
+    /// `slow`ly under it.
+    pub(super) fn after_acceptance(&mut self, slow: bool) {
+        self.fresh = false;
+        if slow {
+            self.have_jac = false;
+        }
+    }
+
     /// After a Newton failure or a singular iteration matrix, which rejects
     /// the step (counted in `stats`): the step size to try next, `h` again
     /// with a new Jacobian when the current one is stale, else `h` 4×

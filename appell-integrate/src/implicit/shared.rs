@@ -6,6 +6,7 @@
 use super::control::{all_finite, wrms};
 use super::dense::{locate, put, Dense, EventG};
 use crate::solution::{IntegrateError, ProjectionFailed};
+use appell_core::ModelError;
 
 /// A projection `p(t, x)` of a state in place back onto a constraint
 /// manifold, as passed to the `solve_projected` of the implicit
@@ -43,9 +44,124 @@ pub(crate) fn check_problem(
     Ok(dir)
 }
 
+/// What a run does at the end of every accepted step besides stepping:
+/// the event function with its last value, the outputs with the next one
+/// to write, and the projection.
+pub(crate) struct Hooks<'a, 'e, 'p> {
+    event: Option<&'a mut EventG<'e>>,
+    /// The event function's value at the start of the next step.
+    g_old: f64,
+    event_tol: f64,
+    out: &'a mut [(f64, Vec<f64>)],
+    /// The first output not yet written.
+    pub(crate) next_out: usize,
+    project: Option<&'a mut ProjectG<'p>>,
+    /// The state before a projection.
+    before: Vec<f64>,
+}
+
+impl<'a, 'e, 'p> Hooks<'a, 'e, 'p> {
+    /// The hooks at the start `(t0, x0)`: the outputs at `t0` written, the
+    /// event function's first value.
+    pub(crate) fn start(
+        out: &'a mut [(f64, Vec<f64>)],
+        mut event: Option<&'a mut EventG<'e>>,
+        event_tol: f64,
+        project: Option<&'a mut ProjectG<'p>>,
+        (t0, x0): (f64, &[f64]),
+    ) -> Result<Self, IntegrateError> {
+        let next_out = initial_outputs(out, t0, x0);
+        let g_old = match event.as_mut() {
+            Some(g) => event_value(g, t0, x0, t0)?,
+            None => 0.0,
+        };
+        Ok(Hooks {
+            event,
+            g_old,
+            event_tol,
+            out,
+            next_out,
+            project,
+            before: Vec::with_capacity(x0.len()),
+        })
+    }
+
+    /// [`end_of_step`] on the step's dense output: the event's time and
+    /// state, if one stops the run in the step.
+    pub(crate) fn end_of_step<D: Dense>(
+        &mut self,
+        dense: &D,
+        dir: f64,
+    ) -> Result<Option<(f64, Vec<f64>)>, IntegrateError> {
+        let (tol, out) = (self.event_tol, &mut *self.out);
+        end_of_step(
+            tol,
+            &mut self.event,
+            dense,
+            &mut self.g_old,
+            out,
+            &mut self.next_out,
+            dir,
+        )
+    }
+
+    /// After an accepted step to `(t, x)`: the projection, where there is
+    /// one; where it moved the state, its derivative `f0` anew (one rhs call,
+    /// counted in `rhs_calls`) and the event function's value.
+    pub(crate) fn project<F>(
+        &mut self,
+        f: &mut F,
+        (t, x): (f64, &mut [f64]),
+        f0: &mut [f64],
+        rhs_calls: &mut usize,
+    ) -> Result<(), IntegrateError>
+    where
+        F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+    {
+        let Some(p) = self.project.as_mut() else {
+            return Ok(());
+        };
+        if project_state(p, t, x, &mut self.before)? {
+            derivative(f, t, x, f0, rhs_calls)?;
+            if let Some(g) = self.event.as_mut() {
+                self.g_old = event_value(g, t, x, t)?;
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The derivative `f(t, x)` into `f0` (one rhs call, counted in
+/// `rhs_calls`); a non-finite one is [`IntegrateError::NonFinite`].
+pub(crate) fn derivative<F>(
+    f: &mut F,
+    t: f64,
+    x: &[f64],
+    f0: &mut [f64],
+    rhs_calls: &mut usize,
+) -> Result<(), IntegrateError>
+where
+    F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
+{
+    *rhs_calls += 1;
+    f(t, x, f0)?;
+    if !all_finite(f0) {
+        return Err(IntegrateError::NonFinite { t });
+    }
+    Ok(())
+}
+
+/// The error scale `atol + rtol |x_i|` of every component of `x`, into
+/// `scale`.
+pub(crate) fn error_scale(scale: &mut [f64], x: &[f64], atol: f64, rtol: f64) {
+    for (s, v) in scale.iter_mut().zip(x) {
+        *s = atol + rtol * v.abs();
+    }
+}
+
 /// Writes `x0` into the outputs at `t0` (the first ones) and returns the
 /// index of the next output.
-pub(crate) fn initial_outputs(out: &mut [(f64, Vec<f64>)], t0: f64, x0: &[f64]) -> usize {
+fn initial_outputs(out: &mut [(f64, Vec<f64>)], t0: f64, x0: &[f64]) -> usize {
     let mut next_out = 0;
     while next_out < out.len() && out[next_out].0 == t0 {
         put(&mut out[next_out].1, x0);
@@ -108,7 +224,7 @@ pub(crate) fn next_step(
 /// was nonzero, is an event, located on `dense` to `event_tol`), then the
 /// outputs up to the end of the step or the event. Updates `g_old` and
 /// `next_out`; returns the event's time and state, if any.
-pub(crate) fn end_of_step<D: Dense>(
+fn end_of_step<D: Dense>(
     event_tol: f64,
     event: &mut Option<&mut EventG<'_>>,
     dense: &D,
@@ -185,7 +301,7 @@ fn put_outputs<D: Dense>(
 /// Projects the state `x` at `t` with `p` (`before` is scratch). Returns
 /// whether it moved; a failure, or a non-finite projected state, is
 /// [`IntegrateError::Projection`].
-pub(crate) fn project_state(
+fn project_state(
     p: &mut ProjectG<'_>,
     t: f64,
     x: &mut [f64],

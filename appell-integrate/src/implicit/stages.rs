@@ -19,8 +19,6 @@ pub(super) struct Stages {
     /// The derivative at the new state (the next step's first stage).
     pub(super) f3: Vec<f64>,
     est: Vec<f64>,
-    /// Scratch room (the state before a projection).
-    pub(super) scratch: Vec<f64>,
 }
 
 impl Stages {
@@ -33,7 +31,6 @@ impl Stages {
             y3: vec![0.0; n],
             f3: vec![0.0; n],
             est: vec![0.0; n],
-            scratch: Vec::with_capacity(n),
         }
     }
 

@@ -46,6 +46,26 @@ pub(super) struct Collocation<'a> {
     pub(super) x1: &'a [f64],
 }
 
+impl<'a> Collocation<'a> {
+    /// The collocation polynomial `q` of the step of signed size `h` from
+    /// `x0` at `t` to `x1` at `t1`.
+    pub(super) fn between(
+        (t, x0): (f64, &'a [f64]),
+        (t1, x1): (f64, &'a [f64]),
+        h: f64,
+        q: &'a [f64],
+    ) -> Self {
+        Collocation {
+            t,
+            t1,
+            h,
+            x0,
+            q,
+            x1,
+        }
+    }
+}
+
 impl Dense for Collocation<'_> {
     fn start(&self) -> f64 {
         self.t

@@ -9,8 +9,8 @@ use super::settings::Radau5;
 use super::stages::{Newton, Stages};
 use super::stats::{Radau5Solution, Radau5Stats};
 use crate::implicit::{
-    all_finite, check_problem, end_of_step, event_value, initial_outputs, initial_step, next_step,
-    project_state, EventG, ProjectG,
+    all_finite, check_problem, derivative, error_scale, initial_step, next_step, EventG, Hooks,
+    ProjectG,
 };
 use crate::solution::IntegrateError;
 use appell_core::ModelError;
@@ -31,8 +31,8 @@ impl Radau5 {
         x0: &[f64],
         t_end: f64,
         out: &mut [(f64, Vec<f64>)],
-        mut event: Option<&mut EventG<'_>>,
-        mut project: Option<&mut ProjectG<'_>>,
+        event: Option<&mut EventG<'_>>,
+        project: Option<&mut ProjectG<'_>>,
     ) -> Result<Radau5Solution, IntegrateError>
     where
         F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
@@ -43,17 +43,13 @@ impl Radau5 {
         let n = x0.len();
         let mut stats = Radau5Stats::default();
         let (mut t, mut x) = (t0, x0.to_vec());
-        let mut next_out = initial_outputs(out, t0, &x);
-        let mut g_old = match event.as_mut() {
-            Some(g) => event_value(g, t, &x, t)?,
-            None => 0.0,
-        };
+        let mut hooks = Hooks::start(out, event, self.event_tol, project, (t0, &x))?;
         if t_end == t0 {
-            return Ok(solution(t, x, stats, 0.0, false, next_out));
+            return Ok(solution(t, x, stats, 0.0, false, hooks.next_out));
         }
 
         let mut f0 = vec![0.0; n];
-        derivative(&mut f, t, &x, &mut f0, &mut stats)?;
+        derivative(&mut f, t, &x, &mut f0, &mut stats.rhs_calls)?;
         let (rtol, atol) = self.internal_tolerances();
         let fnewt = newton_tolerance(rtol);
         let reuse = self.jacobian_reuse.unwrap_or(REUSE_GIVEN);
@@ -64,7 +60,7 @@ impl Radau5 {
         let mut it = Iteration::new(n);
         let mut st = Stages::new(n);
         let mut prev = Previous::new(n);
-        let (mut q, mut x_new, mut buf) = (vec![0.0; 3 * n], vec![0.0; n], Vec::new());
+        let (mut q, mut x_new) = (vec![0.0; 3 * n], vec![0.0; n]);
         let mut gustafsson = Gustafsson::new();
         let mut steps = 0usize;
         // The last step was rejected; a non-finite value was why.
@@ -86,11 +82,7 @@ impl Radau5 {
                 let nit = self.newton_max_iter;
                 st.newton(&it, &mut f, t, hs, &x, &scal, fnewt, nit, &mut stats)?
             } else {
-                // A singular iteration matrix.
-                Newton::Failed {
-                    factor: FAC_FAIL,
-                    non_finite: false,
-                }
+                Newton::SINGULAR
             };
             let (theta, iterations) = match outcome {
                 Newton::Converged { theta, iterations } => (theta, iterations),
@@ -115,11 +107,7 @@ impl Radau5 {
             if !(err < 1.0 && all_finite(&x_new)) {
                 stats.rejected += 1;
                 (rejected, non_finite) = (true, !err.is_finite() || !all_finite(&x_new));
-                h *= match () {
-                    _ if non_finite => FAC_FAIL,
-                    _ if stats.accepted == 0 => FAC_FIRST,
-                    _ => fac,
-                };
+                h *= rejected_factor(non_finite, stats.accepted, fac);
                 // A Jacobian under which Newton converged fast is kept.
                 if theta > reuse {
                     it.after_rejection();
@@ -127,31 +115,13 @@ impl Radau5 {
                 continue;
             }
             stats.accepted += 1;
-            let mut h_new = (h * gustafsson.accepted(h, err, fac)).min(h_max);
-            if rejected {
-                h_new = h_new.min(h);
-            }
+            let grown = (h * gustafsson.accepted(h, err, fac)).min(h_max);
+            let h_new = if rejected { grown.min(h) } else { grown };
 
             coefficients(&st.z, &mut q, n);
-            let dense = Collocation {
-                t,
-                t1: t_new,
-                h: hs,
-                x0: &x,
-                q: &q,
-                x1: &x_new,
-            };
-            let stop = end_of_step(
-                self.event_tol,
-                &mut event,
-                &dense,
-                &mut g_old,
-                out,
-                &mut next_out,
-                dir,
-            )?;
-            if let Some((te, xe)) = stop {
-                return Ok(solution(te, xe, stats, h_new, true, next_out));
+            let dense = Collocation::between((t, &x), (t_new, &x_new), hs, &q);
+            if let Some((te, xe)) = hooks.end_of_step(&dense, dir)? {
+                return Ok(solution(te, xe, stats, h_new, true, hooks.next_out));
             }
 
             // f at the new state for the next error estimate, from the
@@ -160,24 +130,12 @@ impl Radau5 {
             // The step's polynomial starts the next one.
             prev.keep(&mut x, &mut q, &x_new, hs);
             t = t_new;
-            if let Some(p) = project.as_mut() {
-                if project_state(p, t, &mut x, &mut buf)? {
-                    derivative(&mut f, t, &x, &mut f0, &mut stats)?;
-                    if let Some(g) = event.as_mut() {
-                        g_old = event_value(g, t, &x, t)?;
-                    }
-                }
-            }
-            for (s, v) in scal.iter_mut().zip(&x) {
-                *s = atol + rtol * v.abs();
-            }
-            it.fresh = false;
-            if theta > reuse {
-                it.have_jac = false;
-            }
+            hooks.project(&mut f, (t, &mut x), &mut f0, &mut stats.rhs_calls)?;
+            error_scale(&mut scal, &x, atol, rtol);
+            it.after_acceptance(theta > reuse);
             (rejected, non_finite) = (false, false);
             if last {
-                return Ok(solution(t, x, stats, h_new, false, next_out));
+                return Ok(solution(t, x, stats, h_new, false, hooks.next_out));
             }
             if !keeps_step(theta, reuse, h_new / h) {
                 h = h_new;
@@ -186,24 +144,17 @@ impl Radau5 {
     }
 }
 
-/// The derivative `f(t, x)` into `f0` (one rhs call); a non-finite one is
-/// [`IntegrateError::NonFinite`].
-fn derivative<F>(
-    f: &mut F,
-    t: f64,
-    x: &[f64],
-    f0: &mut [f64],
-    stats: &mut Radau5Stats,
-) -> Result<(), IntegrateError>
-where
-    F: FnMut(f64, &[f64], &mut [f64]) -> Result<(), ModelError>,
-{
-    stats.rhs_calls += 1;
-    f(t, x, f0)?;
-    if !all_finite(f0) {
-        return Err(IntegrateError::NonFinite { t });
+/// The factor of the step size after a rejected step whose controller
+/// proposed `fac`: small after a non-finite value, the first step's
+/// before any step was accepted.
+fn rejected_factor(non_finite: bool, accepted: usize, fac: f64) -> f64 {
+    if non_finite {
+        FAC_FAIL
+    } else if accepted == 0 {
+        FAC_FIRST
+    } else {
+        fac
     }
-    Ok(())
 }
 
 /// The result of an integration ending at `t` in state `x`.

@@ -73,6 +73,16 @@ impl Iteration {
         ok
     }
 
+    /// After an accepted step: the Jacobian is no longer fresh, and is
+    /// recomputed for the next step when Newton's iteration converged
+    /// `slow`ly under it.
+    pub(super) fn after_acceptance(&mut self, slow: bool) {
+        self.fresh = false;
+        if slow {
+            self.have_jac = false;
+        }
+    }
+
     /// After a rejected step: a stale Jacobian is recomputed for the retry.
     pub(super) fn after_rejection(&mut self) {
         if !self.fresh {

@@ -3,6 +3,7 @@
 //! estimate.
 
 use super::coefficients::{ALPHA, BETA, C, E, GAMMA, T, TI};
+use super::control::FAC_FAIL;
 use super::iteration::Iteration;
 use super::linear::C64;
 use super::stats::Radau5Stats;
@@ -20,6 +21,14 @@ pub(super) enum Newton {
     /// Diverged, too slow, or a non-finite value: retry with the step
     /// times `factor`.
     Failed { factor: f64, non_finite: bool },
+}
+
+impl Newton {
+    /// A singular iteration matrix: no iteration, the step shrinks.
+    pub(super) const SINGULAR: Newton = Newton::Failed {
+        factor: FAC_FAIL,
+        non_finite: false,
+    };
 }
 
 /// The work vectors of a step: the stage increments `z_i = x(t + c_i h) −
