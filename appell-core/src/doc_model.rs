@@ -1,6 +1,6 @@
-//! A model written by hand, for the runtime's documentation examples: the
-//! runtime cannot use the derive, and one model shared by the examples is
-//! easier to trust than one hidden in each. Not part of the API.
+//! Models written by hand, for the runtime's documentation examples: the
+//! runtime cannot use the derive, and models shared by the examples are
+//! easier to trust than ones hidden in each. Not part of the API.
 
 use crate::{JacobianInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
 
@@ -251,5 +251,239 @@ impl Model for Pendulum {
         _torques: &mut [[T; 3]],
     ) -> Result<(), ModelError> {
         Ok(())
+    }
+}
+
+/// A harmonic oscillator, x'' = −w² x: coordinate x, speed ẋ, parameter
+/// `w`, no inputs; a particle of unit mass on a spring of stiffness w².
+/// With `w = 0` it is a free particle.
+#[derive(Clone, Copy, Debug)]
+pub struct Oscillator {
+    /// The angular frequency.
+    pub w: f64,
+}
+
+static OSCILLATOR: ModelInfo = ModelInfo {
+    name: "Oscillator",
+    parameters: &["w"],
+    coordinates: &["x"],
+    speeds: &["x"],
+    dependent: &[],
+    cyclic: &[],
+    ignorable: &[],
+    retained: &["x"],
+    inputs: &[],
+    effects: &[],
+    outputs: &[],
+    holonomic: 0,
+    constraints: 0,
+    row_sources: &[],
+    contacts: &[],
+    bodies: &[],
+    force_points: 0,
+    torques: 0,
+    form: "closed form, written by hand",
+    symbolic_elimination: true,
+    rhs_ops: OpCounts {
+        add: 0,
+        mul: 2,
+        div: 0,
+        calls: 0,
+        total: 3,
+    },
+    jacobian: None,
+    equations: "x'' = -w^2 x",
+};
+
+impl Model for Oscillator {
+    /// −w².
+    type Prepared<T: Scalar> = T;
+
+    fn info() -> &'static ModelInfo {
+        &OSCILLATOR
+    }
+
+    fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
+        crate::check_len("out", out, 1)?;
+        out[0] = self.w;
+        Ok(())
+    }
+
+    fn set_parameter(&mut self, name: &str, value: f64) -> bool {
+        let known = name == "w";
+        if known {
+            self.w = value;
+        }
+        known
+    }
+
+    fn prepare<T: Scalar>(&self) -> T {
+        let w = T::from_f64(self.w);
+        -(w * w)
+    }
+
+    fn rhs<T: Scalar>(
+        &self,
+        minus_w2: &T,
+        _t: T,
+        state: &[T],
+        _inputs: &[T],
+        dstate: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("state", state, 2)?;
+        crate::check_len("dstate", dstate, 2)?;
+        dstate[0] = state[1];
+        dstate[1] = *minus_w2 * state[0];
+        Ok(())
+    }
+
+    fn mass_matrix_and_forcing<T: Scalar>(
+        &self,
+        _t: T,
+        q: &[T],
+        _u: &[T],
+        _inputs: &[T],
+        m: &mut [T],
+        f: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("q", q, 1)?;
+        crate::check_len("m", m, 1)?;
+        crate::check_len("f", f, 1)?;
+        m[0] = T::one();
+        f[0] = self.prepare::<T>() * q[0];
+        Ok(())
+    }
+
+    fn speed_transform<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        c: &mut [T],
+        c0: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("c", c, 1)?;
+        crate::check_len("c0", c0, 1)?;
+        c[0] = T::one();
+        c0[0] = T::zero();
+        Ok(())
+    }
+
+    fn coordinate_rates<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        u: &[T],
+        qdot: &mut [T],
+    ) -> Result<(), ModelError> {
+        crate::check_len("u", u, 1)?;
+        crate::check_len("qdot", qdot, 1)?;
+        qdot[0] = u[0];
+        Ok(())
+    }
+
+    /// No constraints: nothing to write.
+    fn constraint_residuals<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _qdot: &[T],
+        _position: &mut [T],
+        _velocity: &mut [T],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    fn kinetic_energy<T: Scalar>(&self, _t: T, _q: &[T], u: &[T]) -> Result<T, ModelError> {
+        crate::check_len("u", u, 1)?;
+        Ok(T::from_f64(0.5) * u[0] * u[0])
+    }
+
+    fn potential_energy<T: Scalar>(&self, _t: T, q: &[T]) -> Result<T, ModelError> {
+        crate::check_len("q", q, 1)?;
+        let w = T::from_f64(self.w);
+        Ok(T::from_f64(0.5) * w * w * q[0] * q[0])
+    }
+
+    /// No bodies are declared: nothing to write.
+    fn mass_properties(
+        &self,
+        _masses: &mut [f64],
+        _inertias: &mut [[f64; 9]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// No bodies are declared: nothing to write.
+    fn body_poses<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _positions: &mut [[T; 3]],
+        _rotations: &mut [[T; 9]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// No constraints: nothing to write.
+    fn constraint_rows<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _d: &mut [T],
+        _d0: &mut [T],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// No forces or torques are declared: nothing to write.
+    fn load_geometry<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _points: &mut [[T; 3]],
+        _frames: &mut [[T; 9]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+
+    /// No forces or torques are declared: nothing to write.
+    fn load_values<T: Scalar>(
+        &self,
+        _t: T,
+        _q: &[T],
+        _qdot: &[T],
+        _inputs: &[T],
+        _forces: &mut [[T; 3]],
+        _torques: &mut [[T; 3]],
+    ) -> Result<(), ModelError> {
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_oscillator_s_rhs_is_its_m_and_f_and_its_force_derives_from_v() {
+        let model = Oscillator { w: 3.0 };
+        let (x, u) = (0.4, -1.5);
+        let mut dx = [0.0; 2];
+        model
+            .rhs(&model.prepare::<f64>(), 0.0, &[x, u], &[], &mut dx)
+            .unwrap();
+        let (mut m, mut f) = ([0.0], [0.0]);
+        model
+            .mass_matrix_and_forcing(0.0, &[x], &[u], &[], &mut m, &mut f)
+            .unwrap();
+        assert_eq!(dx, [u, f[0] / m[0]]);
+        assert_eq!(f[0], -9.0 * x);
+        // f = −dV/dx (central difference; V is quadratic, so it is exact
+        // up to rounding).
+        let v = |x: f64| model.potential_energy(0.0, &[x]).unwrap();
+        let h = 1e-3;
+        assert!(((v(x + h) - v(x - h)) / (2.0 * h) + f[0]).abs() < 1e-9);
+        let t = model.kinetic_energy(0.0, &[x], &[u]).unwrap();
+        assert_eq!(t, 0.5 * u * u);
     }
 }

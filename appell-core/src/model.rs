@@ -422,36 +422,12 @@ pub trait Model {
     /// [`ModelError::NotGenerated`] for any other.
     ///
     /// ```
-    /// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-    /// # struct Free;
-    /// # static INFO: ModelInfo = ModelInfo {
-    /// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
-    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
-    /// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-    /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
-    /// # };
-    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NotGenerated { function: "test" }) }
-    /// # impl Model for Free {
-    /// #     type Prepared<T: Scalar> = ();
-    /// #     fn info() -> &'static ModelInfo { &INFO }
-    /// #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-    /// #     fn prepare<T: Scalar>(&self) {}
-    /// #     fn rhs<T: Scalar>(&self, _: &(), _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
-    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
-    /// # }
+    /// use appell_core::Model;
+    /// # use appell_core::__doc_model::Oscillator;
+    ///
     /// // A model without constraints is as far from singular as can be.
-    /// assert_eq!(Free.dependent_block_margin(0.0, &[0.0], &[]), Ok(1.0));
+    /// let free = Oscillator { w: 0.0 }; // x'' = 0: a free particle
+    /// assert_eq!(free.dependent_block_margin(0.0, &[0.0], &[]), Ok(1.0));
     /// ```
     fn dependent_block_margin<T: Scalar>(
         &self,

@@ -109,37 +109,13 @@ impl<'a> Guard<'a> {
     /// own errors.
     ///
     /// ```
-    /// # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-    /// # struct Free;
-    /// # static INFO: ModelInfo = ModelInfo {
-    /// #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
-    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
-    /// #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-    /// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
-    /// # };
-    /// # impl Model for Free {
-    /// #     type Prepared<T: Scalar> = ();
-    /// #     fn info() -> &'static ModelInfo { &INFO }
-    /// #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-    /// #     fn prepare<T: Scalar>(&self) {}
-    /// #     fn rhs<T: Scalar>(&self, _: &(), _: T, s: &[T], _: &[T], d: &mut [T]) -> Result<(), ModelError> { d[0] = s[1]; d[1] = T::zero(); Ok(()) }
-    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], c: &mut [T], c0: &mut [T]) -> Result<(), ModelError> { c[0] = T::one(); c0[0] = T::zero(); Ok(()) }
-    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], u: &[T], qd: &mut [T]) -> Result<(), ModelError> { qd[0] = u[0]; Ok(()) }
-    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], u: &[T]) -> Result<T, ModelError> { Ok(u[0] * u[0]) }
-    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
-    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
-    /// # }
+    /// # use appell_core::ModelError;
+    /// # use appell_core::__doc_model::Oscillator;
     /// use appell_hybrid::Guard;
     ///
     /// // A model without contacts: the guard names none, and says so.
-    /// let guard = Guard::lift_off(1, &Free, 0, &[]);
+    /// let free = Oscillator { w: 0.0 }; // x'' = 0: a free particle
+    /// let guard = Guard::lift_off(1, &free, 0, &[]);
     /// assert_eq!(guard.reason, "lift-off");
     /// assert!(matches!((guard.value)(0.0, &[0.0], &[0.0]), Err(ModelError::Contact { .. })));
     /// ```

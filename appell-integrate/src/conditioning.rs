@@ -12,37 +12,11 @@
 //!
 //! ```
 //! use appell_integrate::conditioning::ConditionWatch;
-//! # use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-//! # struct Free;
-//! # static INFO: ModelInfo = ModelInfo {
-//! #     name: "Free", parameters: &[], coordinates: &["x"], speeds: &["x"],
-//! #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-//! #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0,
-//! #     bodies: &[], force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-//! #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
-//! # };
-//! # impl Model for Free {
-//! #     type Prepared<T: Scalar> = ();
-//! #     fn info() -> &'static ModelInfo { &INFO }
-//! #     fn parameter_values(&self, _: &mut [f64]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-//! #     fn prepare<T: Scalar>(&self) {}
-//! #     fn rhs<T: Scalar>(&self, _: &(), _: T, s: &[T], _: &[T], d: &mut [T]) -> Result<(), ModelError> { d[0] = s[1]; d[1] = T::zero(); Ok(()) }
-//! #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], u: &[T], qd: &mut [T]) -> Result<(), ModelError> { qd[0] = u[0]; Ok(()) }
-//! #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], u: &[T]) -> Result<T, ModelError> { Ok(u[0] * u[0]) }
-//! #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { Ok(()) }
-//! #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { Ok(()) }
-//! # }
+//! # use appell_core::__doc_model::Oscillator;
 //! use appell_integrate::Dop853;
 //!
 //! // A model without constraints has nothing to warn about.
-//! let model = Free;
+//! let model = Oscillator { w: 0.0 }; // x'' = 0: a free particle
 //! let mut watch = ConditionWatch::new(&model, 1e8);
 //! Dop853::new()
 //!     .solve_model_projected(&model, &[], &mut |t, x: &mut [f64; 2]| watch.check(t, x), 0.0, &[0.0, 1.0], 1.0)

@@ -83,40 +83,7 @@ pub fn linearize<M: Model>(
 ///
 /// ```
 /// use appell_linearize::{dual_linearize, linearize};
-/// # use appell_core::{check_len, BodyInfo, Model, ModelError, ModelInfo, OpCounts, Scalar};
-/// # struct Oscillator { w: f64 }
-/// # static INFO: ModelInfo = ModelInfo {
-/// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"],
-/// #     speeds: &["x"], dependent: &[], cyclic: &[], ignorable: &[],
-/// #     retained: &["x"], inputs: &[], effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0,
-/// #     constraints: 0, bodies: &[BodyInfo { name: "m", rigid: false }],
-/// #     force_points: 0, torques: 0, form: "closed form", symbolic_elimination: true,
-/// #     rhs_ops: OpCounts { add: 0, mul: 0, div: 0, calls: 0, total: 0 }, jacobian: None, equations: "",
-/// # };
-/// # fn unused() -> Result<(), ModelError> { Err(ModelError::NotGenerated { function: "test" }) }
-/// # impl Model for Oscillator {
-/// #     type Prepared<T: Scalar> = ();
-/// #     fn info() -> &'static ModelInfo { &INFO }
-/// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
-/// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-/// #     fn prepare<T: Scalar>(&self) {}
-/// #     fn rhs<T: Scalar>(&self, _: &(), _: T, x: &[T], _: &[T], dx: &mut [T]) -> Result<(), ModelError> {
-/// #         check_len("state", x, 2)?;
-/// #         dx[0] = x[1];
-/// #         dx[1] = -(T::from_f64(self.w * self.w) * x[0]);
-/// #         Ok(())
-/// #     }
-/// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-/// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-/// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-/// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-/// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
-/// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
-/// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-/// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-/// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-/// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
-/// # }
+/// # use appell_core::__doc_model::Oscillator;
 /// let model = Oscillator { w: 2.0 };
 /// let dual = dual_linearize(&model, 0.0, &[0.1, 0.0], &[]).unwrap();
 /// assert_eq!(dual.a[(1, 0)], -4.0);

@@ -252,40 +252,8 @@ impl Radau5 {
     ///
     /// ```
     /// use appell_integrate::{IntegrateError, Radau5};
-    /// use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-    /// # struct Oscillator { w: f64 }
-    /// # static INFO: ModelInfo = ModelInfo {
-    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
-    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
-    /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
-    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
-    /// #     jacobian: None,
-    /// #     equations: "x'' = -w^2 x",
-    /// # };
-    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
-    /// # impl Model for Oscillator {
-    /// #     type Prepared<T: Scalar> = T;
-    /// #     fn info() -> &'static ModelInfo { &INFO }
-    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
-    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
-    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-    /// #         appell_core::check_len("state", s, 2)?;
-    /// #         appell_core::check_len("dstate", ds, 2)?;
-    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
-    /// #     }
-    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
-    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
-    /// # }
+    /// use appell_core::{Model, ModelError};
+    /// # use appell_core::__doc_model::Oscillator;
     ///
     /// // x'' = −w² x, x(0) = 1, x'(0) = 0: x(t) = cos(w t).
     /// let model = Oscillator { w: 2.0 };
@@ -320,40 +288,7 @@ impl Radau5 {
     ///
     /// ```
     /// use appell_integrate::Radau5;
-    /// use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-    /// # struct Oscillator { w: f64 }
-    /// # static INFO: ModelInfo = ModelInfo {
-    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
-    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
-    /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
-    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
-    /// #     jacobian: None,
-    /// #     equations: "x'' = -w^2 x",
-    /// # };
-    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
-    /// # impl Model for Oscillator {
-    /// #     type Prepared<T: Scalar> = T;
-    /// #     fn info() -> &'static ModelInfo { &INFO }
-    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
-    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
-    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-    /// #         appell_core::check_len("state", s, 2)?;
-    /// #         appell_core::check_len("dstate", ds, 2)?;
-    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
-    /// #     }
-    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
-    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
-    /// # }
+    /// # use appell_core::__doc_model::Oscillator;
     ///
     /// let model = Oscillator { w: 2.0 };
     /// let mut out: Vec<(f64, Vec<f64>)> = (1..=10).map(|k| (0.1 * k as f64, vec![])).collect();
@@ -387,40 +322,7 @@ impl Radau5 {
     ///
     /// ```
     /// use appell_integrate::Radau5;
-    /// use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-    /// # struct Oscillator { w: f64 }
-    /// # static INFO: ModelInfo = ModelInfo {
-    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
-    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
-    /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
-    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
-    /// #     jacobian: None,
-    /// #     equations: "x'' = -w^2 x",
-    /// # };
-    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
-    /// # impl Model for Oscillator {
-    /// #     type Prepared<T: Scalar> = T;
-    /// #     fn info() -> &'static ModelInfo { &INFO }
-    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
-    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
-    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-    /// #         appell_core::check_len("state", s, 2)?;
-    /// #         appell_core::check_len("dstate", ds, 2)?;
-    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
-    /// #     }
-    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
-    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
-    /// # }
+    /// # use appell_core::__doc_model::Oscillator;
     ///
     /// // x = cos(2t) first reaches 0 at t = π/4.
     /// let model = Oscillator { w: 2.0 };
@@ -454,40 +356,7 @@ impl Radau5 {
     ///
     /// ```
     /// use appell_integrate::{ProjectionFailed, Radau5};
-    /// use appell_core::{Model, ModelError, ModelInfo, OpCounts, Scalar};
-    /// # struct Oscillator { w: f64 }
-    /// # static INFO: ModelInfo = ModelInfo {
-    /// #     name: "Oscillator", parameters: &["w"], coordinates: &["x"], speeds: &["x"],
-    /// #     dependent: &[], cyclic: &[], ignorable: &[], retained: &["x"], inputs: &[],
-    /// #     effects: &[], outputs: &[], row_sources: &[], contacts: &[], holonomic: 0, constraints: 0, bodies: &[], force_points: 0,
-    /// #     torques: 0, form: "closed form", symbolic_elimination: true, rhs_ops: OpCounts {
-    /// #         add: 0, mul: 2, div: 0, calls: 0, total: 3 },
-    /// #     jacobian: None,
-    /// #     equations: "x'' = -w^2 x",
-    /// # };
-    /// # fn unused() -> Result<(), ModelError> { Err(ModelError::NonFinite { what: "unused" }) }
-    /// # impl Model for Oscillator {
-    /// #     type Prepared<T: Scalar> = T;
-    /// #     fn info() -> &'static ModelInfo { &INFO }
-    /// #     fn parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> { out[0] = self.w; Ok(()) }
-    /// #     fn set_parameter(&mut self, _: &str, _: f64) -> bool { false }
-    /// #     fn prepare<T: Scalar>(&self) -> T { let w = T::from_f64(self.w); -(w * w) }
-    /// #     fn rhs<T: Scalar>(&self, p: &T, _t: T, s: &[T], _i: &[T], ds: &mut [T]) -> Result<(), ModelError> {
-    /// #         appell_core::check_len("state", s, 2)?;
-    /// #         appell_core::check_len("dstate", ds, 2)?;
-    /// #         ds[0] = s[1]; ds[1] = *p * s[0]; Ok(())
-    /// #     }
-    /// #     fn mass_matrix_and_forcing<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn speed_transform<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn coordinate_rates<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_residuals<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn kinetic_energy<T: Scalar>(&self, _: T, _: &[T], _: &[T]) -> Result<T, ModelError> { unused().map(|_| T::zero()) }
-    /// #     fn mass_properties(&self, _: &mut [f64], _: &mut [[f64; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn body_poses<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn constraint_rows<T: Scalar>(&self, _: T, _: &[T], _: &mut [T], _: &mut [T]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_geometry<T: Scalar>(&self, _: T, _: &[T], _: &mut [[T; 3]], _: &mut [[T; 9]]) -> Result<(), ModelError> { unused() }
-    /// #     fn load_values<T: Scalar>(&self, _: T, _: &[T], _: &[T], _: &[T], _: &mut [[T; 3]], _: &mut [[T; 3]]) -> Result<(), ModelError> { unused() }
-    /// # }
+    /// # use appell_core::__doc_model::Oscillator;
     ///
     /// // x'' = −x keeps x² + x'² = 1 from (1, 0).
     /// let model = Oscillator { w: 1.0 };
