@@ -58,6 +58,108 @@ fn forcing<T: Scalar>(g_over_l: T, q: &[T], inputs: &[T]) -> T {
     -g_over_l * q[0].sin() + inputs[0]
 }
 
+/// The methods both models share: one coordinate whose rate is the one
+/// speed (q̇ = u), the kinetic energy ½ u² of a unit mass on it, and no
+/// constraints, bodies or loads to describe.
+macro_rules! one_free_coordinate {
+    () => {
+        fn speed_transform<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            c: &mut [T],
+            c0: &mut [T],
+        ) -> Result<(), ModelError> {
+            crate::check_len("c", c, 1)?;
+            crate::check_len("c0", c0, 1)?;
+            c[0] = T::one();
+            c0[0] = T::zero();
+            Ok(())
+        }
+
+        fn coordinate_rates<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            u: &[T],
+            qdot: &mut [T],
+        ) -> Result<(), ModelError> {
+            crate::check_len("u", u, 1)?;
+            crate::check_len("qdot", qdot, 1)?;
+            qdot[0] = u[0];
+            Ok(())
+        }
+
+        fn constraint_residuals<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            _qdot: &[T],
+            _position: &mut [T],
+            _velocity: &mut [T],
+        ) -> Result<(), ModelError> {
+            Ok(())
+        }
+
+        fn kinetic_energy<T: Scalar>(&self, _t: T, _q: &[T], u: &[T]) -> Result<T, ModelError> {
+            crate::check_len("u", u, 1)?;
+            Ok(T::from_f64(0.5) * u[0] * u[0])
+        }
+
+        fn mass_properties(
+            &self,
+            _masses: &mut [f64],
+            _inertias: &mut [[f64; 9]],
+        ) -> Result<(), ModelError> {
+            Ok(())
+        }
+
+        fn body_poses<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            _positions: &mut [[T; 3]],
+            _rotations: &mut [[T; 9]],
+        ) -> Result<(), ModelError> {
+            Ok(())
+        }
+
+        fn constraint_rows<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            _d: &mut [T],
+            _d0: &mut [T],
+        ) -> Result<(), ModelError> {
+            Ok(())
+        }
+
+        /// No forces or torques are declared: nothing to write.
+        fn load_geometry<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            _points: &mut [[T; 3]],
+            _frames: &mut [[T; 9]],
+        ) -> Result<(), ModelError> {
+            Ok(())
+        }
+
+        /// No forces or torques are declared: nothing to write.
+        fn load_values<T: Scalar>(
+            &self,
+            _t: T,
+            _q: &[T],
+            _qdot: &[T],
+            _inputs: &[T],
+            _forces: &mut [[T; 3]],
+            _torques: &mut [[T; 3]],
+        ) -> Result<(), ModelError> {
+            Ok(())
+        }
+    };
+}
+
 impl Model for Pendulum {
     type Prepared<T: Scalar> = T;
 
@@ -158,100 +260,7 @@ impl Model for Pendulum {
         Ok(())
     }
 
-    fn speed_transform<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        c: &mut [T],
-        c0: &mut [T],
-    ) -> Result<(), ModelError> {
-        crate::check_len("c", c, 1)?;
-        crate::check_len("c0", c0, 1)?;
-        c[0] = T::one();
-        c0[0] = T::zero();
-        Ok(())
-    }
-
-    fn coordinate_rates<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        u: &[T],
-        qdot: &mut [T],
-    ) -> Result<(), ModelError> {
-        crate::check_len("u", u, 1)?;
-        crate::check_len("qdot", qdot, 1)?;
-        qdot[0] = u[0];
-        Ok(())
-    }
-
-    fn constraint_residuals<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _qdot: &[T],
-        _position: &mut [T],
-        _velocity: &mut [T],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    fn kinetic_energy<T: Scalar>(&self, _t: T, _q: &[T], u: &[T]) -> Result<T, ModelError> {
-        crate::check_len("u", u, 1)?;
-        Ok(T::from_f64(0.5) * u[0] * u[0])
-    }
-
-    fn mass_properties(
-        &self,
-        _masses: &mut [f64],
-        _inertias: &mut [[f64; 9]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    fn body_poses<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _positions: &mut [[T; 3]],
-        _rotations: &mut [[T; 9]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    fn constraint_rows<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _d: &mut [T],
-        _d0: &mut [T],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    /// No forces or torques are declared: nothing to write.
-    fn load_geometry<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _points: &mut [[T; 3]],
-        _frames: &mut [[T; 9]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    /// No forces or torques are declared: nothing to write.
-    fn load_values<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _qdot: &[T],
-        _inputs: &[T],
-        _forces: &mut [[T; 3]],
-        _torques: &mut [[T; 3]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
+    one_free_coordinate!();
 }
 
 /// A harmonic oscillator, x'' = −w² x: coordinate x, speed ẋ, parameter
@@ -354,109 +363,12 @@ impl Model for Oscillator {
         Ok(())
     }
 
-    fn speed_transform<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        c: &mut [T],
-        c0: &mut [T],
-    ) -> Result<(), ModelError> {
-        crate::check_len("c", c, 1)?;
-        crate::check_len("c0", c0, 1)?;
-        c[0] = T::one();
-        c0[0] = T::zero();
-        Ok(())
-    }
-
-    fn coordinate_rates<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        u: &[T],
-        qdot: &mut [T],
-    ) -> Result<(), ModelError> {
-        crate::check_len("u", u, 1)?;
-        crate::check_len("qdot", qdot, 1)?;
-        qdot[0] = u[0];
-        Ok(())
-    }
-
-    /// No constraints: nothing to write.
-    fn constraint_residuals<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _qdot: &[T],
-        _position: &mut [T],
-        _velocity: &mut [T],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    fn kinetic_energy<T: Scalar>(&self, _t: T, _q: &[T], u: &[T]) -> Result<T, ModelError> {
-        crate::check_len("u", u, 1)?;
-        Ok(T::from_f64(0.5) * u[0] * u[0])
-    }
+    one_free_coordinate!();
 
     fn potential_energy<T: Scalar>(&self, _t: T, q: &[T]) -> Result<T, ModelError> {
         crate::check_len("q", q, 1)?;
         let w = T::from_f64(self.w);
         Ok(T::from_f64(0.5) * w * w * q[0] * q[0])
-    }
-
-    /// No bodies are declared: nothing to write.
-    fn mass_properties(
-        &self,
-        _masses: &mut [f64],
-        _inertias: &mut [[f64; 9]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    /// No bodies are declared: nothing to write.
-    fn body_poses<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _positions: &mut [[T; 3]],
-        _rotations: &mut [[T; 9]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    /// No constraints: nothing to write.
-    fn constraint_rows<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _d: &mut [T],
-        _d0: &mut [T],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    /// No forces or torques are declared: nothing to write.
-    fn load_geometry<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _points: &mut [[T; 3]],
-        _frames: &mut [[T; 9]],
-    ) -> Result<(), ModelError> {
-        Ok(())
-    }
-
-    /// No forces or torques are declared: nothing to write.
-    fn load_values<T: Scalar>(
-        &self,
-        _t: T,
-        _q: &[T],
-        _qdot: &[T],
-        _inputs: &[T],
-        _forces: &mut [[T; 3]],
-        _torques: &mut [[T; 3]],
-    ) -> Result<(), ModelError> {
-        Ok(())
     }
 }
 
