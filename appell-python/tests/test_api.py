@@ -270,3 +270,62 @@ def test_foot_forces_of_a_scene(cache, rng):
     a = q[:, standing.coordinate_names.index("hip_pitch")]
     b = q[:, standing.coordinate_names.index("knee")]
     np.testing.assert_allclose(position[:, 2], 0.4 - 0.2 * (np.cos(a) + np.cos(a + b)), atol=1e-14)
+
+
+def _rk4(model, x, u, h):
+    k1 = model.rhs(x, u)
+    k2 = model.rhs(x + 0.5 * h * k1, u, t=0.5 * h)
+    k3 = model.rhs(x + 0.5 * h * k2, u, t=0.5 * h)
+    k4 = model.rhs(x + h * k3, u, t=h)
+    return x + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
+
+
+def _semi_implicit_euler(model, x, u, h):
+    r = len(model.info["retained"])
+    speeds = x[r:] + h * model.rhs(x, u)[r:]
+    at_new_speeds = np.concatenate([x[:r], speeds])
+    return np.concatenate([x[:r] + h * model.rhs(at_new_speeds, u)[:r], speeds])
+
+
+@pytest.mark.parametrize("method, step", [("rk4", _rk4), ("semi_implicit_euler", _semi_implicit_euler)])
+def test_step_jacobian_is_the_step_and_its_derivatives(ur5, wheel_axle, method, step, rng):
+    # The UR5 through its generated Jacobian (chained through the stages),
+    # the wheel-axle as well or by dual numbers: either way x⁺ is the step
+    # written here from rhs, A and B its central differences.
+    for model in (ur5, wheel_axle):
+        s, ni, h = len(model.state_names), len(model.input_names), 0.01
+        x = rng.uniform(-1, 1, s)
+        u = rng.uniform(-1, 1, ni)
+        nxt, A, B = model.step_jacobian(x, u, h=h, method=method)
+        assert A.shape == (s, s) and B.shape == (s, ni)
+        np.testing.assert_allclose(nxt, step(model, x, u, h), rtol=1e-12, atol=1e-12)
+        eps = 1e-6
+        for j in range(s):
+            d = np.zeros(s)
+            d[j] = eps
+            column = (step(model, x + d, u, h) - step(model, x - d, u, h)) / (2 * eps)
+            np.testing.assert_allclose(A[:, j], column, rtol=1e-6, atol=1e-8)
+        for j in range(ni):
+            d = np.zeros(ni)
+            d[j] = eps
+            column = (step(model, x, u + d, h) - step(model, x, u - d, h)) / (2 * eps)
+            np.testing.assert_allclose(B[:, j], column, rtol=1e-6, atol=1e-8)
+        # Batched rows are the single calls.
+        xs, us = rng.uniform(-1, 1, (4, s)), rng.uniform(-1, 1, (4, ni))
+        batch = model.step_jacobian(xs, us, h=h, method=method)
+        for k in (0, 3):
+            for got, one in zip(batch, model.step_jacobian(xs[k], us[k], h=h, method=method)):
+                assert np.array_equal(got[k], one)
+
+
+def test_step_jacobian_without_inputs_and_bad_arguments(pendulum):
+    x = np.array([0.4, -0.2])
+    nxt, A, B = pendulum.step_jacobian(x, h=0.01, method="semi_implicit_euler")
+    # ω⁺ = ω − h (g/l) sin θ, θ⁺ = θ + h ω⁺.
+    dw = -0.01 * 9.81 / 0.5 * np.cos(0.4)
+    np.testing.assert_allclose(A, [[1 + 0.01 * dw, 0.01], [dw, 1.0]], rtol=1e-12)
+    assert B.shape == (2, 0)
+    with pytest.raises(ValueError, match="semi_implicit_euler"):
+        pendulum.step_jacobian(x, h=0.01, method="euler")
+    with pytest.raises(appell.ModelError, match="h"):
+        pendulum.step_jacobian(x, h=float("nan"))

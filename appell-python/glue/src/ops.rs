@@ -4,6 +4,7 @@
 
 use std::sync::Arc;
 
+use appell::linearize::{step_jacobian, FixedStep};
 use appell::{DynModel, Model, ModelInfo, SceneVisitor};
 
 use crate::simulate::{simulate_dyn, SimJob};
@@ -46,6 +47,12 @@ pub enum Op {
     /// `(q, v, u) -> multipliers[m], qddot[n]` (the constraint forces'
     /// multipliers from the independent KKT solve).
     ConstraintForces,
+    /// One fixed step of the classical Runge–Kutta method and its
+    /// Jacobians (`appell::linearize::step_jacobian`): `(x[s], u[i], h[1])
+    /// -> x⁺[s], ∂x⁺/∂x[s×s], ∂x⁺/∂u[s×i]`.
+    StepJacobianRk4,
+    /// The same for one semi-implicit Euler step.
+    StepJacobianSemiImplicitEuler,
     /// `(q, v, u) -> [position[3], force[3], moment[3]]` for each foot of
     /// [`held_feet`] (`appell::constraint_forces::FootForce`; a point
     /// foot's moment zero).
@@ -71,7 +78,7 @@ pub fn held_feet(info: &ModelInfo) -> Vec<(usize, bool)> {
 
 impl Op {
     /// Every operation, for the Python package's table.
-    pub const ALL: [Op; 14] = [
+    pub const ALL: [Op; 16] = [
         Op::Rhs,
         Op::RhsJacobian,
         Op::Linearize,
@@ -86,6 +93,8 @@ impl Op {
         Op::Energies,
         Op::ConstraintForces,
         Op::FootForces,
+        Op::StepJacobianRk4,
+        Op::StepJacobianSemiImplicitEuler,
     ];
 
     /// The name the Python package uses.
@@ -105,6 +114,8 @@ impl Op {
             Op::Energies => "energies",
             Op::ConstraintForces => "constraint_forces",
             Op::FootForces => "foot_forces",
+            Op::StepJacobianRk4 => "step_jacobian_rk4",
+            Op::StepJacobianSemiImplicitEuler => "step_jacobian_semi_implicit_euler",
         }
     }
 
@@ -134,6 +145,9 @@ impl Op {
                 vec![("q", n), ("v", l), ("a", l)]
             }
             Op::BiasForces => vec![("q", n), ("v", l)],
+            Op::StepJacobianRk4 | Op::StepJacobianSemiImplicitEuler => {
+                vec![("x", s), ("u", i), ("h", 1)]
+            }
         }
     }
 
@@ -148,7 +162,9 @@ impl Op {
         );
         match self {
             Op::Rhs => s,
-            Op::RhsJacobian => s + s * s + s * i,
+            Op::RhsJacobian | Op::StepJacobianRk4 | Op::StepJacobianSemiImplicitEuler => {
+                s + s * s + s * i
+            }
             Op::Linearize => s * s + s * i,
             Op::CoordinateRates => n,
             Op::MassMatrix => l * l,
@@ -475,6 +491,19 @@ fn eval_row<M: Model>(
             model
                 .forward_dynamics_derivatives(t, a[0], a[1], a[2], accel, dq, du, dinputs)
                 .map_err(text)
+        }
+        Op::StepJacobianRk4 | Op::StepJacobianSemiImplicitEuler => {
+            let method = match op {
+                Op::StepJacobianRk4 => FixedStep::Rk4,
+                _ => FixedStep::SemiImplicitEuler,
+            };
+            let step = step_jacobian(model, method, t, a[2][0], a[0], a[1]).map_err(text)?;
+            let (next, rest) = out.split_at_mut(s);
+            let (da, db) = rest.split_at_mut(s * s);
+            next.copy_from_slice(&step.next);
+            row_major(&step.a, da);
+            row_major(&step.b, db);
+            Ok(())
         }
         Op::GravityForces => model.gravity_forces(t, a[0], out).map_err(text),
         Op::BiasForces => model.bias_forces(t, a[0], a[1], out).map_err(text),

@@ -356,6 +356,32 @@ class Model:
         lead = out.shape[:-1]
         return out[..., : s * s].reshape(lead + (s, s)), out[..., s * s :].reshape(lead + (s, ni))
 
+    _STEP_METHODS = {"rk4": "step_jacobian_rk4",
+                     "semi_implicit_euler": "step_jacobian_semi_implicit_euler"}
+
+    def step_jacobian(self, x: ArrayLike, u: Optional[ArrayLike] = None, *, h: float,
+                      method: str = "rk4", t: float = 0.0,
+                      params: Any = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """One fixed step of size ``h`` of the integrator a controller loop
+        runs, the inputs held over it, and its Jacobians in one call:
+        (x⁺, A = ∂x⁺/∂x, B = ∂x⁺/∂u), what a discrete-time MPC or DDP
+        solver linearizes at every knot. ``method``: ``"rk4"`` (the
+        classical Runge–Kutta step) or ``"semi_implicit_euler"`` (the
+        speeds first, u⁺ = u + h u̇, then the retained coordinates at the
+        new speeds). Exact to rounding: the chain rule through the stages
+        of the generated Jacobian (``has_jacobian``), else the step in dual
+        numbers. Batched over rows of ``x`` and ``u``; one ``h``."""
+        op = self._STEP_METHODS.get(method)
+        if op is None:
+            raise ValueError(f"unknown method {method!r}; the fixed steps are {sorted(self._STEP_METHODS)}"
+                             f"{_hint(str(method), list(self._STEP_METHODS))}")
+        xa, ua = self._array("x", x, self.state_names), self._array("u", u, self.input_names)
+        out = self._call(op, [xa, ua, np.array([float(h)])], t, params)
+        s, ni = self._s, self._ni
+        lead = out.shape[:-1]
+        return (out[..., :s], out[..., s : s + s * s].reshape(lead + (s, s)),
+                out[..., s + s * s :].reshape(lead + (s, ni)))
+
     def inverse_dynamics_derivatives(
             self, q: ArrayLike, v: ArrayLike, a: ArrayLike, t: float = 0.0, params: Any = None
     ) -> Tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
