@@ -95,6 +95,12 @@ pub(super) fn build_in(
     if cx.has_errors() {
         return None;
     }
+    // The tree's numbers in the graph last, after everything the model
+    // itself makes.
+    let tree = super::tree::tree_spec(ast).and_then(|spec| {
+        spec.lower(&mut b.g)
+            .map_err(|e| format!("the tree's numbers could not be lowered: {e}"))
+    });
     let model = Model {
         g: b.g,
         name: ast.name.clone(),
@@ -128,7 +134,7 @@ pub(super) fn build_in(
         quaternions: b.quaternions,
         joint_speeds: ast.joint_speeds.iter().map(|q| q.to_string()).collect(),
         files: ast.files.clone(),
-        tree: super::tree::tree_spec(ast),
+        tree,
     };
     Some((model, b.cuts))
 }

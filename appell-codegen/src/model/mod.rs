@@ -14,6 +14,8 @@
 //! | `scenes` | scenes: their effects and outputs |
 //! | `expr` | expressions: names, arithmetic on scalars, vectors and points |
 //! | `calls` | function calls: `dt`, `dot`, `cross`, `norm`, `unit`, `omega`, `velocity`, ... |
+//! | `contacts` | `contact(...)`s: a foot's rows, and the speeds of a scene that holds it |
+//! | [`tree`] | a tree of joints: its links, placements and bodies, its numbers lowered into the graph |
 
 mod bodies;
 mod builder;

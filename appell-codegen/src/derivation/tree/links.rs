@@ -2,12 +2,10 @@
 //! joint's transform from its parent link (welded links merged into the
 //! link they are fixed to), its motion subspace, its inertia, its input.
 
-use appell_symbolic::{Func, Graph, Id, SymbolicError};
+use appell_symbolic::{Graph, Id, SymbolicError};
 
 use super::spatial::{Algebra, Transform, M3, M6, V3, V6};
-use crate::ast::JointAxis;
-use crate::ast::{BinOp, Expr, Inertia};
-use crate::model::tree::{Motion, Term, TreeSpec, Turns};
+use crate::model::tree::{Axis, CentralInertia, MassSpec, Motion, Term, TreeSpec, Turns};
 use crate::model::Model;
 
 type R<T> = Result<T, SymbolicError>;
@@ -313,19 +311,16 @@ fn quaternion_rotation(a: &mut Algebra, e: [Id; 4]) -> R<M3> {
 }
 
 /// The axis as a unit vector in the joint frame.
-fn unit_axis(a: &mut Algebra, axis: &JointAxis) -> R<V3> {
+fn unit_axis(a: &mut Algebra, axis: &Axis) -> R<V3> {
     let zero = a.zero();
     match axis {
-        JointAxis::Unit(k, negative) => {
+        Axis::Unit(k, negative) => {
             let mut u = [zero; 3];
             u[*k] = a.g.int(if *negative { -1 } else { 1 })?;
             Ok(u)
         }
-        JointAxis::Components(c) => {
-            let mut v = [zero; 3];
-            for (i, e) in c.iter().enumerate() {
-                v[i] = constant(a.g, e)?;
-            }
+        Axis::Components(c) => {
+            let v = *c;
             let len2 = a.dot((0..3).map(|i| (v[i], v[i])))?;
             let len = a.g.sqrt(len2)?;
             let inv = a.g.recip(len)?;
@@ -336,8 +331,8 @@ fn unit_axis(a: &mut Algebra, axis: &JointAxis) -> R<V3> {
 
 /// The rotation by `q` about the unit axis `u` (Rodrigues' formula; a
 /// simple rotation for a coordinate axis).
-fn rotation_about(a: &mut Algebra, axis: &JointAxis, u: V3, q: Id) -> R<M3> {
-    if let JointAxis::Unit(k, negative) = axis {
+fn rotation_about(a: &mut Algebra, axis: &Axis, u: V3, q: Id) -> R<M3> {
+    if let Axis::Unit(k, negative) = axis {
         let angle = if *negative { a.g.neg(q)? } else { q };
         return simple(a, *k, angle);
     }
@@ -383,9 +378,8 @@ fn simple(a: &mut Algebra, k: usize, angle: Id) -> R<M3> {
 /// The product of `turns` from a link's axes.
 fn turned(a: &mut Algebra, turns: &Turns) -> R<M3> {
     let mut r = identity(a)?.rot;
-    for (k, angle) in turns {
-        let angle = constant(a.g, angle)?;
-        let t = simple(a, *k, angle)?;
+    for &(k, angle) in turns {
+        let t = simple(a, k, angle)?;
         r = a.mat_mul(&r, &t)?;
     }
     Ok(r)
@@ -393,15 +387,13 @@ fn turned(a: &mut Algebra, turns: &Turns) -> R<M3> {
 
 /// The joint frame in the parent link: `xyz`, then fixed-axis roll,
 /// pitch, yaw (R = Rz(yaw) Ry(pitch) Rx(roll)).
-fn placement(a: &mut Algebra, xyz: Option<&[Expr; 3]>, rpy: Option<&[Expr; 3]>) -> R<Transform> {
+fn placement(a: &mut Algebra, xyz: Option<&[Id; 3]>, rpy: Option<&[Id; 3]>) -> R<Transform> {
     let mut x = identity(a)?;
     if let Some(v) = xyz {
-        for (i, e) in v.iter().enumerate() {
-            x.pos[i] = constant(a.g, e)?;
-        }
+        x.pos = *v;
     }
-    if let Some([r, p, y]) = rpy {
-        let turns = vec![(2, y.clone()), (1, p.clone()), (0, r.clone())];
+    if let Some(&[r, p, y]) = rpy {
+        let turns = vec![(2, y), (1, p), (0, r)];
         x.rot = turned(a, &turns)?;
     }
     Ok(x)
@@ -432,7 +424,7 @@ pub(super) fn compose(a: &mut Algebra, first: &Transform, second: &Transform) ->
 fn terms_vector(a: &mut Algebra, terms: &[Term]) -> R<V3> {
     let mut v = [a.zero(); 3];
     for t in terms {
-        let k = constant(a.g, &t.coefficient)?;
+        let k = t.coefficient;
         let r = turned(a, &t.turns)?;
         let column = [r[0][t.axis], r[1][t.axis], r[2][t.axis]];
         let scaled = a.scale(column, k)?;
@@ -442,10 +434,10 @@ fn terms_vector(a: &mut Algebra, terms: &[Term]) -> R<V3> {
 }
 
 /// The bodies' spatial inertia about the link's origin, in its axes.
-fn link_inertia(a: &mut Algebra, bodies: &[crate::model::tree::MassSpec]) -> R<M6> {
+fn link_inertia(a: &mut Algebra, bodies: &[MassSpec]) -> R<M6> {
     let mut total = [[a.zero(); 6]; 6];
     for b in bodies {
-        let m = constant(a.g, &b.mass)?;
+        let m = b.mass;
         let c = terms_vector(a, &b.center)?;
         let central = match &b.inertia {
             Some((turns, inertia)) => {
@@ -464,16 +456,15 @@ fn link_inertia(a: &mut Algebra, bodies: &[crate::model::tree::MassSpec]) -> R<M
 }
 
 /// The central inertia as written, in the body's axes.
-fn inertia_matrix(a: &mut Algebra, inertia: &Inertia) -> R<M3> {
+fn inertia_matrix(a: &mut Algebra, inertia: &CentralInertia) -> R<M3> {
     let mut m = [[a.zero(); 3]; 3];
-    match inertia {
-        Inertia::Principal(d) => {
-            for (i, e) in d.iter().enumerate() {
-                m[i][i] = constant(a.g, e)?;
+    match *inertia {
+        CentralInertia::Principal(d) => {
+            for (i, e) in d.into_iter().enumerate() {
+                m[i][i] = e;
             }
         }
-        Inertia::Matrix(e) => {
-            let v: Vec<Id> = e.iter().map(|x| constant(a.g, x)).collect::<R<_>>()?;
+        CentralInertia::Matrix(v) => {
             m = [[v[0], v[3], v[5]], [v[3], v[1], v[4]], [v[5], v[4], v[2]]];
         }
     }
@@ -488,44 +479,4 @@ fn transpose(m: &M3) -> M3 {
         }
     }
     t
-}
-
-/// A constant of the model language (numbers and parameters) in the
-/// graph; the tree's checks admitted only those.
-pub fn constant(g: &mut Graph, e: &Expr) -> R<Id> {
-    match e {
-        Expr::Int(i, _) => g.int(*i),
-        Expr::Float(x, _) => g.float(*x),
-        Expr::Name(n) => match g.symbol_named(&n.to_string()) {
-            Some(s) => g.sym(s),
-            None => Err(SymbolicError::UnknownSymbol {
-                name: n.to_string(),
-            }),
-        },
-        Expr::Neg(x, _) => {
-            let x = constant(g, x)?;
-            g.neg(x)
-        }
-        Expr::Binary(op, x, y, _) => {
-            let (x, y) = (constant(g, x)?, constant(g, y)?);
-            match op {
-                BinOp::Add => g.add(x, y),
-                BinOp::Sub => g.sub(x, y),
-                BinOp::Mul => g.mul(x, y),
-                BinOp::Div => g.div(x, y),
-            }
-        }
-        Expr::Call(f, args, _) if args.len() == 1 => {
-            let x = constant(g, &args[0])?;
-            match Func::from_name(&f.to_string()) {
-                Some(func) => g.func(func, x),
-                None => Err(SymbolicError::UnknownSymbol {
-                    name: f.to_string(),
-                }),
-            }
-        }
-        _ => Err(SymbolicError::UnknownSymbol {
-            name: "a vector in a scalar".into(),
-        }),
-    }
 }

@@ -1,8 +1,9 @@
-//! The kinematic tree of a model made of joints, as written: which link
-//! each joint moves, where its frame sits in the parent link, and the
-//! bodies each link carries, every number still an expression of the
-//! model language. The structured form of the equations
-//! ([`crate::derivation::tree`]) is built from it. A tree under
+//! The kinematic tree of a model made of joints: which link each joint
+//! moves, where its frame sits in the parent link, and the bodies each
+//! link carries. [`tree_spec`] reads it off the syntax, every number an
+//! expression of the model language; [`TreeSpec::lower`] puts those
+//! numbers in the model's graph, and the structured form of the equations
+//! ([`crate::derivation::tree`]) is built from the lowered tree. A tree under
 //! constraints (rolling contacts, closing rows, dependent joints, speeds
 //! other than the joint rates) is still a tree: its equations are the
 //! tree's projected onto the privileged speeds, and [`TreeSpec::plain`]
@@ -10,22 +11,37 @@
 //! coordinate no joint makes, a load other than gravity and joint
 //! actuation, ...) gets the reason instead, reported in `info()`.
 
+mod lower;
+
 use std::collections::HashMap;
+
+use appell_symbolic::Id;
 
 use crate::ast::{BinOp, Expr, Inertia, ModelAst, RotationAxis};
 use crate::ast::{JointAxis, JointDef, JointKind};
 
 /// Constant rotations from a link's axes to a frame fixed in it: each
-/// about the current frame's axis 0, 1 or 2 by the angle.
-pub type Turns = Vec<(usize, Expr)>;
+/// about the current frame's axis 0, 1 or 2 by the angle. `C`, here and
+/// in the types below, is a constant: an expression as written while the
+/// tree is read, a node of the model's graph once lowered.
+pub type Turns<C = Id> = Vec<(usize, C)>;
+
+/// A joint's axis in the joint frame.
+#[derive(Clone, Debug)]
+pub enum Axis<C = Id> {
+    /// Axis 0, 1 or 2 (`x`, `y`, `z`), negated when the flag is set.
+    Unit(usize, bool),
+    /// Components in the joint frame, of any length.
+    Components([C; 3]),
+}
 
 /// What a joint lets its child do, in the joint frame.
 #[derive(Clone, Debug)]
-pub enum Motion {
+pub enum Motion<C = Id> {
     /// Turn about the axis.
-    Revolute(JointAxis),
+    Revolute(Axis<C>),
     /// Slide along the axis.
-    Prismatic(JointAxis),
+    Prismatic(Axis<C>),
     /// Turn about the joint origin by a unit quaternion (its coordinates
     /// `{joint}_qw, _qx, _qy, _qz`), at the child's angular velocity
     /// relative to the joint frame in the child's axes (its speeds
@@ -41,49 +57,58 @@ pub enum Motion {
 /// One term of a vector fixed in a link: `coefficient · F.axis`, with `F`
 /// reached from the link's axes by `turns`.
 #[derive(Clone, Debug)]
-pub struct Term {
+pub struct Term<C = Id> {
     /// The scalar coefficient (parameters and numbers only).
-    pub coefficient: Expr,
+    pub coefficient: C,
     /// The frame's rotations from the link.
-    pub turns: Turns,
+    pub turns: Turns<C>,
     /// Its axis, 0, 1 or 2.
     pub axis: usize,
     /// The link the frame is fixed in (None: the ground).
     pub link: Option<usize>,
 }
 
+/// A central inertia in a body's axes, as written.
+#[derive(Clone, Debug)]
+pub enum CentralInertia<C = Id> {
+    /// `principal(i1, i2, i3)`.
+    Principal([C; 3]),
+    /// `matrix(ixx, iyy, izz, ixy, iyz, izx)`.
+    Matrix([C; 6]),
+}
+
 /// A body or particle carried by a link.
 #[derive(Clone, Debug)]
-pub struct MassSpec {
+pub struct MassSpec<C = Id> {
     /// The body's name.
     pub name: String,
     /// Its mass.
-    pub mass: Expr,
+    pub mass: C,
     /// Its mass centre from the link's origin.
-    pub center: Vec<Term>,
+    pub center: Vec<Term<C>>,
     /// Its frame's rotations from the link and its central inertia in that
     /// frame (none for a particle).
-    pub inertia: Option<(Turns, Inertia)>,
+    pub inertia: Option<(Turns<C>, CentralInertia<C>)>,
 }
 
 /// One link: the child of one joint.
 #[derive(Clone, Debug)]
-pub struct LinkSpec {
+pub struct LinkSpec<C = Id> {
     /// The joint's name (its coordinate's, for a moving joint).
     pub joint: String,
     /// The parent link; None for the ground N.
     pub parent: Option<usize>,
     /// The parent frame's rotations from the parent link.
-    pub parent_turns: Turns,
+    pub parent_turns: Turns<C>,
     /// The parent frame's origin from the parent link's.
-    pub parent_origin: Vec<Term>,
+    pub parent_origin: Vec<Term<C>>,
     /// The joint frame's origin in the parent frame's axes (zero when
     /// None).
-    pub xyz: Option<[Expr; 3]>,
+    pub xyz: Option<[C; 3]>,
     /// The joint frame's fixed-axis roll, pitch, yaw in the parent frame.
-    pub rpy: Option<[Expr; 3]>,
+    pub rpy: Option<[C; 3]>,
     /// The joint's motion; None for a weld.
-    pub motion: Option<Motion>,
+    pub motion: Option<Motion<C>>,
     /// The coordinates the link's motion reads, by name: the joint's for
     /// one degree of freedom, a ball's quaternion (none for a weld).
     pub coordinates: Vec<String>,
@@ -93,16 +118,16 @@ pub struct LinkSpec {
     /// Whether the joint carries the input `tau_{joint}`.
     pub actuated: bool,
     /// The bodies fixed in the link.
-    pub bodies: Vec<MassSpec>,
+    pub bodies: Vec<MassSpec<C>>,
 }
 
 /// A model's kinematic tree.
 #[derive(Clone, Debug)]
-pub struct TreeSpec {
+pub struct TreeSpec<C = Id> {
     /// Links in declaration order: a parent comes before its children.
-    pub links: Vec<LinkSpec>,
+    pub links: Vec<LinkSpec<C>>,
     /// The gravity acceleration as terms along N's axes.
-    pub gravity: Vec<Term>,
+    pub gravity: Vec<Term<C>>,
     /// Ok for a plain tree, whose privileged speeds are its joint rates
     /// and which has no constraints; else why not. Moving link k moves
     /// coordinate k either way.
@@ -111,10 +136,10 @@ pub struct TreeSpec {
 
 /// Where a frame or point sits: its link (None: the ground) and, for a
 /// frame, its rotations from the link, for a point, its offset.
-type FrameAt = (Option<usize>, Turns);
-type PointAt = (Option<usize>, Vec<Term>);
+type FrameAt = (Option<usize>, Turns<Expr>);
+type PointAt = (Option<usize>, Vec<Term<Expr>>);
 
-/// The model's kinematic tree, or why it has none.
+/// The model's kinematic tree as written, or why it has none.
 ///
 /// ```
 /// use appell_codegen::{ctxt::Ctxt, parse, model::tree};
@@ -133,7 +158,7 @@ type PointAt = (Option<usize>, Vec<Term>);
 /// assert_eq!(spec.links.len(), 1);
 /// assert_eq!(spec.links[0].bodies[0].center.len(), 1);
 /// ```
-pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec, String> {
+pub fn tree_spec(ast: &ModelAst) -> Result<TreeSpec<Expr>, String> {
     if ast.joints.is_empty() {
         // No reason to give: a model without joints is not a tree of them.
         return Err(String::new());
@@ -430,7 +455,7 @@ fn links_of(
     frames: &HashMap<String, FrameAt>,
     points: &HashMap<String, PointAt>,
     first: usize,
-) -> Result<Option<Vec<LinkSpec>>, String> {
+) -> Result<Option<Vec<LinkSpec<Expr>>>, String> {
     let Some((parent, parent_turns)) = frames.get(&j.parent.to_string()).cloned() else {
         return Ok(None);
     };
@@ -451,7 +476,7 @@ fn links_of(
             j.name
         ));
     }
-    let link = |joint: String, motion: Option<Motion>| LinkSpec {
+    let link = |joint: String, motion: Option<Motion<Expr>>| LinkSpec {
         coordinates: link_coordinates(&joint, motion.as_ref()),
         speeds: link_speeds(&joint, motion.as_ref()),
         joint,
@@ -465,7 +490,7 @@ fn links_of(
         bodies: Vec::new(),
     };
     // A link moving on the one before it, in its axes.
-    let next = |joint: String, parent: usize, motion: Option<Motion>| LinkSpec {
+    let next = |joint: String, parent: usize, motion: Option<Motion<Expr>>| LinkSpec {
         coordinates: link_coordinates(&joint, motion.as_ref()),
         speeds: link_speeds(&joint, motion.as_ref()),
         joint,
@@ -478,13 +503,13 @@ fn links_of(
         actuated: false,
         bodies: Vec::new(),
     };
-    let slide = |k: usize| Some(Motion::Prismatic(JointAxis::Unit(k, false)));
+    let slide = |k: usize| Some(Motion::Prismatic(Axis::Unit(k, false)));
     let name = j.name.to_string();
     Ok(Some(match &j.kind {
-        JointKind::Revolute(a) => vec![link(name, Some(Motion::Revolute(a.clone())))],
-        JointKind::Prismatic(a) => vec![link(name, Some(Motion::Prismatic(a.clone())))],
+        JointKind::Revolute(a) => vec![link(name, Some(Motion::Revolute(axis(a))))],
+        JointKind::Prismatic(a) => vec![link(name, Some(Motion::Prismatic(axis(a))))],
         JointKind::Planar(k) => {
-            let turn = Some(Motion::Revolute(JointAxis::Unit(*k, false)));
+            let turn = Some(Motion::Revolute(Axis::Unit(*k, false)));
             vec![
                 link(format!("{name}_x"), slide((k + 1) % 3)),
                 next(format!("{name}_y"), first, slide((k + 2) % 3)),
@@ -497,8 +522,16 @@ fn links_of(
     }))
 }
 
+/// A joint's axis as written.
+fn axis(a: &JointAxis) -> Axis<Expr> {
+    match a {
+        JointAxis::Unit(k, negative) => Axis::Unit(*k, *negative),
+        JointAxis::Components(c) => Axis::Components(c.clone()),
+    }
+}
+
 /// The coordinates a link named `joint` reads.
-fn link_coordinates(joint: &str, motion: Option<&Motion>) -> Vec<String> {
+fn link_coordinates(joint: &str, motion: Option<&Motion<Expr>>) -> Vec<String> {
     match motion {
         None => Vec::new(),
         Some(Motion::Spherical) => ["w", "x", "y", "z"]
@@ -512,7 +545,7 @@ fn link_coordinates(joint: &str, motion: Option<&Motion>) -> Vec<String> {
 }
 
 /// The speeds of a link named `joint`'s motion.
-fn link_speeds(joint: &str, motion: Option<&Motion>) -> Vec<String> {
+fn link_speeds(joint: &str, motion: Option<&Motion<Expr>>) -> Vec<String> {
     match motion {
         None => Vec::new(),
         Some(Motion::Spherical) => ["x", "y", "z"].map(|c| format!("{joint}_w{c}")).to_vec(),
@@ -528,7 +561,7 @@ fn mass_spec(
     b: &crate::ast::BodyDef,
     frames: &HashMap<String, FrameAt>,
     points: &HashMap<String, PointAt>,
-) -> Result<(Option<usize>, MassSpec), String> {
+) -> Result<(Option<usize>, MassSpec<Expr>), String> {
     let not_fixed = || format!("body `{}` is not fixed in a link", b.name);
     let (link, center) = points
         .get(&b.center.to_string())
@@ -540,7 +573,11 @@ fn mass_spec(
             if frame_link != link {
                 return Err(not_fixed());
             }
-            Some((turns, i.clone()))
+            let central = match i {
+                Inertia::Principal(d) => CentralInertia::Principal(d.clone()),
+                Inertia::Matrix(e) => CentralInertia::Matrix(e.clone()),
+            };
+            Some((turns, central))
         }
         (Some(f), None) => {
             let (frame_link, _) = frames.get(&f.to_string()).ok_or_else(not_fixed)?;
@@ -603,7 +640,7 @@ fn vector_terms(
     factor: Option<Expr>,
     frames: &HashMap<String, FrameAt>,
     coordinates: &[String],
-    out: &mut Vec<Term>,
+    out: &mut Vec<Term<Expr>>,
 ) -> bool {
     let scaled = |k: &Expr| match &factor {
         Some(f) => Expr::Binary(
