@@ -186,338 +186,6 @@ impl<M: Model> DynRhs for Prepared<'_, M> {
     }
 }
 
-/// The object-safe face of a [`Model`]: its metadata, parameters, reduced
-/// equations and kinematic description in `f64`, and the few methods the
-/// oracle evaluates in dual numbers ([`Dual64`], [`Dual2_64`]). Each method
-/// is the `Model` method of the same name without the `dyn_` prefix, at the
-/// scalar its suffix names (none: `f64`).
-///
-/// Implemented for every [`Model`] (and only for them); a `&M` coerces to
-/// `&dyn DynModel`, so one function over `&dyn DynModel` serves every model
-/// and is compiled once. The command line is written this way.
-///
-/// ```
-/// use appell_core::DynModel;
-/// # use appell_core::ModelError;
-/// # use appell_core::__doc_model::Oscillator;
-/// // A function compiled once, whatever the model.
-/// fn period_guess(model: &mut dyn DynModel, w: f64) -> Result<f64, ModelError> {
-///     assert!(model.dyn_set_parameter("w", w));
-///     let mut d = vec![0.0; model.dyn_info().state_len()];
-///     model.dyn_rhs(0.0, &[1.0, 0.0], &[], &mut d)?;
-///     Ok(2.0 * std::f64::consts::PI / (-d[1]).sqrt())
-/// }
-///
-/// let mut model = Oscillator { w: 1.0 };
-/// assert!((period_guess(&mut model, 2.0).unwrap() - std::f64::consts::PI).abs() < 1e-12);
-/// assert_eq!(model.w, 2.0);
-/// ```
-pub trait DynModel: sealed::Sealed {
-    /// [`Model::info`].
-    fn dyn_info(&self) -> &'static ModelInfo;
-
-    /// [`Model::scene_infos`].
-    fn dyn_scene_infos(&self) -> &'static [&'static ModelInfo];
-
-    /// [`Model::parameter_values`].
-    fn dyn_parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError>;
-
-    /// [`Model::set_parameter`].
-    fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool;
-
-    /// [`Model::validate`].
-    fn dyn_validate(&self) -> Result<(), ModelError>;
-
-    /// The reduced rhs with [`Model::prepare`] done once, in `f64` and
-    /// [`Dual64`].
-    fn dyn_prepare(&self) -> Box<dyn DynRhs + '_>;
-
-    /// [`Model::rhs`] after [`Model::prepare`], in `f64`.
-    fn dyn_rhs(
-        &self,
-        t: f64,
-        state: &[f64],
-        inputs: &[f64],
-        dstate: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::scene_rhs`].
-    fn dyn_scene_rhs(
-        &self,
-        scene: usize,
-        t: f64,
-        state: &[f64],
-        inputs: &[f64],
-        dstate: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// Calls `visit` with scene `scene` as a `DynModel` ([`Model::visit_scene`]).
-    fn dyn_visit_scene(
-        &self,
-        scene: usize,
-        visit: &mut dyn FnMut(&dyn DynModel),
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::coordinate_rates`].
-    fn dyn_coordinate_rates(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        qdot: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::constraint_residuals`].
-    fn dyn_constraint_residuals(
-        &self,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-        holonomic: &mut [f64],
-        velocity: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::speed_definitions`].
-    fn dyn_speed_definitions(
-        &self,
-        t: f64,
-        q: &[f64],
-        w: &mut [f64],
-        w0: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::mass_matrix_and_forcing`].
-    fn dyn_mass_matrix_and_forcing(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-        m: &mut [f64],
-        f: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::speed_definitions`] in [`Dual64`].
-    fn dyn_speed_definitions_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        w: &mut [Dual64],
-        w0: &mut [Dual64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::kinetic_energy`] in [`Dual64`].
-    fn dyn_kinetic_energy_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        u: &[Dual64],
-    ) -> Result<Dual64, ModelError>;
-
-    /// [`Model::potential_energy`] in [`Dual64`].
-    fn dyn_potential_energy_dual(&self, t: Dual64, q: &[Dual64]) -> Result<Dual64, ModelError>;
-
-    /// [`Model::input_power`].
-    fn dyn_input_power(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-    ) -> Result<f64, ModelError>;
-
-    /// [`Model::mass_properties`].
-    fn dyn_mass_properties(
-        &self,
-        masses: &mut [f64],
-        inertias: &mut [[f64; 9]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::body_poses`].
-    fn dyn_body_poses(
-        &self,
-        t: f64,
-        q: &[f64],
-        positions: &mut [[f64; 3]],
-        rotations: &mut [[f64; 9]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::body_poses`] in [`Dual64`].
-    fn dyn_body_poses_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        positions: &mut [[Dual64; 3]],
-        rotations: &mut [[Dual64; 9]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::body_poses`] in [`Dual2_64`].
-    fn dyn_body_poses_dual2(
-        &self,
-        t: Dual2_64,
-        q: &[Dual2_64],
-        positions: &mut [[Dual2_64; 3]],
-        rotations: &mut [[Dual2_64; 9]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::constraint_rows`].
-    fn dyn_constraint_rows(
-        &self,
-        t: f64,
-        q: &[f64],
-        d: &mut [f64],
-        d0: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::driven_constraint_rows`].
-    fn dyn_driven_constraint_rows(
-        &self,
-        t: f64,
-        q: &[f64],
-        inputs: &[f64],
-        d: &mut [f64],
-        d0: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::dependent_block_margin`].
-    fn dyn_dependent_block_margin(
-        &self,
-        t: f64,
-        q: &[f64],
-        inputs: &[f64],
-    ) -> Result<f64, ModelError>;
-
-    /// [`Model::driven_constraint_rows`] in [`Dual64`].
-    fn dyn_driven_constraint_rows_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        inputs: &[Dual64],
-        d: &mut [Dual64],
-        d0: &mut [Dual64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::driven_coordinate_rates`].
-    fn dyn_driven_coordinate_rates(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-        qdot: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::driven_coordinate_rates`] in [`Dual64`].
-    fn dyn_driven_coordinate_rates_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        u: &[Dual64],
-        inputs: &[Dual64],
-        qdot: &mut [Dual64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::driven_speed_transform`].
-    fn dyn_driven_speed_transform(
-        &self,
-        t: f64,
-        q: &[f64],
-        inputs: &[f64],
-        c: &mut [f64],
-        c0: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::driven_constraint_residuals`].
-    fn dyn_driven_constraint_residuals(
-        &self,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-        inputs: &[f64],
-        holonomic: &mut [f64],
-        velocity: &mut [f64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::driven_kinetic_energy`].
-    fn dyn_driven_kinetic_energy(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-    ) -> Result<f64, ModelError>;
-
-    /// [`Model::driven_kinetic_energy`] in [`Dual64`].
-    fn dyn_driven_kinetic_energy_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        u: &[Dual64],
-        inputs: &[Dual64],
-    ) -> Result<Dual64, ModelError>;
-
-    /// [`Model::constraint_rows`] in [`Dual64`].
-    fn dyn_constraint_rows_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        d: &mut [Dual64],
-        d0: &mut [Dual64],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::load_geometry`].
-    fn dyn_load_geometry(
-        &self,
-        t: f64,
-        q: &[f64],
-        points: &mut [[f64; 3]],
-        frames: &mut [[f64; 9]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::load_geometry`] in [`Dual64`].
-    fn dyn_load_geometry_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        points: &mut [[Dual64; 3]],
-        frames: &mut [[Dual64; 9]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::contact_geometry`].
-    fn dyn_contact_geometry(
-        &self,
-        t: f64,
-        q: &[f64],
-        points: &mut [[f64; 3]],
-        directions: &mut [[f64; 3]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::contact_links`].
-    fn dyn_contact_links(&self) -> &'static [&'static str];
-
-    /// [`Model::joint_limits`].
-    fn dyn_joint_limits(&self) -> &'static [crate::JointLimit];
-
-    /// [`Model::contact_points`].
-    fn dyn_contact_points(
-        &self,
-        t: f64,
-        q: &[f64],
-        points: &mut [[f64; 3]],
-    ) -> Result<(), ModelError>;
-
-    /// [`Model::load_values`].
-    fn dyn_load_values(
-        &self,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-        inputs: &[f64],
-        forces: &mut [[f64; 3]],
-        torques: &mut [[f64; 3]],
-    ) -> Result<(), ModelError>;
-}
-
 /// Passes a scene to a `dyn` callback.
 struct Visit<'a, 'b>(&'a mut (dyn FnMut(&dyn DynModel) + 'b));
 
@@ -528,346 +196,368 @@ impl SceneVisitor for Visit<'_, '_> {
     }
 }
 
-impl<M: Model> DynModel for M {
-    fn dyn_info(&self) -> &'static ModelInfo {
-        M::info()
+/// Writes [`DynModel`] and its implementation for every [`Model`]: the
+/// methods written out by hand, then the forwarded ones, each declared
+/// with its docs and implemented as the `Model` method it names, called
+/// with the same arguments (at the scalar its argument types give).
+macro_rules! dyn_model {
+    (
+        $(#[$attr:meta])*
+        declared { $($declared:tt)* }
+        implemented { $($implemented:tt)* }
+        forwarded {
+            $(
+                $(#[$doc:meta])*
+                fn $dyn:ident => $name:ident($($arg:ident: $ty:ty),* $(,)?) -> $ret:ty;
+            )*
+        }
+    ) => {
+        $(#[$attr])*
+        pub trait DynModel: sealed::Sealed {
+            $($declared)*
+            $(
+                $(#[$doc])*
+                fn $dyn(&self, $($arg: $ty),*) -> $ret;
+            )*
+        }
+
+        impl<M: Model> DynModel for M {
+            $($implemented)*
+            $(
+                fn $dyn(&self, $($arg: $ty),*) -> $ret {
+                    self.$name($($arg),*)
+                }
+            )*
+        }
+    };
+}
+
+dyn_model! {
+    /// The object-safe face of a [`Model`]: its metadata, parameters, reduced
+    /// equations and kinematic description in `f64`, and the few methods the
+    /// oracle evaluates in dual numbers ([`Dual64`], [`Dual2_64`]). Each method
+    /// is the `Model` method of the same name without the `dyn_` prefix, at the
+    /// scalar its suffix names (none: `f64`).
+    ///
+    /// Implemented for every [`Model`] (and only for them); a `&M` coerces to
+    /// `&dyn DynModel`, so one function over `&dyn DynModel` serves every model
+    /// and is compiled once. The command line is written this way.
+    ///
+    /// ```
+    /// use appell_core::DynModel;
+    /// # use appell_core::ModelError;
+    /// # use appell_core::__doc_model::Oscillator;
+    /// // A function compiled once, whatever the model.
+    /// fn period_guess(model: &mut dyn DynModel, w: f64) -> Result<f64, ModelError> {
+    ///     assert!(model.dyn_set_parameter("w", w));
+    ///     let mut d = vec![0.0; model.dyn_info().state_len()];
+    ///     model.dyn_rhs(0.0, &[1.0, 0.0], &[], &mut d)?;
+    ///     Ok(2.0 * std::f64::consts::PI / (-d[1]).sqrt())
+    /// }
+    ///
+    /// let mut model = Oscillator { w: 1.0 };
+    /// assert!((period_guess(&mut model, 2.0).unwrap() - std::f64::consts::PI).abs() < 1e-12);
+    /// assert_eq!(model.w, 2.0);
+    /// ```
+    declared {
+        /// [`Model::info`].
+        fn dyn_info(&self) -> &'static ModelInfo;
+
+        /// [`Model::scene_infos`].
+        fn dyn_scene_infos(&self) -> &'static [&'static ModelInfo];
+
+        /// [`Model::set_parameter`].
+        fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool;
+
+        /// The reduced rhs with [`Model::prepare`] done once, in `f64` and
+        /// [`Dual64`].
+        fn dyn_prepare(&self) -> Box<dyn DynRhs + '_>;
+
+        /// [`Model::rhs`] after [`Model::prepare`], in `f64`.
+        fn dyn_rhs(
+            &self,
+            t: f64,
+            state: &[f64],
+            inputs: &[f64],
+            dstate: &mut [f64],
+        ) -> Result<(), ModelError>;
+
+        /// Calls `visit` with scene `scene` as a `DynModel` ([`Model::visit_scene`]).
+        fn dyn_visit_scene(
+            &self,
+            scene: usize,
+            visit: &mut dyn FnMut(&dyn DynModel),
+        ) -> Result<(), ModelError>;
+
+        /// [`Model::contact_links`].
+        fn dyn_contact_links(&self) -> &'static [&'static str];
+
+        /// [`Model::joint_limits`].
+        fn dyn_joint_limits(&self) -> &'static [crate::JointLimit];
     }
 
-    fn dyn_scene_infos(&self) -> &'static [&'static ModelInfo] {
-        M::scene_infos()
+    implemented {
+        fn dyn_info(&self) -> &'static ModelInfo {
+            M::info()
+        }
+
+        fn dyn_scene_infos(&self) -> &'static [&'static ModelInfo] {
+            M::scene_infos()
+        }
+
+        fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool {
+            self.set_parameter(name, value)
+        }
+
+        fn dyn_prepare(&self) -> Box<dyn DynRhs + '_> {
+            Box::new(Prepared::new(self))
+        }
+
+        fn dyn_rhs(
+            &self,
+            t: f64,
+            state: &[f64],
+            inputs: &[f64],
+            dstate: &mut [f64],
+        ) -> Result<(), ModelError> {
+            self.rhs(&self.prepare::<f64>(), t, state, inputs, dstate)
+        }
+
+        fn dyn_visit_scene(
+            &self,
+            scene: usize,
+            visit: &mut dyn FnMut(&dyn DynModel),
+        ) -> Result<(), ModelError> {
+            self.visit_scene(scene, Visit(visit))
+        }
+
+        fn dyn_contact_links(&self) -> &'static [&'static str] {
+            M::contact_links()
+        }
+
+        fn dyn_joint_limits(&self) -> &'static [crate::JointLimit] {
+            M::joint_limits()
+        }
     }
 
-    fn dyn_parameter_values(&self, out: &mut [f64]) -> Result<(), ModelError> {
-        self.parameter_values(out)
-    }
+    forwarded {
+        /// [`Model::parameter_values`].
+        fn dyn_parameter_values => parameter_values(out: &mut [f64]) -> Result<(), ModelError>;
 
-    fn dyn_set_parameter(&mut self, name: &str, value: f64) -> bool {
-        self.set_parameter(name, value)
-    }
+        /// [`Model::validate`].
+        fn dyn_validate => validate() -> Result<(), ModelError>;
 
-    fn dyn_validate(&self) -> Result<(), ModelError> {
-        self.validate()
-    }
+        /// [`Model::scene_rhs`].
+        fn dyn_scene_rhs => scene_rhs(
+            scene: usize,
+            t: f64,
+            state: &[f64],
+            inputs: &[f64],
+            dstate: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_prepare(&self) -> Box<dyn DynRhs + '_> {
-        Box::new(Prepared::new(self))
-    }
+        /// [`Model::coordinate_rates`].
+        fn dyn_coordinate_rates => coordinate_rates(t: f64, q: &[f64], u: &[f64], qdot: &mut [f64])
+            -> Result<(), ModelError>;
 
-    fn dyn_rhs(
-        &self,
-        t: f64,
-        state: &[f64],
-        inputs: &[f64],
-        dstate: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.rhs(&self.prepare::<f64>(), t, state, inputs, dstate)
-    }
+        /// [`Model::constraint_residuals`].
+        fn dyn_constraint_residuals => constraint_residuals(
+            t: f64,
+            q: &[f64],
+            qdot: &[f64],
+            holonomic: &mut [f64],
+            velocity: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_scene_rhs(
-        &self,
-        scene: usize,
-        t: f64,
-        state: &[f64],
-        inputs: &[f64],
-        dstate: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.scene_rhs(scene, t, state, inputs, dstate)
-    }
+        /// [`Model::speed_definitions`].
+        fn dyn_speed_definitions => speed_definitions(
+            t: f64,
+            q: &[f64],
+            w: &mut [f64],
+            w0: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_visit_scene(
-        &self,
-        scene: usize,
-        visit: &mut dyn FnMut(&dyn DynModel),
-    ) -> Result<(), ModelError> {
-        self.visit_scene(scene, Visit(visit))
-    }
+        /// [`Model::mass_matrix_and_forcing`].
+        fn dyn_mass_matrix_and_forcing => mass_matrix_and_forcing(
+            t: f64,
+            q: &[f64],
+            u: &[f64],
+            inputs: &[f64],
+            m: &mut [f64],
+            f: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_coordinate_rates(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        qdot: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.coordinate_rates(t, q, u, qdot)
-    }
+        /// [`Model::speed_definitions`] in [`Dual64`].
+        fn dyn_speed_definitions_dual => speed_definitions(
+            t: Dual64,
+            q: &[Dual64],
+            w: &mut [Dual64],
+            w0: &mut [Dual64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_constraint_residuals(
-        &self,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-        holonomic: &mut [f64],
-        velocity: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.constraint_residuals(t, q, qdot, holonomic, velocity)
-    }
+        /// [`Model::kinetic_energy`] in [`Dual64`].
+        fn dyn_kinetic_energy_dual => kinetic_energy(t: Dual64, q: &[Dual64], u: &[Dual64])
+            -> Result<Dual64, ModelError>;
 
-    fn dyn_mass_matrix_and_forcing(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-        m: &mut [f64],
-        f: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.mass_matrix_and_forcing(t, q, u, inputs, m, f)
-    }
+        /// [`Model::potential_energy`] in [`Dual64`].
+        fn dyn_potential_energy_dual => potential_energy(t: Dual64, q: &[Dual64])
+            -> Result<Dual64, ModelError>;
 
-    fn dyn_speed_definitions(
-        &self,
-        t: f64,
-        q: &[f64],
-        w: &mut [f64],
-        w0: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.speed_definitions(t, q, w, w0)
-    }
+        /// [`Model::input_power`].
+        fn dyn_input_power => input_power(t: f64, q: &[f64], u: &[f64], inputs: &[f64])
+            -> Result<f64, ModelError>;
 
-    fn dyn_speed_definitions_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        w: &mut [Dual64],
-        w0: &mut [Dual64],
-    ) -> Result<(), ModelError> {
-        self.speed_definitions(t, q, w, w0)
-    }
+        /// [`Model::mass_properties`].
+        fn dyn_mass_properties => mass_properties(masses: &mut [f64], inertias: &mut [[f64; 9]])
+            -> Result<(), ModelError>;
 
-    fn dyn_kinetic_energy_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        u: &[Dual64],
-    ) -> Result<Dual64, ModelError> {
-        self.kinetic_energy(t, q, u)
-    }
+        /// [`Model::body_poses`].
+        fn dyn_body_poses => body_poses(
+            t: f64,
+            q: &[f64],
+            positions: &mut [[f64; 3]],
+            rotations: &mut [[f64; 9]],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_potential_energy_dual(&self, t: Dual64, q: &[Dual64]) -> Result<Dual64, ModelError> {
-        self.potential_energy(t, q)
-    }
+        /// [`Model::body_poses`] in [`Dual64`].
+        fn dyn_body_poses_dual => body_poses(
+            t: Dual64,
+            q: &[Dual64],
+            positions: &mut [[Dual64; 3]],
+            rotations: &mut [[Dual64; 9]],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_input_power(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-    ) -> Result<f64, ModelError> {
-        self.input_power(t, q, u, inputs)
-    }
+        /// [`Model::body_poses`] in [`Dual2_64`].
+        fn dyn_body_poses_dual2 => body_poses(
+            t: Dual2_64,
+            q: &[Dual2_64],
+            positions: &mut [[Dual2_64; 3]],
+            rotations: &mut [[Dual2_64; 9]],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_mass_properties(
-        &self,
-        masses: &mut [f64],
-        inertias: &mut [[f64; 9]],
-    ) -> Result<(), ModelError> {
-        self.mass_properties(masses, inertias)
-    }
+        /// [`Model::constraint_rows`].
+        fn dyn_constraint_rows => constraint_rows(t: f64, q: &[f64], d: &mut [f64], d0: &mut [f64])
+            -> Result<(), ModelError>;
 
-    fn dyn_body_poses(
-        &self,
-        t: f64,
-        q: &[f64],
-        positions: &mut [[f64; 3]],
-        rotations: &mut [[f64; 9]],
-    ) -> Result<(), ModelError> {
-        self.body_poses(t, q, positions, rotations)
-    }
+        /// [`Model::driven_constraint_rows`].
+        fn dyn_driven_constraint_rows => driven_constraint_rows(
+            t: f64,
+            q: &[f64],
+            inputs: &[f64],
+            d: &mut [f64],
+            d0: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_body_poses_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        positions: &mut [[Dual64; 3]],
-        rotations: &mut [[Dual64; 9]],
-    ) -> Result<(), ModelError> {
-        self.body_poses(t, q, positions, rotations)
-    }
+        /// [`Model::dependent_block_margin`].
+        fn dyn_dependent_block_margin => dependent_block_margin(t: f64, q: &[f64], inputs: &[f64])
+            -> Result<f64, ModelError>;
 
-    fn dyn_body_poses_dual2(
-        &self,
-        t: Dual2_64,
-        q: &[Dual2_64],
-        positions: &mut [[Dual2_64; 3]],
-        rotations: &mut [[Dual2_64; 9]],
-    ) -> Result<(), ModelError> {
-        self.body_poses(t, q, positions, rotations)
-    }
+        /// [`Model::driven_constraint_rows`] in [`Dual64`].
+        fn dyn_driven_constraint_rows_dual => driven_constraint_rows(
+            t: Dual64,
+            q: &[Dual64],
+            inputs: &[Dual64],
+            d: &mut [Dual64],
+            d0: &mut [Dual64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_constraint_rows(
-        &self,
-        t: f64,
-        q: &[f64],
-        d: &mut [f64],
-        d0: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.constraint_rows(t, q, d, d0)
-    }
+        /// [`Model::driven_coordinate_rates`].
+        fn dyn_driven_coordinate_rates => driven_coordinate_rates(
+            t: f64,
+            q: &[f64],
+            u: &[f64],
+            inputs: &[f64],
+            qdot: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_constraint_rows_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        d: &mut [Dual64],
-        d0: &mut [Dual64],
-    ) -> Result<(), ModelError> {
-        self.constraint_rows(t, q, d, d0)
-    }
+        /// [`Model::driven_coordinate_rates`] in [`Dual64`].
+        fn dyn_driven_coordinate_rates_dual => driven_coordinate_rates(
+            t: Dual64,
+            q: &[Dual64],
+            u: &[Dual64],
+            inputs: &[Dual64],
+            qdot: &mut [Dual64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_driven_constraint_rows(
-        &self,
-        t: f64,
-        q: &[f64],
-        inputs: &[f64],
-        d: &mut [f64],
-        d0: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.driven_constraint_rows(t, q, inputs, d, d0)
-    }
+        /// [`Model::driven_speed_transform`].
+        fn dyn_driven_speed_transform => driven_speed_transform(
+            t: f64,
+            q: &[f64],
+            inputs: &[f64],
+            c: &mut [f64],
+            c0: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_driven_constraint_rows_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        inputs: &[Dual64],
-        d: &mut [Dual64],
-        d0: &mut [Dual64],
-    ) -> Result<(), ModelError> {
-        self.driven_constraint_rows(t, q, inputs, d, d0)
-    }
+        /// [`Model::driven_constraint_residuals`].
+        fn dyn_driven_constraint_residuals => driven_constraint_residuals(
+            t: f64,
+            q: &[f64],
+            qdot: &[f64],
+            inputs: &[f64],
+            holonomic: &mut [f64],
+            velocity: &mut [f64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_dependent_block_margin(
-        &self,
-        t: f64,
-        q: &[f64],
-        inputs: &[f64],
-    ) -> Result<f64, ModelError> {
-        self.dependent_block_margin(t, q, inputs)
-    }
+        /// [`Model::driven_kinetic_energy`].
+        fn dyn_driven_kinetic_energy => driven_kinetic_energy(
+            t: f64,
+            q: &[f64],
+            u: &[f64],
+            inputs: &[f64],
+        ) -> Result<f64, ModelError>;
 
-    fn dyn_driven_coordinate_rates(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-        qdot: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.driven_coordinate_rates(t, q, u, inputs, qdot)
-    }
+        /// [`Model::driven_kinetic_energy`] in [`Dual64`].
+        fn dyn_driven_kinetic_energy_dual => driven_kinetic_energy(
+            t: Dual64,
+            q: &[Dual64],
+            u: &[Dual64],
+            inputs: &[Dual64],
+        ) -> Result<Dual64, ModelError>;
 
-    fn dyn_driven_coordinate_rates_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        u: &[Dual64],
-        inputs: &[Dual64],
-        qdot: &mut [Dual64],
-    ) -> Result<(), ModelError> {
-        self.driven_coordinate_rates(t, q, u, inputs, qdot)
-    }
+        /// [`Model::constraint_rows`] in [`Dual64`].
+        fn dyn_constraint_rows_dual => constraint_rows(
+            t: Dual64,
+            q: &[Dual64],
+            d: &mut [Dual64],
+            d0: &mut [Dual64],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_driven_speed_transform(
-        &self,
-        t: f64,
-        q: &[f64],
-        inputs: &[f64],
-        c: &mut [f64],
-        c0: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.driven_speed_transform(t, q, inputs, c, c0)
-    }
+        /// [`Model::load_geometry`].
+        fn dyn_load_geometry => load_geometry(
+            t: f64,
+            q: &[f64],
+            points: &mut [[f64; 3]],
+            frames: &mut [[f64; 9]],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_driven_constraint_residuals(
-        &self,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-        inputs: &[f64],
-        holonomic: &mut [f64],
-        velocity: &mut [f64],
-    ) -> Result<(), ModelError> {
-        self.driven_constraint_residuals(t, q, qdot, inputs, holonomic, velocity)
-    }
+        /// [`Model::load_geometry`] in [`Dual64`].
+        fn dyn_load_geometry_dual => load_geometry(
+            t: Dual64,
+            q: &[Dual64],
+            points: &mut [[Dual64; 3]],
+            frames: &mut [[Dual64; 9]],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_driven_kinetic_energy(
-        &self,
-        t: f64,
-        q: &[f64],
-        u: &[f64],
-        inputs: &[f64],
-    ) -> Result<f64, ModelError> {
-        self.driven_kinetic_energy(t, q, u, inputs)
-    }
+        /// [`Model::contact_geometry`].
+        fn dyn_contact_geometry => contact_geometry(
+            t: f64,
+            q: &[f64],
+            points: &mut [[f64; 3]],
+            directions: &mut [[f64; 3]],
+        ) -> Result<(), ModelError>;
 
-    fn dyn_driven_kinetic_energy_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        u: &[Dual64],
-        inputs: &[Dual64],
-    ) -> Result<Dual64, ModelError> {
-        self.driven_kinetic_energy(t, q, u, inputs)
-    }
+        /// [`Model::contact_points`].
+        fn dyn_contact_points => contact_points(t: f64, q: &[f64], points: &mut [[f64; 3]])
+            -> Result<(), ModelError>;
 
-    fn dyn_load_geometry(
-        &self,
-        t: f64,
-        q: &[f64],
-        points: &mut [[f64; 3]],
-        frames: &mut [[f64; 9]],
-    ) -> Result<(), ModelError> {
-        self.load_geometry(t, q, points, frames)
-    }
-
-    fn dyn_load_geometry_dual(
-        &self,
-        t: Dual64,
-        q: &[Dual64],
-        points: &mut [[Dual64; 3]],
-        frames: &mut [[Dual64; 9]],
-    ) -> Result<(), ModelError> {
-        self.load_geometry(t, q, points, frames)
-    }
-
-    fn dyn_contact_geometry(
-        &self,
-        t: f64,
-        q: &[f64],
-        points: &mut [[f64; 3]],
-        directions: &mut [[f64; 3]],
-    ) -> Result<(), ModelError> {
-        self.contact_geometry(t, q, points, directions)
-    }
-
-    fn dyn_contact_links(&self) -> &'static [&'static str] {
-        M::contact_links()
-    }
-
-    fn dyn_joint_limits(&self) -> &'static [crate::JointLimit] {
-        M::joint_limits()
-    }
-
-    fn dyn_contact_points(
-        &self,
-        t: f64,
-        q: &[f64],
-        points: &mut [[f64; 3]],
-    ) -> Result<(), ModelError> {
-        self.contact_points(t, q, points)
-    }
-
-    fn dyn_load_values(
-        &self,
-        t: f64,
-        q: &[f64],
-        qdot: &[f64],
-        inputs: &[f64],
-        forces: &mut [[f64; 3]],
-        torques: &mut [[f64; 3]],
-    ) -> Result<(), ModelError> {
-        self.load_values(t, q, qdot, inputs, forces, torques)
+        /// [`Model::load_values`].
+        fn dyn_load_values => load_values(
+            t: f64,
+            q: &[f64],
+            qdot: &[f64],
+            inputs: &[f64],
+            forces: &mut [[f64; 3]],
+            torques: &mut [[f64; 3]],
+        ) -> Result<(), ModelError>;
     }
 }
