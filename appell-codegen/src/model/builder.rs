@@ -96,11 +96,11 @@ pub(super) fn build_in(
         return None;
     }
     // The tree's numbers in the graph last, after everything the model
-    // itself makes.
-    let tree = super::tree::tree_spec(ast).and_then(|spec| {
-        spec.lower(&mut b.g)
-            .map_err(|e| format!("the tree's numbers could not be lowered: {e}"))
-    });
+    // itself makes; the twin (built again in the same graph) keeps none.
+    let tree = match b.cut_from {
+        Some(_) => Err("the twin keeps no tree".to_string()),
+        None => lowered_tree(cx, ast, &mut b.g),
+    };
     let model = Model {
         g: b.g,
         name: ast.name.clone(),
@@ -137,6 +137,19 @@ pub(super) fn build_in(
         tree,
     };
     Some((model, b.cuts))
+}
+
+/// The tree of joints with its numbers in `g`, or why the model is not one.
+/// A number that cannot be lowered (every name in it was resolved with the
+/// model, so this is not the model's fault) is an error, not a quiet
+/// fallback to the closed form.
+fn lowered_tree(cx: &Ctxt, ast: &ModelAst, g: &mut Graph) -> Result<super::tree::TreeSpec, String> {
+    let spec = super::tree::tree_spec(ast)?;
+    spec.lower(g).map_err(|e| {
+        let why = format!("lowering the joint tree's numbers failed: {e}");
+        cx.error_at(ast.name.span(), why.clone());
+        why
+    })
 }
 
 /// Every effect (the loads', then those only constraints name, then the

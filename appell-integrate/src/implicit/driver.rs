@@ -104,7 +104,6 @@ impl TrBdf2 {
             };
 
             // Error estimate, filtered by the iteration matrix.
-            // Error estimate, filtered by the iteration matrix.
             let err = st.error(&it, hs, &x, &f0, self.atol, self.rtol);
             if let Some((non_finite, factor)) = self.rejection(err, &st.y3) {
                 stats.rejected += 1;

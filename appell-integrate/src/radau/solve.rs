@@ -252,7 +252,7 @@ impl Radau5 {
     ///
     /// ```
     /// use appell_integrate::{IntegrateError, Radau5};
-    /// use appell_core::{Model, ModelError};
+    /// use appell_core::ModelError;
     /// # use appell_core::__doc_model::Oscillator;
     ///
     /// // x'' = −w² x, x(0) = 1, x'(0) = 0: x(t) = cos(w t).

@@ -362,15 +362,23 @@ class Model:
     def step_jacobian(self, x: ArrayLike, u: Optional[ArrayLike] = None, *, h: float,
                       method: str = "rk4", t: float = 0.0,
                       params: Any = None) -> Tuple[np.ndarray, np.ndarray, np.ndarray]:
-        """One fixed step of size ``h`` of the integrator a controller loop
-        runs, the inputs held over it, and its Jacobians in one call:
-        (x⁺, A = ∂x⁺/∂x, B = ∂x⁺/∂u), what a discrete-time MPC or DDP
+        """One fixed step of size ``h`` from time ``t`` of the integrator a
+        controller loop runs, the inputs ``u`` held over it, and its
+        Jacobians in one call: (x⁺, A = ∂x⁺/∂x of shape (s, s),
+        B = ∂x⁺/∂u of shape (s, inputs)), what a discrete-time MPC or DDP
         solver linearizes at every knot. ``method``: ``"rk4"`` (the
         classical Runge–Kutta step) or ``"semi_implicit_euler"`` (the
-        speeds first, u⁺ = u + h u̇, then the retained coordinates at the
+        speeds first, v⁺ = v + h v̇, then the retained coordinates at the
         new speeds). Exact to rounding: the chain rule through the stages
         of the generated Jacobian (``has_jacobian``), else the step in dual
-        numbers. Batched over rows of ``x`` and ``u``; one ``h``."""
+        numbers. Batched over rows of ``x`` and ``u``; one ``h``.
+
+        ``x`` is the reduced state (:meth:`reduced_state`): a free base's
+        quaternion is four of its components and is not renormalised by
+        the step, so A is not Crocoddyl's tangent-space Jacobian. An
+        unknown ``method`` is ValueError; a non-finite ``h``, ``x`` or
+        ``u``, or a failed step, ModelError. ``params``: parameter values
+        for this call only."""
         op = self._STEP_METHODS.get(method)
         if op is None:
             raise ValueError(f"unknown method {method!r}; the fixed steps are {sorted(self._STEP_METHODS)}"

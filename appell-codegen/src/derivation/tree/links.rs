@@ -1,4 +1,6 @@
-//! From the tree as written to the links the recursions walk: each moving
+//! From the lowered tree (its numbers graph nodes, see
+//! [`TreeSpec::lower`](crate::model::tree::TreeSpec::lower)) to the links
+//! the recursions walk: each moving
 //! joint's transform from its parent link (welded links merged into the
 //! link they are fixed to), its motion subspace, its inertia, its input.
 
@@ -455,7 +457,7 @@ fn link_inertia(a: &mut Algebra, bodies: &[MassSpec]) -> R<M6> {
     Ok(total)
 }
 
-/// The central inertia as written, in the body's axes.
+/// The central inertia as a matrix, in the body's axes.
 fn inertia_matrix(a: &mut Algebra, inertia: &CentralInertia) -> R<M3> {
     let mut m = [[a.zero(); 3]; 3];
     match *inertia {
