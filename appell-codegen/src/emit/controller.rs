@@ -158,18 +158,9 @@ impl Emitter<'_> {
         ];
         let (params_t, pos) = (&c.params_t, &c.positivity);
         let (bind_q, bind_u) = (self.bind_q("__q"), self.bind_u("__u"));
-        let bind_a = self
-            .d
-            .constraint_set
-            .speed_specs
-            .iter()
-            .enumerate()
-            .map(|(k, spec)| {
-                let (a, k) = (self.ident(g.symbol_name(spec.accel)), int(k));
-                quote!(let #a = __accel[#k];)
-            });
+        let bind_a = self.bind_accel("__accel");
         let body = braced([quote! {
-            #params_t #bind_q #bind_u #(#bind_a)*
+            #params_t #bind_q #bind_u #bind_a
             #body
             #(#writes)*
         }]);
@@ -214,17 +205,7 @@ impl Emitter<'_> {
             (TokenStream::new(), TokenStream::new())
         };
         let (chk_a, bind_a) = if name == "inverse_dynamics" {
-            let binds = self
-                .d
-                .constraint_set
-                .speed_specs
-                .iter()
-                .enumerate()
-                .map(|(k, spec)| {
-                    let (a, k) = (self.ident(g.symbol_name(spec.accel)), int(k));
-                    quote!(let #a = __accel[#k];)
-                });
-            (self.check("__accel", l), quote!(#(#binds)*))
+            (self.check("__accel", l), self.bind_accel("__accel"))
         } else {
             (TokenStream::new(), TokenStream::new())
         };

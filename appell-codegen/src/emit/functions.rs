@@ -740,7 +740,7 @@ impl Emitter<'_> {
             .iter()
             .map(|&r| self.coord(r).to_string())
             .collect();
-        names.extend(self.d.constraint_set.speed_specs.iter().map(|sp| {
+        names.extend(self.speeds().iter().map(|sp| {
             let name = self.model.g.symbol_name(sp.symbol).to_string();
             match sp.coordinate {
                 Some(_) => name,

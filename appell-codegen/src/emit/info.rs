@@ -40,14 +40,7 @@ impl Emitter<'_> {
         let name = self.info_name();
         let params = strings(model.params.iter().map(|p| p.ident.to_string()).collect());
         let all = names(&(0..d.n).collect::<Vec<_>>());
-        let speeds = strings(
-            self.d
-                .constraint_set
-                .speed_specs
-                .iter()
-                .map(|sp| sp.name.clone())
-                .collect(),
-        );
+        let speeds = strings(self.speeds().iter().map(|sp| sp.name.clone()).collect());
         let dependent = names(&d.speeds.dependent);
         let cyclic = names(&d.reduction.cyclic);
         let ignorable = names(&d.reduction.ignorable);

@@ -182,20 +182,34 @@ impl Emitter<'_> {
         quote!(#(#binds)*)
     }
 
+    /// The privileged speeds this implementation's derivation has (a
+    /// scene's own, where it names them).
+    fn speeds(&self) -> &[crate::model::SpeedSpec] {
+        &self.d.constraint_set.speed_specs
+    }
+
     /// `let u_k = slice[k];` for every privileged speed.
     fn bind_u(&self, slice: &str) -> TokenStream {
+        self.bind_speeds(slice, |spec| spec.symbol)
+    }
+
+    /// `let a_k = slice[k];` for every privileged speed's acceleration.
+    fn bind_accel(&self, slice: &str) -> TokenStream {
+        self.bind_speeds(slice, |spec| spec.accel)
+    }
+
+    /// `let s_k = slice[k];` for the symbol `of` each privileged speed.
+    fn bind_speeds(
+        &self,
+        slice: &str,
+        of: impl Fn(&crate::model::SpeedSpec) -> appell_symbolic::Symbol,
+    ) -> TokenStream {
         let slice = self.ident(slice);
         let g = &self.model.g;
-        let binds = self
-            .d
-            .constraint_set
-            .speed_specs
-            .iter()
-            .enumerate()
-            .map(|(k, spec)| {
-                let (u, k) = (self.ident(g.symbol_name(spec.symbol)), int(k));
-                quote!(let #u = #slice[#k];)
-            });
+        let binds = self.speeds().iter().enumerate().map(|(k, spec)| {
+            let (s, k) = (self.ident(g.symbol_name(of(spec))), int(k));
+            quote!(let #s = #slice[#k];)
+        });
         quote!(#(#binds)*)
     }
 
@@ -208,19 +222,13 @@ impl Emitter<'_> {
             let (q, k) = (self.coord(r), int(k));
             quote!(let #q = __state[#k];)
         });
-        let state_u = self
-            .d
-            .constraint_set
-            .speed_specs
-            .iter()
-            .enumerate()
-            .map(|(k, spec)| {
-                let (u, k) = (
-                    self.ident(g.symbol_name(spec.symbol)),
-                    int(retained.len() + k),
-                );
-                quote!(let #u = __state[#k];)
-            });
+        let state_u = self.speeds().iter().enumerate().map(|(k, spec)| {
+            let (u, k) = (
+                self.ident(g.symbol_name(spec.symbol)),
+                int(retained.len() + k),
+            );
+            quote!(let #u = __state[#k];)
+        });
         quote!(#(#state_q)* #(#state_u)*)
     }
 

@@ -255,7 +255,7 @@ pub fn columns(model: &Model, d: &Derivation) -> Columns {
         .retained
         .iter()
         .map(|&r| model.coords[r].1.q)
-        .chain(d.constraint_set.speed_specs.iter().map(|s| s.symbol))
+        .chain(d.map.speed_rates.iter().copied())
         .collect();
     let inputs = model.inputs.iter().map(|(_, s)| *s).collect();
     Columns { state, inputs }
@@ -309,12 +309,7 @@ fn recursive(
     let spec = model.tree.clone()?;
     let residual = super::tree::residual(model, &spec, &d.reduction.ignorable)
         .map_err(|e| format!("the residual failed: {e}"))?;
-    let accels: Vec<Symbol> = d
-        .constraint_set
-        .speed_specs
-        .iter()
-        .map(|s| s.accel)
-        .collect();
+    let accels = d.map.accels.clone();
     let rates = retained_rates(d);
     let mass = lower_triangle(&residual.mass, d.l);
     let g = &mut model.g;
@@ -361,7 +356,7 @@ pub fn inverse_dynamics(model: &mut Model, d: &Derivation) -> Result<Vec<Id>, St
             .coords
             .iter()
             .map(|c| c.1.q)
-            .chain(d.constraint_set.speed_specs.iter().map(|s| s.symbol))
+            .chain(d.map.speed_rates.iter().copied())
             .collect(),
         inputs: Vec::new(),
     };

@@ -111,12 +111,7 @@ fn right_sides(
             found: "accelerations given".to_string(),
         })?;
     let l = d.l;
-    let speeds: Vec<Symbol> = d
-        .constraint_set
-        .speed_specs
-        .iter()
-        .map(|s| s.symbol)
-        .collect();
+    let speeds = d.map.speed_rates.clone();
     let rates = retained_rates(d);
     let g = &mut model.g;
     let derivatives = self::derivatives(g, &rates, columns)?;
@@ -346,10 +341,10 @@ pub(super) fn world_inverse_dynamics(
         allowed,
         |model| {
             let accels: Vec<Id> = d
-                .constraint_set
-                .speed_specs
+                .map
+                .accels
                 .iter()
-                .map(|s| model.g.sym(s.accel))
+                .map(|&a| model.g.sym(a))
                 .collect::<Result<_, _>>()?;
             let w = world_frame(model, &[], Accelerations::At(&accels))?;
             let (n, l) = (model.coords.len(), w.coordinates.len());
